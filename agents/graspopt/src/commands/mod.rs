@@ -1,0 +1,3 @@
+//! The subcommands of `graspopt`.
+
+pub mod quality;

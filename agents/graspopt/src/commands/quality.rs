@@ -1,0 +1,302 @@
+//! `graspopt quality --input FILE [--format json|table] [--timing]`: the metrics of
+//! every case of a JSON file shaped like `shared/reference/metric-cases.json`: an object
+//! with `cases`, each with `params` + `contacts`, or `wrenches`, or both (contacts win).
+//!
+//! One output row per case, in order. A bad case prints an error naming the case index
+//! and the field (on stderr, and as `{"error": ...}` in its JSON row) and the others are
+//! still evaluated; the exit status is then 1.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use graspopt_quality::metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
+use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, Wrench};
+use nalgebra::Vector3;
+use serde::Serialize;
+use serde_json::{Value, json};
+
+#[derive(Args, Debug)]
+pub struct QualityArgs {
+    /// JSON file with a `cases` array.
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Json)]
+    pub format: Format,
+    /// Add `micros`: the median microseconds per evaluation over repeated runs.
+    #[arg(long)]
+    pub timing: bool,
+    /// Skip the Grasp Wrench Volume (it needs the full hull, slow for surface models).
+    #[arg(long)]
+    pub no_volume: bool,
+    /// Solver for the distance from the origin to the wrench hull.
+    #[arg(long, value_enum, default_value_t = Solver::MinNorm)]
+    pub solver: Solver,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// One JSON object per line.
+    Json,
+    /// An aligned text table.
+    Table,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Solver {
+    /// Wolfe's minimum-norm-point algorithm (default).
+    MinNorm,
+    /// The conic program solved by Clarabel.
+    Clarabel,
+}
+
+pub fn run(args: &QualityArgs) -> Result<ExitCode> {
+    let text = std::fs::read_to_string(&args.input)
+        .with_context(|| format!("cannot read {}", args.input.display()))?;
+    let doc: Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not valid JSON", args.input.display()))?;
+    let Some(cases) = doc.get("cases").and_then(Value::as_array) else {
+        bail!(
+            "{}: expected an object with a `cases` array",
+            args.input.display()
+        );
+    };
+    let options = MetricsOptions {
+        volume: !args.no_volume,
+        distance_solver: match args.solver {
+            Solver::MinNorm => DistanceSolver::MinNorm,
+            Solver::Clarabel => DistanceSolver::Clarabel,
+        },
+    };
+    let mut out = std::io::stdout().lock();
+    let mut failed = 0;
+    let written = (|| -> std::io::Result<()> {
+        if args.format == Format::Table {
+            write_table_header(&mut out, args.timing)?;
+        }
+        for (i, case) in cases.iter().enumerate() {
+            let row = parse_case(case)
+                .and_then(|grasp| {
+                    let metrics = evaluate(&grasp, &options)?;
+                    let micros = args.timing.then(|| median_micros(&grasp, &options));
+                    Ok((metrics, micros))
+                })
+                .map_err(|e| format!("case {i}: {e:#}"));
+            if let Err(message) = &row {
+                eprintln!("graspopt: {message}");
+                failed += 1;
+            }
+            match args.format {
+                Format::Json => writeln!(out, "{}", json_row(&row))?,
+                Format::Table => write_table_row(&mut out, i, &row)?,
+            }
+        }
+        out.flush()
+    })();
+    match written {
+        // A closed pipe (`graspopt quality ... | head`) is the reader's choice, not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(ExitCode::SUCCESS),
+        Err(e) => return Err(e).context("cannot write the results"),
+        Ok(()) => {}
+    }
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("graspopt: {failed} of {} cases failed", cases.len());
+        ExitCode::FAILURE
+    })
+}
+
+type Row = std::result::Result<(Metrics, Option<f64>), String>;
+
+/// One JSON output row, keys in the documented order.
+#[derive(Serialize)]
+struct JsonRow {
+    rank: usize,
+    force_closure: bool,
+    epsilon: f64,
+    volume: Option<f64>,
+    distance: f64,
+    bw: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    micros: Option<f64>,
+}
+
+fn json_row(row: &Row) -> String {
+    match row {
+        Ok((m, micros)) => serde_json::to_string(&JsonRow {
+            rank: m.rank,
+            force_closure: m.force_closure,
+            epsilon: m.epsilon,
+            volume: m.volume,
+            distance: m.distance,
+            bw: m.bw,
+            micros: *micros,
+        })
+        .unwrap_or_else(|e| json!({ "error": e.to_string() }).to_string()),
+        Err(message) => json!({ "error": message }).to_string(),
+    }
+}
+
+fn write_table_header(out: &mut impl Write, timing: bool) -> std::io::Result<()> {
+    write!(
+        out,
+        "{:>5} {:>4} {:>5} {:>15} {:>15} {:>15} {:>16}",
+        "case", "rank", "fc", "epsilon", "volume", "distance", "bw"
+    )?;
+    if timing {
+        write!(out, " {:>10}", "micros")?;
+    }
+    writeln!(out)
+}
+
+fn write_table_row(out: &mut impl Write, i: usize, row: &Row) -> std::io::Result<()> {
+    match row {
+        Ok((m, micros)) => {
+            let volume = m.volume.map_or("-".to_string(), |v| format!("{v:.9e}"));
+            write!(
+                out,
+                "{i:>5} {:>4} {:>5} {:>15.9e} {volume:>15} {:>15.9e} {:>16.9e}",
+                m.rank, m.force_closure, m.epsilon, m.distance, m.bw
+            )?;
+            if let Some(us) = micros {
+                write!(out, " {us:>10.1}")?;
+            }
+            writeln!(out)
+        }
+        Err(message) => writeln!(out, "{i:>5} error: {message}"),
+    }
+}
+
+/// The median time of one evaluation, over repeated runs (at least 5, and at least
+/// 50 ms in total, at most 1,000 runs).
+fn median_micros(grasp: &GraspMap, options: &MetricsOptions) -> f64 {
+    let mut samples = Vec::new();
+    let started = Instant::now();
+    while samples.len() < 5
+        || (started.elapsed() < Duration::from_millis(50) && samples.len() < 1000)
+    {
+        let t = Instant::now();
+        let _ = std::hint::black_box(evaluate(std::hint::black_box(grasp), options));
+        samples.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+/// The grasp map of one case: from `params` + `contacts` when contacts are present,
+/// else from `wrenches`.
+fn parse_case(case: &Value) -> Result<GraspMap> {
+    let Some(obj) = case.as_object() else {
+        bail!("expected an object");
+    };
+    if let Some(contacts) = obj.get("contacts") {
+        let params = obj.get("params").context("`contacts` given without `params`")?;
+        let model = parse_params(params)?;
+        let contacts = parse_contacts(contacts)?;
+        return GraspMap::from_contacts(&contacts, &model).map_err(|e| anyhow::anyhow!("contacts: {e}"));
+    }
+    if let Some(wrenches) = obj.get("wrenches") {
+        let list = wrenches.as_array().context("wrenches: expected an array")?;
+        let parsed = list
+            .iter()
+            .enumerate()
+            .map(|(k, w)| {
+                let v = numbers(w, 6).with_context(|| format!("wrenches[{k}]"))?;
+                Ok(Wrench::from_row_slice(&v))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        return GraspMap::from_wrenches(parsed).map_err(|e| anyhow::anyhow!("wrenches: {e}"));
+    }
+    bail!("neither `contacts` (with `params`) nor `wrenches` given")
+}
+
+fn parse_params(params: &Value) -> Result<GraspModel> {
+    let obj = params.as_object().context("params: expected an object")?;
+    let number = |name: &str| -> Result<f64> {
+        obj.get(name)
+            .with_context(|| format!("params.{name}: missing"))?
+            .as_f64()
+            .with_context(|| format!("params.{name}: expected a number"))
+    };
+    let model = obj
+        .get("model")
+        .and_then(Value::as_str)
+        .context("params.model: expected \"frictionless\", \"point_friction\" or \"soft_finger\"")?;
+    let edges = || -> Result<usize> {
+        let e = obj.get("edges").context("params.edges: missing")?;
+        let n = e
+            .as_u64()
+            .context("params.edges: expected a whole number of cone edges")?;
+        usize::try_from(n).context("params.edges: too large")
+    };
+    let contact = match model {
+        "frictionless" => ContactModel::Frictionless,
+        "point_friction" => ContactModel::PointFriction {
+            mu: number("mu")?,
+            edges: edges()?,
+        },
+        "soft_finger" => ContactModel::SoftFinger {
+            mu: number("mu")?,
+            edges: edges()?,
+            gamma: number("gamma")?,
+        },
+        other => bail!(
+            "params.model: unknown model {other:?} (expected frictionless, point_friction or soft_finger)"
+        ),
+    };
+    let reference_point = match obj.get("reference_point") {
+        Some(v) => vector3(v).context("params.reference_point")?,
+        None => Vector3::zeros(),
+    };
+    let torque_scale = match obj.get("torque_scale") {
+        Some(_) => number("torque_scale")?,
+        None => 1.0,
+    };
+    let model = GraspModel {
+        contact,
+        reference_point,
+        torque_scale,
+    };
+    model.validate().map_err(|e| anyhow::anyhow!("params: {e}"))?;
+    Ok(model)
+}
+
+fn parse_contacts(contacts: &Value) -> Result<Vec<Contact>> {
+    let list = contacts.as_array().context("contacts: expected an array")?;
+    list.iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let position = c
+                .get("position")
+                .with_context(|| format!("contacts[{k}].position: missing"))
+                .and_then(|v| vector3(v).with_context(|| format!("contacts[{k}].position")))?;
+            let normal = c
+                .get("normal")
+                .with_context(|| format!("contacts[{k}].normal: missing"))
+                .and_then(|v| vector3(v).with_context(|| format!("contacts[{k}].normal")))?;
+            Ok(Contact::new(position, normal))
+        })
+        .collect()
+}
+
+fn vector3(v: &Value) -> Result<Vector3<f64>> {
+    let n = numbers(v, 3)?;
+    Ok(Vector3::new(n[0], n[1], n[2]))
+}
+
+fn numbers(v: &Value, len: usize) -> Result<Vec<f64>> {
+    let list = v
+        .as_array()
+        .with_context(|| format!("expected an array of {len} numbers"))?;
+    if list.len() != len {
+        bail!("expected {len} numbers, got {}", list.len());
+    }
+    list.iter()
+        .map(|x| x.as_f64().with_context(|| format!("expected a number, got {x}")))
+        .collect()
+}

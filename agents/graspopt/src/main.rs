@@ -1,0 +1,36 @@
+//! `graspopt`: the one command users install. Each subcommand lives in `commands/` and
+//! wires a library crate to files and the terminal.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod commands;
+
+#[derive(Parser, Debug)]
+#[command(name = "graspopt", version, about = "Find good robotic grasps by trial")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Grasp-quality metrics (rank, force closure, epsilon, volume, distance, BW) of the
+    /// cases in a JSON file.
+    Quality(commands::quality::QualityArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Quality(args) => commands::quality::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("graspopt: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,821 @@
+//! The ask/tell Bayesian optimisation engine (thesis section 3.4, plus batch proposals).
+//!
+//! Convention: the optimizer **maximises** (grasp quality) unless [`Settings::minimize`] is set,
+//! in which case observations are negated internally and [`Optimizer::best`] reports the
+//! minimum. Inputs are scaled to the unit cube and outputs standardised at every iteration;
+//! hyperparameters are refitted (MAP, warm-started) on every proposal round, with random
+//! restarts every [`Settings::full_refit_every`] rounds. The acquisition (log-EI by default) is
+//! maximised by DIRECT on the unit cube and polished by L-BFGS from the best few rectangles.
+//! Batches (`q > 1`, or points still pending from earlier calls) use the kriging believer or a
+//! constant liar. The whole state serialises with serde, including the generator state, so a
+//! restored optimizer proposes exactly what the original would have (serde_json needs its
+//! `float_roundtrip` feature for bit-exact floats).
+
+use serde::{Deserialize, Serialize};
+
+use crate::acquisition::{
+    self, AcquisitionKind, LOG_EI_FLOOR, XiRule, expected_improvement, log_expected_improvement,
+};
+use crate::baseline::AskTell;
+use crate::direct::{self, DirectSettings};
+use crate::error::{BoError, Result};
+use crate::fit::{FitSettings, Hyperparameters, fit_map};
+use crate::gp::Gp;
+use crate::kernel::KernelKind;
+use crate::rng::Rng;
+
+/// Value assumed for pending points when proposing a batch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum BatchStrategy {
+    /// Kriging believer: the posterior mean at the pending point.
+    #[default]
+    KrigingBeliever,
+    /// Constant liar with the worst observed value (pessimistic, spreads points most).
+    ConstantLiarMin,
+    /// Constant liar with the mean of the observations.
+    ConstantLiarMean,
+    /// Constant liar with the best observed value (optimistic).
+    ConstantLiarMax,
+}
+
+/// When to stop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StopRule {
+    /// Stop once this many observations are in (None: no budget).
+    pub budget: Option<usize>,
+    /// Stop on small EI only after this many observations (None: 10 x d).
+    pub min_evals: Option<usize>,
+    /// Threshold on the best EI divided by the observed range of y.
+    pub relative_ei_threshold: f64,
+    /// Number of consecutive proposal rounds below the threshold needed to stop.
+    pub patience: usize,
+}
+
+impl Default for StopRule {
+    fn default() -> Self {
+        StopRule {
+            budget: None,
+            min_evals: None,
+            relative_ei_threshold: 1e-6,
+            patience: 3,
+        }
+    }
+}
+
+/// Why the optimizer says to stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StopReason {
+    /// The evaluation budget is used up.
+    Budget,
+    /// The best EI stayed below the threshold for `patience` rounds after `min_evals`.
+    SmallExpectedImprovement,
+}
+
+/// Engine settings. Defaults follow the thesis (Matern 3/2, EI with xi = sigma_f^2/100,
+/// DIRECT) plus the robustness measures listed in the module doc.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Minimise instead of maximise.
+    pub minimize: bool,
+    /// Kernel family.
+    pub kernel: KernelKind,
+    /// Size of the random initial design (None: `max(5, ceil(5 d / 3))`, i.e. 5 in 2D, 10 in
+    /// 6D).
+    pub n_init: Option<usize>,
+    /// Acquisition function.
+    pub acquisition: AcquisitionKind,
+    /// EI exploration margin rule (thesis default `sigma_f^2 / 100`).
+    pub xi: XiRule,
+    /// Hyperparameter priors, bounds and effort.
+    pub fit: FitSettings,
+    /// Random restarts of the fit every this many proposal rounds (1 = always; others are
+    /// warm-started only).
+    pub full_refit_every: usize,
+    /// DIRECT budget per input dimension for the acquisition maximisation.
+    pub direct_evals_per_dim: usize,
+    /// Local polish starts (best DIRECT centres); 0 disables the polish.
+    pub polish_starts: usize,
+    /// L-BFGS iterations per polish start.
+    pub polish_iters: usize,
+    /// Batch strategy for pending points.
+    pub batch: BatchStrategy,
+    /// When the best EI (standardised units) falls below this, propose instead the most
+    /// uncertain of 100 d random candidates (a space-filling exploration step that helps leave
+    /// a local optimum in higher dimensions). None disables it.
+    pub explore_below_ei: Option<f64>,
+    /// GP prior mean at this quantile of the (transformed) observations instead of their
+    /// mean (None: the mean). Low quantiles are pessimistic away from data.
+    pub prior_mean_quantile: Option<f64>,
+    /// Monotone transform of the outputs applied before standardising.
+    pub output_transform: OutputTransform,
+    /// Stopping rule.
+    pub stop: StopRule,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            minimize: false,
+            kernel: KernelKind::Matern32,
+            n_init: None,
+            acquisition: AcquisitionKind::ExpectedImprovement,
+            xi: XiRule::ThesisSignalVariance,
+            fit: FitSettings::default(),
+            full_refit_every: 5,
+            direct_evals_per_dim: 250,
+            polish_starts: 3,
+            polish_iters: 30,
+            batch: BatchStrategy::KrigingBeliever,
+            output_transform: OutputTransform::None,
+            prior_mean_quantile: None,
+            explore_below_ei: None,
+            stop: StopRule::default(),
+        }
+    }
+}
+
+impl Settings {
+    /// Default initial-design size for dimension `d`.
+    pub fn default_n_init(d: usize) -> usize {
+        (5 * d).div_ceil(3).max(5)
+    }
+
+    fn validate(&self) -> Result<()> {
+        self.fit.validate()?;
+        if self.direct_evals_per_dim == 0 || self.full_refit_every == 0 {
+            return Err(BoError::InvalidSetting(
+                "direct_evals_per_dim and full_refit_every must be >= 1".into(),
+            ));
+        }
+        match self.xi {
+            XiRule::Fixed(v) | XiRule::SignalVarianceTimes(v) if !(v >= 0.0 && v.is_finite()) => {
+                return Err(BoError::InvalidSetting(format!("xi must be >= 0, got {v}")));
+            }
+            _ => {}
+        }
+        if let AcquisitionKind::Ucb { beta } = self.acquisition
+            && !(beta > 0.0 && beta.is_finite())
+        {
+            return Err(BoError::InvalidSetting(format!("UCB beta must be > 0, got {beta}")));
+        }
+        if !(self.stop.relative_ei_threshold >= 0.0) {
+            return Err(BoError::InvalidSetting("relative_ei_threshold must be >= 0".into()));
+        }
+        Ok(())
+    }
+}
+
+/// Diagnostics of the last proposal round.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct RoundInfo {
+    /// EI (standardised units) at the first model-based proposal of the round.
+    pub best_ei: Option<f64>,
+    /// The same divided by the observed range of y (raw units).
+    pub relative_ei: Option<f64>,
+    /// xi used (standardised units).
+    pub xi: Option<f64>,
+    /// Number of random (initial-design) points in the round.
+    pub random_points: usize,
+    /// Number of exploration steps (see [`Settings::explore_below_ei`]) in the round.
+    pub exploration_points: usize,
+}
+
+/// The ask/tell optimizer. See the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Optimizer {
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    settings: Settings,
+    seed: u64,
+    rng: Rng,
+    xs: Vec<Vec<f64>>,
+    ys: Vec<f64>,
+    pending: Vec<Vec<f64>>,
+    hyper: Option<Hyperparameters>,
+    rounds: usize,
+    low_ei_streak: usize,
+    last_round: RoundInfo,
+}
+
+struct Standardised {
+    x: Vec<Vec<f64>>,
+    y: Vec<f64>,
+    mean: f64,
+    std: f64,
+    warp: Option<Warp>,
+}
+
+/// Monotone output transform applied (to the maximisation-direction values) before
+/// standardising.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum OutputTransform {
+    /// Values as observed.
+    #[default]
+    None,
+    /// Compress the bad tail logarithmically: values below the median `m` map to
+    /// `m - s ln(1 + (m - z) / s)` (`s` = best minus median), the good half stays linear, so a
+    /// few huge bad values do not flatten the model where the optimum is.
+    TailLog,
+    /// Replace values by their rank scores `(rank + 1/2) / n` (ties averaged): a copula-style
+    /// transform that makes mediocre differences visible next to a deep basin.
+    Rank,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Warp {
+    Tail(TailWarp),
+    Rank(RankWarp),
+}
+
+impl Warp {
+    fn forward(&self, z: f64) -> f64 {
+        match self {
+            Warp::Tail(t) => t.forward(z),
+            Warp::Rank(r) => r.forward(z),
+        }
+    }
+    fn inverse(&self, w: f64) -> f64 {
+        match self {
+            Warp::Tail(t) => t.inverse(w),
+            Warp::Rank(r) => r.inverse(w),
+        }
+    }
+    fn slope_at_image(&self, w: f64) -> f64 {
+        match self {
+            Warp::Tail(t) => t.slope_at_image(w),
+            Warp::Rank(r) => {
+                let h = 1e-3;
+                let dz = r.inverse(w + h) - r.inverse(w - h);
+                if dz > 0.0 { 2.0 * h / dz } else { 1.0 }
+            }
+        }
+    }
+}
+
+/// Piecewise-linear rank transform through the sorted distinct observations.
+#[derive(Debug, Clone, PartialEq)]
+struct RankWarp {
+    /// Sorted distinct values and their scores.
+    z: Vec<f64>,
+    w: Vec<f64>,
+}
+
+impl RankWarp {
+    fn fit(z: &[f64]) -> Option<Self> {
+        let n = z.len();
+        if n < 3 {
+            return None;
+        }
+        let mut v = z.to_vec();
+        v.sort_by(|a, b| a.total_cmp(b));
+        let mut zs = Vec::new();
+        let mut ws = Vec::new();
+        let mut i = 0;
+        while i < n {
+            let mut j = i;
+            while j + 1 < n && v[j + 1] == v[i] {
+                j += 1;
+            }
+            zs.push(v[i]);
+            ws.push(((i + j) as f64 / 2.0 + 0.5) / n as f64);
+            i = j + 1;
+        }
+        if zs.len() < 2 {
+            return None;
+        }
+        Some(RankWarp { z: zs, w: ws })
+    }
+
+    fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+        let n = xs.len();
+        if x <= xs[0] {
+            let slope = (ys[1] - ys[0]) / (xs[1] - xs[0]);
+            return ys[0] + slope * (x - xs[0]);
+        }
+        if x >= xs[n - 1] {
+            let slope = (ys[n - 1] - ys[n - 2]) / (xs[n - 1] - xs[n - 2]);
+            return ys[n - 1] + slope * (x - xs[n - 1]);
+        }
+        let k = xs.partition_point(|v| *v <= x).clamp(1, n - 1);
+        let t = (x - xs[k - 1]) / (xs[k] - xs[k - 1]);
+        ys[k - 1] + t * (ys[k] - ys[k - 1])
+    }
+
+    fn forward(&self, z: f64) -> f64 {
+        Self::interp(&self.z, &self.w, z)
+    }
+
+    fn inverse(&self, w: f64) -> f64 {
+        Self::interp(&self.w, &self.z, w)
+    }
+}
+
+/// Monotone output warp that compresses the bad tail logarithmically (values below the
+/// median `m` map to `m - s ln(1 + (m - z) / s)`), leaving the good half linear, so a few
+/// huge bad values do not flatten the model where the optimum is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct TailWarp {
+    m: f64,
+    s: f64,
+}
+
+impl TailWarp {
+    fn fit(z: &[f64]) -> Option<Self> {
+        if z.len() < 3 {
+            return None;
+        }
+        let mut v = z.to_vec();
+        v.sort_by(|a, b| a.total_cmp(b));
+        let m = v[v.len() / 2];
+        let top = v[v.len() - 1] - m;
+        let mut dev: Vec<f64> = v.iter().map(|x| (x - m).abs()).collect();
+        dev.sort_by(|a, b| a.total_cmp(b));
+        let mad = dev[dev.len() / 2];
+        let s = top.max(mad);
+        if s > 0.0 && s.is_finite() {
+            Some(TailWarp { m, s })
+        } else {
+            None
+        }
+    }
+
+    fn forward(&self, z: f64) -> f64 {
+        if z >= self.m {
+            z
+        } else {
+            self.m - self.s * ((self.m - z) / self.s).ln_1p()
+        }
+    }
+
+    fn inverse(&self, w: f64) -> f64 {
+        if w >= self.m {
+            w
+        } else {
+            self.m - self.s * ((self.m - w) / self.s).exp_m1()
+        }
+    }
+
+    /// d forward / dz at the pre-image of `w`.
+    fn slope_at_image(&self, w: f64) -> f64 {
+        if w >= self.m {
+            1.0
+        } else {
+            (-(self.m - w) / self.s).exp()
+        }
+    }
+}
+
+impl Optimizer {
+    /// New optimizer on the box given by `bounds` (one `(lower, upper)` per dimension).
+    pub fn new(bounds: &[(f64, f64)], settings: Settings, seed: u64) -> Result<Self> {
+        let lower: Vec<f64> = bounds.iter().map(|b| b.0).collect();
+        let upper: Vec<f64> = bounds.iter().map(|b| b.1).collect();
+        direct::check_bounds(&lower, &upper)?;
+        settings.validate()?;
+        Ok(Optimizer {
+            lower,
+            upper,
+            settings,
+            seed,
+            rng: Rng::new(seed),
+            xs: Vec::new(),
+            ys: Vec::new(),
+            pending: Vec::new(),
+            hyper: None,
+            rounds: 0,
+            low_ei_streak: 0,
+            last_round: RoundInfo::default(),
+        })
+    }
+
+    /// Input dimension.
+    pub fn dim(&self) -> usize {
+        self.lower.len()
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The seed given at construction.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Observations `(x, y)` so far, in the order told.
+    pub fn observations(&self) -> impl Iterator<Item = (&[f64], f64)> {
+        self.xs.iter().map(|x| x.as_slice()).zip(self.ys.iter().copied())
+    }
+
+    /// Number of observations.
+    pub fn len(&self) -> usize {
+        self.xs.len()
+    }
+
+    /// True before the first observation.
+    pub fn is_empty(&self) -> bool {
+        self.xs.is_empty()
+    }
+
+    /// Points suggested and not yet observed.
+    pub fn pending(&self) -> &[Vec<f64>] {
+        &self.pending
+    }
+
+    /// Forget all pending points (e.g. trials that were abandoned).
+    pub fn clear_pending(&mut self) {
+        self.pending.clear();
+    }
+
+    /// Hyperparameters of the last fit (unit-cube inputs, standardised outputs).
+    pub fn hyperparameters(&self) -> Option<&Hyperparameters> {
+        self.hyper.as_ref()
+    }
+
+    /// Diagnostics of the last proposal round.
+    pub fn last_round(&self) -> &RoundInfo {
+        &self.last_round
+    }
+
+    /// Best observation (maximum, or minimum with `minimize`).
+    pub fn best(&self) -> Option<(Vec<f64>, f64)> {
+        let mut best: Option<usize> = None;
+        for (i, y) in self.ys.iter().enumerate() {
+            let better = match best {
+                None => true,
+                Some(b) => {
+                    if self.settings.minimize {
+                        *y < self.ys[b]
+                    } else {
+                        *y > self.ys[b]
+                    }
+                }
+            };
+            if better {
+                best = Some(i);
+            }
+        }
+        best.map(|i| (self.xs[i].clone(), self.ys[i]))
+    }
+
+    fn n_init(&self) -> usize {
+        self.settings
+            .n_init
+            .unwrap_or_else(|| Settings::default_n_init(self.dim()))
+    }
+
+    fn to_unit(&self, x: &[f64]) -> Vec<f64> {
+        x.iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .map(|(v, (l, u))| ((v - l) / (u - l)).clamp(0.0, 1.0))
+            .collect()
+    }
+
+    fn from_unit(&self, u: &[f64]) -> Vec<f64> {
+        u.iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .map(|(v, (l, h))| (l + v * (h - l)).clamp(*l, *h))
+            .collect()
+    }
+
+    fn check_point(&self, x: &[f64]) -> Result<()> {
+        if x.len() != self.dim() {
+            return Err(BoError::DimensionMismatch {
+                expected: self.dim(),
+                got: x.len(),
+            });
+        }
+        for (i, v) in x.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(BoError::NonFinite { what: "point" });
+            }
+            let (l, u) = (self.lower[i], self.upper[i]);
+            let tol = 1e-9 * (u - l);
+            if *v < l - tol || *v > u + tol {
+                return Err(BoError::OutOfBounds {
+                    dim: i,
+                    value: *v,
+                    lower: l,
+                    upper: u,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Tell the result `y` of evaluating `x`. Removes `x` from the pending points if it is
+    /// one of them. Errors on a dimension mismatch, a point outside the bounds or a
+    /// non-finite value (nothing is recorded then).
+    pub fn observe(&mut self, x: &[f64], y: f64) -> Result<()> {
+        self.check_point(x)?;
+        if !y.is_finite() {
+            return Err(BoError::NonFinite {
+                what: "observation",
+            });
+        }
+        if let Some(i) = self
+            .pending
+            .iter()
+            .position(|p| p.iter().zip(x).all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs())))
+        {
+            self.pending.remove(i);
+        }
+        self.xs.push(x.to_vec());
+        self.ys.push(y);
+        Ok(())
+    }
+
+    /// Why to stop now, if so.
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        if let Some(b) = self.settings.stop.budget
+            && self.xs.len() >= b
+        {
+            return Some(StopReason::Budget);
+        }
+        let min_evals = self.settings.stop.min_evals.unwrap_or(10 * self.dim());
+        if self.xs.len() >= min_evals && self.low_ei_streak >= self.settings.stop.patience.max(1)
+        {
+            return Some(StopReason::SmallExpectedImprovement);
+        }
+        None
+    }
+
+    fn standardised(&self) -> Standardised {
+        let sign = if self.settings.minimize { -1.0 } else { 1.0 };
+        let mut y: Vec<f64> = self.ys.iter().map(|v| sign * v).collect();
+        let warp = match self.settings.output_transform {
+            OutputTransform::None => None,
+            OutputTransform::TailLog => TailWarp::fit(&y).map(Warp::Tail),
+            OutputTransform::Rank => RankWarp::fit(&y).map(Warp::Rank),
+        };
+        if let Some(w) = &warp {
+            y.iter_mut().for_each(|v| *v = w.forward(*v));
+        }
+        let n = y.len().max(1) as f64;
+        let avg = y.iter().sum::<f64>() / n;
+        let var = y.iter().map(|v| (v - avg) * (v - avg)).sum::<f64>() / n;
+        let mean = match self.settings.prior_mean_quantile {
+            Some(qt) if !y.is_empty() => {
+                let mut sorted = y.clone();
+                sorted.sort_by(|a, b| a.total_cmp(b));
+                let k = ((qt.clamp(0.0, 1.0) * (sorted.len() - 1) as f64).round()) as usize;
+                sorted[k.min(sorted.len() - 1)]
+            }
+            _ => avg,
+        };
+        let std = if var.sqrt() > 1e-12 * mean.abs().max(1e-300) && var > 0.0 {
+            var.sqrt()
+        } else {
+            1.0
+        };
+        Standardised {
+            x: self.xs.iter().map(|p| self.to_unit(p)).collect(),
+            y: y.iter().map(|v| (v - mean) / std).collect(),
+            mean,
+            std,
+            warp,
+        }
+    }
+
+    /// Refit the hyperparameters (MAP, warm-started) and build the GP on the observations.
+    fn fit_model(&mut self, data: &Standardised, full: bool) -> Result<Gp> {
+        let restarts = if full || self.hyper.is_none() {
+            self.settings.fit.restarts
+        } else {
+            0
+        };
+        let (h, _) = fit_map(
+            self.settings.kernel,
+            &self.settings.fit,
+            &data.x,
+            &data.y,
+            self.hyper.as_ref(),
+            restarts,
+            &mut self.rng,
+        )?;
+        let gp = Gp::new(
+            data.x.clone(),
+            data.y.clone(),
+            h.kernel(self.settings.kernel),
+            h.noise,
+        )?;
+        self.hyper = Some(h);
+        Ok(gp)
+    }
+
+    /// Posterior mean and standard deviation of the objective at `x` (raw units, the user's
+    /// sign convention), with the hyperparameters of the last fit (prior ones before the
+    /// first). Needs at least one observation.
+    pub fn predict(&self, x: &[f64]) -> Result<(f64, f64)> {
+        self.check_point(x)?;
+        if self.xs.is_empty() {
+            return Err(BoError::NotEnoughData("no observation yet".into()));
+        }
+        let data = self.standardised();
+        let h = self.hyper.clone().unwrap_or_else(|| {
+            Hyperparameters::from_theta(&self.settings.fit.prior_mean(self.dim()))
+        });
+        let gp = Gp::new(data.x, data.y, h.kernel(self.settings.kernel), h.noise)?;
+        let (m, v) = gp.predict(&self.to_unit(x));
+        let sign = if self.settings.minimize { -1.0 } else { 1.0 };
+        let w = data.mean + data.std * m;
+        let sd = data.std * v.sqrt();
+        Ok(match &data.warp {
+            Some(t) => (sign * t.inverse(w), sd / t.slope_at_image(w)),
+            None => (sign * w, sd),
+        })
+    }
+
+    /// Propose `q` new points (distinct from each other, from the observations and from the
+    /// pending points), taking into account the points still pending. The points are added
+    /// to the pending list until observed.
+    pub fn suggest(&mut self, q: usize) -> Result<Vec<Vec<f64>>> {
+        if q == 0 {
+            return Err(BoError::InvalidSetting("q must be >= 1".into()));
+        }
+        let d = self.dim();
+        let mut out: Vec<Vec<f64>> = Vec::with_capacity(q);
+        let mut info = RoundInfo::default();
+        // Initial design (and fallback while fewer than 2 observations exist).
+        while out.len() < q
+            && (self.xs.len() + self.pending.len() + out.len() < self.n_init()
+                || self.xs.len() < 2)
+        {
+            let u = self.rng.unit_point(d);
+            out.push(self.from_unit(&u));
+            info.random_points += 1;
+        }
+        if out.len() < q {
+            let data = self.standardised();
+            let full = self.rounds % self.settings.full_refit_every == 0;
+            let mut gp = self.fit_model(&data, full)?;
+            let signal = gp.kernel().signal_variance;
+            let xi = self.settings.xi.xi(signal);
+            info.xi = Some(xi);
+            let mut incumbent = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let y_mean_std = data.y.iter().sum::<f64>() / data.y.len().max(1) as f64;
+            let y_min_std = data.y.iter().copied().fold(f64::INFINITY, f64::min);
+            let mut taken: Vec<Vec<f64>> = data.x.clone();
+            let fantasies: Vec<Vec<f64>> = self
+                .pending
+                .iter()
+                .chain(out.iter())
+                .map(|p| self.to_unit(p))
+                .collect();
+            for u in fantasies {
+                let lie = self.lie(&gp, &u, incumbent, y_mean_std, y_min_std);
+                incumbent = incumbent.max(lie);
+                gp.push(u.clone(), lie)?;
+                taken.push(u);
+            }
+            while out.len() < q {
+                let (u, ei) = self.maximize_acquisition(&gp, incumbent, xi)?;
+                let duplicate = taken.iter().any(|t| {
+                    t.iter().zip(&u).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() < 1e-16
+                });
+                let explore = matches!(self.settings.explore_below_ei, Some(th) if ei < th);
+                let u = if explore {
+                    info.exploration_points += 1;
+                    self.exploration_point(&gp)
+                } else if duplicate {
+                    self.rng.unit_point(d)
+                } else {
+                    u
+                };
+                if info.best_ei.is_none() {
+                    info.best_ei = Some(ei);
+                    let ymax = self.ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    let ymin = self.ys.iter().copied().fold(f64::INFINITY, f64::min);
+                    let range = ymax - ymin;
+                    let rel = if range > 0.0 {
+                        ei * data.std / range
+                    } else {
+                        f64::INFINITY
+                    };
+                    info.relative_ei = Some(rel);
+                }
+                let lie = self.lie(&gp, &u, incumbent, y_mean_std, y_min_std);
+                if out.len() + 1 < q {
+                    incumbent = incumbent.max(lie);
+                    gp.push(u.clone(), lie)?;
+                }
+                taken.push(u.clone());
+                out.push(self.from_unit(&u));
+            }
+            if let Some(rel) = info.relative_ei {
+                if rel < self.settings.stop.relative_ei_threshold {
+                    self.low_ei_streak += 1;
+                } else {
+                    self.low_ei_streak = 0;
+                }
+            }
+            self.rounds += 1;
+        }
+        self.pending.extend(out.iter().cloned());
+        self.last_round = info;
+        Ok(out)
+    }
+
+    /// Space-filling exploration step: the random candidate (100 d uniform draws) with the
+    /// largest posterior variance.
+    fn exploration_point(&mut self, gp: &Gp) -> Vec<f64> {
+        let d = self.dim();
+        let mut best = self.rng.unit_point(d);
+        let mut best_var = gp.predict(&best).1;
+        for _ in 1..100 * d {
+            let c = self.rng.unit_point(d);
+            let v = gp.predict(&c).1;
+            if v > best_var {
+                best_var = v;
+                best = c;
+            }
+        }
+        best
+    }
+
+    fn lie(&self, gp: &Gp, u: &[f64], incumbent: f64, mean: f64, min: f64) -> f64 {
+        match self.settings.batch {
+            BatchStrategy::KrigingBeliever => gp.predict(u).0,
+            BatchStrategy::ConstantLiarMin => min,
+            BatchStrategy::ConstantLiarMean => mean,
+            BatchStrategy::ConstantLiarMax => incumbent,
+        }
+    }
+
+    /// Maximise the acquisition on the unit cube: DIRECT then L-BFGS polish from the best
+    /// centres. Returns the point and its EI (standardised units; the UCB value for UCB).
+    fn maximize_acquisition(&self, gp: &Gp, incumbent: f64, xi: f64) -> Result<(Vec<f64>, f64)> {
+        let d = self.dim();
+        let lo = vec![0.0; d];
+        let hi = vec![1.0; d];
+        let acq = self.settings.acquisition;
+        let value = |u: &[f64]| -> f64 {
+            let (m, v) = gp.predict(u);
+            match acq {
+                AcquisitionKind::ExpectedImprovement => {
+                    log_expected_improvement(m, v, incumbent, xi)
+                }
+                AcquisitionKind::Ucb { beta } => acquisition::ucb(m, v, beta),
+            }
+        };
+        let ds = DirectSettings {
+            max_evals: self.settings.direct_evals_per_dim * d,
+            ..DirectSettings::default()
+        };
+        let res = direct::maximize(value, &lo, &hi, &ds, self.settings.polish_starts.max(1))?;
+        let mut best_u = res.x.clone();
+        let mut best_v = res.value;
+        if self.settings.polish_starts > 0 {
+            let mut dm = vec![0.0; d];
+            let mut dv = vec![0.0; d];
+            for (start, _) in res.top.iter().take(self.settings.polish_starts) {
+                let (u, v) = direct::polish(
+                    |u, g| {
+                        let (m, var) = gp.predict_with_grad(u, &mut dm, &mut dv);
+                        match acq {
+                            AcquisitionKind::ExpectedImprovement => acquisition::log_ei_with_grad(
+                                m, var, &dm, &dv, incumbent, xi, g,
+                            ),
+                            AcquisitionKind::Ucb { beta } => {
+                                acquisition::ucb_with_grad(m, var, &dm, &dv, beta, g)
+                            }
+                        }
+                    },
+                    start,
+                    &lo,
+                    &hi,
+                    self.settings.polish_iters,
+                );
+                if v > best_v && v.is_finite() {
+                    best_u = u;
+                    best_v = v;
+                }
+            }
+        }
+        let (m, var) = gp.predict(&best_u);
+        let ei = match acq {
+            AcquisitionKind::ExpectedImprovement => {
+                if best_v <= LOG_EI_FLOOR {
+                    0.0
+                } else {
+                    expected_improvement(m, var, incumbent, xi)
+                }
+            }
+            AcquisitionKind::Ucb { .. } => best_v,
+        };
+        Ok((best_u, ei))
+    }
+}
+
+impl AskTell for Optimizer {
+    fn suggest(&mut self, q: usize) -> Result<Vec<Vec<f64>>> {
+        Optimizer::suggest(self, q)
+    }
+    fn observe(&mut self, x: &[f64], y: f64) -> Result<()> {
+        Optimizer::observe(self, x, y)
+    }
+    fn best(&self) -> Option<(Vec<f64>, f64)> {
+        Optimizer::best(self)
+    }
+}

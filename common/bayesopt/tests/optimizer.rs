@@ -1,0 +1,197 @@
+//! Integration tests of the ask/tell optimizer: determinism, serde round trip, batches,
+//! stopping and input validation.
+
+use graspopt_bayesopt::{
+    AskTell, BoError, Optimizer, Settings, StopReason, StopRule, TestFunction, XiRule,
+};
+
+fn branin_bounds() -> Vec<(f64, f64)> {
+    vec![(-5.0, 10.0), (0.0, 15.0)]
+}
+
+fn fast_settings() -> Settings {
+    Settings {
+        minimize: true,
+        n_init: Some(5),
+        direct_evals_per_dim: 150,
+        xi: XiRule::Fixed(0.0),
+        ..Settings::default()
+    }
+}
+
+fn step(opt: &mut Optimizer, q: usize) -> Vec<Vec<f64>> {
+    let pts = opt.suggest(q).unwrap();
+    for p in &pts {
+        opt.observe(p, TestFunction::Branin.eval(p)).unwrap();
+    }
+    pts
+}
+
+#[test]
+fn same_seed_same_proposals() {
+    let mut a = Optimizer::new(&branin_bounds(), fast_settings(), 42).unwrap();
+    let mut b = Optimizer::new(&branin_bounds(), fast_settings(), 42).unwrap();
+    for _ in 0..9 {
+        assert_eq!(step(&mut a, 1), step(&mut b, 1));
+    }
+    let mut c = Optimizer::new(&branin_bounds(), fast_settings(), 43).unwrap();
+    assert_ne!(step(&mut c, 1), {
+        let mut d = Optimizer::new(&branin_bounds(), fast_settings(), 42).unwrap();
+        step(&mut d, 1)
+    });
+}
+
+#[test]
+fn serde_round_trip_continues_identically() {
+    let mut a = Optimizer::new(&branin_bounds(), fast_settings(), 7).unwrap();
+    for _ in 0..8 {
+        step(&mut a, 1);
+    }
+    // one pending point at the time of the snapshot
+    let pending = a.suggest(1).unwrap();
+    let json = serde_json::to_string(&a).unwrap();
+    let mut b: Optimizer = serde_json::from_str(&json).unwrap();
+    assert_eq!(a, b);
+    for p in &pending {
+        let y = TestFunction::Branin.eval(p);
+        a.observe(p, y).unwrap();
+        b.observe(p, y).unwrap();
+    }
+    for _ in 0..4 {
+        assert_eq!(step(&mut a, 1), step(&mut b, 1));
+    }
+    assert_eq!(step(&mut a, 3), step(&mut b, 3));
+    assert_eq!(a, b);
+}
+
+#[test]
+fn batch_points_are_distinct_and_pending_is_tracked() {
+    let mut opt = Optimizer::new(&branin_bounds(), fast_settings(), 3).unwrap();
+    for _ in 0..2 {
+        step(&mut opt, 4);
+    }
+    let first = opt.suggest(4).unwrap();
+    assert_eq!(opt.pending().len(), 4);
+    let second = opt.suggest(2).unwrap();
+    assert_eq!(opt.pending().len(), 6);
+    let all: Vec<&Vec<f64>> = first
+        .iter()
+        .chain(second.iter())
+        .chain(std::iter::empty())
+        .collect();
+    for i in 0..all.len() {
+        for j in 0..i {
+            let d: f64 = all[i]
+                .iter()
+                .zip(all[j].iter())
+                .map(|(a, b)| (a - b).powi(2))
+                .sum();
+            assert!(d > 1e-10, "duplicate proposals {i} {j}");
+        }
+        for (x, _) in opt.observations() {
+            assert_ne!(x, all[i].as_slice());
+        }
+    }
+    opt.observe(&first[0], 1.0).unwrap();
+    assert_eq!(opt.pending().len(), 5);
+    opt.clear_pending();
+    assert!(opt.pending().is_empty());
+}
+
+#[test]
+fn maximisation_convention_and_best() {
+    let s = Settings {
+        n_init: Some(3),
+        direct_evals_per_dim: 100,
+        ..Settings::default()
+    };
+    let mut opt = Optimizer::new(&[(0.0, 1.0)], s, 1).unwrap();
+    let f = |x: f64| -(x - 0.7).powi(2);
+    for _ in 0..10 {
+        let p = opt.suggest(1).unwrap();
+        opt.observe(&p[0], f(p[0][0])).unwrap();
+    }
+    let (x, y) = opt.best().unwrap();
+    assert!((x[0] - 0.7).abs() < 0.02, "{x:?} {y}");
+    let (m, sd) = opt.predict(&[0.7]).unwrap();
+    assert!(m.abs() < 0.05 && sd >= 0.0);
+}
+
+#[test]
+fn stops_at_budget_and_on_small_ei() {
+    let s = Settings {
+        stop: StopRule {
+            budget: Some(12),
+            ..StopRule::default()
+        },
+        ..fast_settings()
+    };
+    let mut opt = Optimizer::new(&branin_bounds(), s, 1).unwrap();
+    while opt.stop_reason().is_none() {
+        step(&mut opt, 1);
+    }
+    assert_eq!(opt.len(), 12);
+    assert_eq!(opt.stop_reason(), Some(StopReason::Budget));
+
+    // A constant function: EI collapses, stop after min_evals and patience.
+    let s = Settings {
+        n_init: Some(3),
+        direct_evals_per_dim: 100,
+        stop: StopRule {
+            budget: Some(60),
+            min_evals: Some(8),
+            relative_ei_threshold: 1e-3,
+            patience: 2,
+        },
+        ..Settings::default()
+    };
+    let mut opt = Optimizer::new(&[(0.0, 1.0)], s, 2).unwrap();
+    while opt.stop_reason().is_none() {
+        let p = opt.suggest(1).unwrap();
+        let y = -(p[0][0] - 0.3).powi(2);
+        opt.observe(&p[0], y).unwrap();
+    }
+    assert_eq!(opt.stop_reason(), Some(StopReason::SmallExpectedImprovement));
+    assert!(opt.len() >= 8 && opt.len() < 60, "{}", opt.len());
+}
+
+#[test]
+fn bad_input_gives_errors() {
+    let s = Settings::default;
+    assert_eq!(Optimizer::new(&[], s(), 0).unwrap_err(), BoError::EmptyBounds);
+    assert!(matches!(
+        Optimizer::new(&[(1.0, 1.0)], s(), 0),
+        Err(BoError::InvalidBound { .. })
+    ));
+    assert!(Optimizer::new(&[(2.0, 1.0)], s(), 0).is_err());
+    assert!(Optimizer::new(&[(f64::NAN, 1.0)], s(), 0).is_err());
+    let bad = Settings {
+        xi: XiRule::Fixed(-1.0),
+        ..Settings::default()
+    };
+    assert!(Optimizer::new(&[(0.0, 1.0)], bad, 0).is_err());
+    let mut opt = Optimizer::new(&[(0.0, 1.0), (0.0, 1.0)], s(), 0).unwrap();
+    assert!(matches!(
+        opt.observe(&[0.5], 1.0),
+        Err(BoError::DimensionMismatch { .. })
+    ));
+    assert!(matches!(
+        opt.observe(&[0.5, 0.5], f64::NAN),
+        Err(BoError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        opt.observe(&[0.5, 1.5], 1.0),
+        Err(BoError::OutOfBounds { .. })
+    ));
+    assert!(opt.observe(&[0.5, f64::INFINITY], 1.0).is_err());
+    assert!(opt.suggest(0).is_err());
+    assert!(opt.predict(&[0.5, 0.5]).is_err());
+    assert!(opt.is_empty());
+    // duplicates and constant observations do not break the engine
+    for _ in 0..6 {
+        opt.observe(&[0.5, 0.5], 2.0).unwrap();
+    }
+    let p = opt.suggest(2).unwrap();
+    assert_eq!(p.len(), 2);
+    assert!(AskTell::best(&opt).is_some());
+}

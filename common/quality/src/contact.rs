@@ -1,0 +1,337 @@
+//! Contacts and contact models (thesis section 2.2, conventions in
+//! `shared/spec/metric-conventions.md`).
+//!
+//! A contact is a position and a unit normal that points **into** the object: the
+//! direction in which the finger pushes. A contact model turns a contact into the set
+//! of wrenches it can apply with unit normal force, expressed about a reference point
+//! and with torques divided by a torque scale `rho` (a characteristic length).
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::QualityError;
+use crate::wrench::{Wrench, wrench};
+
+/// How far a normal's length may be from 1 before it is rejected.
+pub const UNIT_NORMAL_TOLERANCE: f64 = 1e-6;
+
+/// A point contact: position and inward unit normal, in the frame of the grasp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Contact {
+    pub position: Vector3<f64>,
+    pub normal: Vector3<f64>,
+}
+
+impl Contact {
+    /// A contact from a position and a normal taken as given (see [`Contact::validate`]).
+    pub fn new(position: Vector3<f64>, normal: Vector3<f64>) -> Self {
+        Self { position, normal }
+    }
+
+    /// A contact whose normal is normalised first; errors on a zero or non-finite normal.
+    pub fn normalized(position: Vector3<f64>, normal: Vector3<f64>) -> Result<Self, QualityError> {
+        let c = Self { position, normal };
+        c.check_finite(0)?;
+        let norm = normal.norm();
+        if norm <= f64::MIN_POSITIVE {
+            return Err(QualityError::ZeroNormal { index: 0 });
+        }
+        Ok(Self {
+            position,
+            normal: normal / norm,
+        })
+    }
+
+    fn check_finite(&self, index: usize) -> Result<(), QualityError> {
+        for (field, v) in [("position", &self.position), ("normal", &self.normal)] {
+            if !v.iter().all(|x| x.is_finite()) {
+                return Err(QualityError::NotFinite {
+                    what: "contact",
+                    index,
+                    field,
+                    value: [v.x, v.y, v.z],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that the coordinates are finite and the normal has unit length;
+    /// `index` is the contact's position in its list, used in the error.
+    pub fn validate(&self, index: usize) -> Result<(), QualityError> {
+        self.check_finite(index)?;
+        let norm = self.normal.norm();
+        if norm <= f64::MIN_POSITIVE {
+            return Err(QualityError::ZeroNormal { index });
+        }
+        if (norm - 1.0).abs() > UNIT_NORMAL_TOLERANCE {
+            return Err(QualityError::NonUnitNormal { index, norm });
+        }
+        Ok(())
+    }
+}
+
+/// The tangent basis `(t1, t2)` of a unit normal `n`, by the project's convention:
+/// `a` is the world axis with the smallest `|a . n|` (x, y, z first on ties),
+/// `t1 = normalize(a - (a . n) n)`, `t2 = n x t1`.
+pub fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let mut axis = 0;
+    for i in 1..3 {
+        if n[i].abs() < n[axis].abs() {
+            axis = i;
+        }
+    }
+    let mut a = Vector3::zeros();
+    a[axis] = 1.0;
+    let t1 = (a - n * n[axis]).normalize();
+    let t2 = n.cross(&t1);
+    (t1, t2)
+}
+
+/// A contact model (thesis section 2.2). The friction cone is sampled on its boundary
+/// with `edges` generators `f_j = n + mu (cos th_j t1 + sin th_j t2)`, `th_j = 2 pi j / edges`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case")]
+pub enum ContactModel {
+    /// Frictionless point contact: one wrench `(n, r x n / rho)`.
+    Frictionless,
+    /// Point contact with Coulomb friction `mu`: `edges` wrenches `(f_j, r x f_j / rho)`.
+    PointFriction { mu: f64, edges: usize },
+    /// Soft finger with torsional coefficient `gamma` (a length): `2 edges` wrenches
+    /// `(f_j, (r x f_j +- gamma n) / rho)` (eq. 2.11).
+    SoftFinger { mu: f64, edges: usize, gamma: f64 },
+}
+
+impl ContactModel {
+    /// The number of wrenches one contact produces.
+    pub fn wrenches_per_contact(&self) -> usize {
+        match *self {
+            ContactModel::Frictionless => 1,
+            ContactModel::PointFriction { edges, .. } => edges,
+            ContactModel::SoftFinger { edges, .. } => 2 * edges,
+        }
+    }
+
+    /// Checks the parameters: `mu >= 0`, `edges >= 3`, `gamma >= 0`, all finite.
+    pub fn validate(&self) -> Result<(), QualityError> {
+        let check_mu = |mu: f64| {
+            if mu.is_finite() && mu >= 0.0 {
+                Ok(())
+            } else {
+                Err(QualityError::Parameter {
+                    name: "mu",
+                    value: mu,
+                    expected: "the friction coefficient must be finite and >= 0",
+                })
+            }
+        };
+        let check_edges = |edges: usize| {
+            if edges >= 3 {
+                Ok(())
+            } else {
+                Err(QualityError::Parameter {
+                    name: "edges",
+                    value: edges as f64,
+                    expected: "the friction cone needs at least 3 edges",
+                })
+            }
+        };
+        match *self {
+            ContactModel::Frictionless => Ok(()),
+            ContactModel::PointFriction { mu, edges } => {
+                check_mu(mu)?;
+                check_edges(edges)
+            }
+            ContactModel::SoftFinger { mu, edges, gamma } => {
+                check_mu(mu)?;
+                check_edges(edges)?;
+                if gamma.is_finite() && gamma >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(QualityError::Parameter {
+                        name: "gamma",
+                        value: gamma,
+                        expected: "the torsional coefficient must be finite and >= 0",
+                    })
+                }
+            }
+        }
+    }
+}
+
+/// Everything needed to turn contacts into wrenches: the contact model, the reference
+/// point about which torques are taken, and the torque scale `rho > 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GraspModel {
+    pub contact: ContactModel,
+    pub reference_point: Vector3<f64>,
+    pub torque_scale: f64,
+}
+
+impl GraspModel {
+    /// A model with the reference point at the origin and `rho = 1`.
+    pub fn new(contact: ContactModel) -> Self {
+        Self {
+            contact,
+            reference_point: Vector3::zeros(),
+            torque_scale: 1.0,
+        }
+    }
+
+    /// The same model with another reference point.
+    pub fn with_reference_point(mut self, c: Vector3<f64>) -> Self {
+        self.reference_point = c;
+        self
+    }
+
+    /// The same model with another torque scale.
+    pub fn with_torque_scale(mut self, rho: f64) -> Self {
+        self.torque_scale = rho;
+        self
+    }
+
+    /// Checks the contact model, the reference point and `rho`.
+    pub fn validate(&self) -> Result<(), QualityError> {
+        self.contact.validate()?;
+        let c = &self.reference_point;
+        if !c.iter().all(|x| x.is_finite()) {
+            return Err(QualityError::NotFinite {
+                what: "model",
+                index: 0,
+                field: "reference_point",
+                value: [c.x, c.y, c.z],
+            });
+        }
+        if !(self.torque_scale.is_finite() && self.torque_scale > 0.0) {
+            return Err(QualityError::Parameter {
+                name: "torque_scale",
+                value: self.torque_scale,
+                expected: "the torque scale must be finite and > 0",
+            });
+        }
+        Ok(())
+    }
+
+    /// Appends the wrenches of one (validated) contact to `out`.
+    pub fn push_wrenches(&self, contact: &Contact, out: &mut Vec<Wrench>) {
+        let n = contact.normal;
+        let r = contact.position - self.reference_point;
+        let inv_rho = 1.0 / self.torque_scale;
+        let cone = |mu: f64, edges: usize| {
+            let (t1, t2) = tangent_basis(&n);
+            (0..edges).map(move |j| {
+                let th = std::f64::consts::TAU * j as f64 / edges as f64;
+                n + (t1 * th.cos() + t2 * th.sin()) * mu
+            })
+        };
+        match self.contact {
+            ContactModel::Frictionless => out.push(wrench(&n, &(r.cross(&n) * inv_rho))),
+            ContactModel::PointFriction { mu, edges } => {
+                out.extend(cone(mu, edges).map(|f| wrench(&f, &(r.cross(&f) * inv_rho))));
+            }
+            ContactModel::SoftFinger { mu, edges, gamma } => {
+                for f in cone(mu, edges) {
+                    let t = r.cross(&f);
+                    out.push(wrench(&f, &((t + n * gamma) * inv_rho)));
+                    out.push(wrench(&f, &((t - n * gamma) * inv_rho)));
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tangent_basis_is_orthonormal_and_follows_the_convention() {
+        let n = Vector3::new(0.0, 0.0, 1.0);
+        let (t1, t2) = tangent_basis(&n);
+        // Ties between x and y: x wins.
+        assert_eq!(t1, Vector3::x());
+        assert_eq!(t2, Vector3::y());
+        let n = Vector3::new(0.3, -0.5, 0.2).normalize();
+        let (t1, t2) = tangent_basis(&n);
+        assert!(t1.dot(&n).abs() < 1e-15 && t2.dot(&n).abs() < 1e-15);
+        assert!((t1.norm() - 1.0).abs() < 1e-15 && (t2.norm() - 1.0).abs() < 1e-15);
+        // Smallest |component| is z: t1 lies in the plane of z and n.
+        assert!(t1.dot(&Vector3::z().cross(&n)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn soft_finger_wrenches_have_unit_normal_force_and_torsion() {
+        let model = GraspModel::new(ContactModel::SoftFinger {
+            mu: 0.5,
+            edges: 8,
+            gamma: 0.2,
+        });
+        let c = Contact::new(Vector3::zeros(), Vector3::z());
+        let mut w = Vec::new();
+        model.push_wrenches(&c, &mut w);
+        assert_eq!(w.len(), 16);
+        for (i, wi) in w.iter().enumerate() {
+            assert!((wi[2] - 1.0).abs() < 1e-15);
+            let tangential = (wi[0] * wi[0] + wi[1] * wi[1]).sqrt();
+            assert!((tangential - 0.5).abs() < 1e-15);
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            assert!((wi[5] - sign * 0.2).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn invalid_parameters_are_named() {
+        let bad = [
+            ContactModel::PointFriction {
+                mu: -0.1,
+                edges: 8,
+            },
+            ContactModel::PointFriction { mu: 0.5, edges: 2 },
+            ContactModel::SoftFinger {
+                mu: 0.5,
+                edges: 8,
+                gamma: f64::NAN,
+            },
+        ];
+        let names: Vec<_> = bad
+            .iter()
+            .map(|m| match m.validate() {
+                Err(QualityError::Parameter { name, .. }) => name,
+                other => panic!("expected a parameter error, got {other:?}"),
+            })
+            .collect();
+        assert_eq!(names, ["mu", "edges", "gamma"]);
+        let rho = GraspModel::new(ContactModel::Frictionless).with_torque_scale(0.0);
+        assert!(matches!(
+            rho.validate(),
+            Err(QualityError::Parameter {
+                name: "torque_scale",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn contact_validation_rejects_bad_normals() {
+        let p = Vector3::zeros();
+        assert_eq!(
+            Contact::new(p, Vector3::zeros()).validate(4),
+            Err(QualityError::ZeroNormal { index: 4 })
+        );
+        assert!(matches!(
+            Contact::new(p, Vector3::new(0.0, 0.0, 2.0)).validate(1),
+            Err(QualityError::NonUnitNormal { index: 1, .. })
+        ));
+        assert!(matches!(
+            Contact::new(Vector3::new(f64::NAN, 0.0, 0.0), Vector3::z()).validate(2),
+            Err(QualityError::NotFinite {
+                index: 2,
+                field: "position",
+                ..
+            })
+        ));
+        assert!(Contact::new(p, Vector3::new(f64::INFINITY, 0.0, 0.0)).validate(0).is_err());
+        let c = Contact::normalized(p, Vector3::new(0.0, 3.0, 4.0)).unwrap();
+        assert!((c.normal - Vector3::new(0.0, 0.6, 0.8)).norm() < 1e-15);
+    }
+}

@@ -1,0 +1,151 @@
+//! The expanding-polytope algorithm for the Largest Sphere (epsilon) metric: the
+//! distance from the origin to the boundary of `conv(points)` when the origin is inside.
+//!
+//! Start from a simplex of input points; repeatedly take the facet of the current
+//! polytope nearest the origin and ask for the input point farthest along its normal
+//! (the support point). If no point lies beyond that facet, the facet belongs to the
+//! true hull, and as the current polytope is inside the hull, no hull facet is nearer:
+//! its offset is the answer. Otherwise add the support point and repeat. Only facets
+//! nearer than the answer are ever refined, so the cost grows with the part of the hull
+//! near the inscribed ball, not with the full facet count (which explodes for surface
+//! patches).
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use nalgebra::SVector;
+
+use super::affine::affine_basis;
+use super::coordinate_scale;
+use super::polytope::{Degenerate, FacetId, Polytope};
+use super::quickhull;
+
+/// Relative tolerance (times the coordinate scale) at which a support point no longer
+/// counts as beyond a facet.
+const SUPPORT_TOLERANCE: f64 = 1e-10;
+/// Visibility tolerance of the polytope (relative); at most the support tolerance, so
+/// the facet that asked for a point always sees it.
+const VISIBILITY_TOLERANCE: f64 = 1e-10;
+
+/// Outcome of the expanding-polytope search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InnerDistance {
+    /// The signed distance from the origin to the nearest facet hyperplane of the hull:
+    /// positive when the origin is inside, zero or negative otherwise.
+    pub offset: f64,
+    /// Points added to the initial simplex.
+    pub iterations: usize,
+}
+
+/// The signed distance from the origin to the nearest facet of `conv(points)`, for a
+/// full-dimensional set (affine rank D); `None` when the set is lower-dimensional.
+///
+/// The value is exact for an origin inside the hull (the Largest Sphere radius). For an
+/// origin outside it is only a certificate (negative), not the distance to the hull.
+pub fn inner_distance<const D: usize>(points: &[SVector<f64, D>]) -> Option<InnerDistance> {
+    let basis = affine_basis(points);
+    if basis.rank < D {
+        return None;
+    }
+    let scale = coordinate_scale(points);
+    match expand(points, &basis.indices, scale) {
+        Ok(r) => Some(r),
+        // Floating-point degeneracy in the incremental polytope: fall back to the
+        // full hull, which is slower but has its own recovery.
+        Err(Degenerate) => quickhull::Hull::new(points).ok().map(|h| InnerDistance {
+            offset: h.min_offset(),
+            iterations: h.added(),
+        }),
+    }
+}
+
+/// As [`inner_distance`], starting from a given simplex (D+1 affinely independent
+/// point indices), e.g. the corral of the minimum-norm point, which holds the origin.
+pub fn inner_distance_from<const D: usize>(
+    points: &[SVector<f64, D>],
+    simplex: &[usize],
+) -> Option<InnerDistance> {
+    expand(points, simplex, coordinate_scale(points)).ok()
+}
+
+#[derive(PartialEq, PartialOrd)]
+struct Key(f64);
+impl Eq for Key {}
+#[allow(clippy::derive_ord_xor_partial_ord)]
+impl Ord for Key {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+fn expand<const D: usize>(
+    points: &[SVector<f64, D>],
+    simplex: &[usize],
+    scale: f64,
+) -> Result<InnerDistance, Degenerate> {
+    let mut poly = Polytope::simplex(points, simplex, VISIBILITY_TOLERANCE * scale)?;
+    let tolerance = SUPPORT_TOLERANCE * scale;
+    let mut heap: BinaryHeap<Reverse<(Key, FacetId)>> = poly
+        .live_facets()
+        .map(|f| Reverse((Key(poly.facets[f as usize].offset), f)))
+        .collect();
+    let mut iterations = 0;
+    while let Some(Reverse((Key(offset), f))) = heap.pop() {
+        let facet = &poly.facets[f as usize];
+        if !facet.alive {
+            continue;
+        }
+        let normal = facet.normal;
+        let (best, height) = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, normal.dot(p)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .ok_or(Degenerate)?;
+        if height - offset <= tolerance {
+            return Ok(InnerDistance { offset, iterations });
+        }
+        let new = poly.add_point(best, f)?;
+        iterations += 1;
+        for g in new {
+            heap.push(Reverse((Key(poly.facets[g as usize].offset), g)));
+        }
+    }
+    Err(Degenerate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Vector2, Vector3};
+
+    #[test]
+    fn square_and_cube_inradius() {
+        let square: Vec<Vector2<f64>> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(x, y)| Vector2::new(x, y))
+            .collect();
+        let r = inner_distance(&square).unwrap();
+        assert!((r.offset - 1.0).abs() < 1e-12);
+        let mut cube = Vec::new();
+        for i in 0..8 {
+            let c = |b: i32| if i & b != 0 { 1.0 } else { -1.0 };
+            cube.push(Vector3::new(c(1) + 0.5, c(2), c(4)));
+        }
+        // Shifted by 0.5 along x: the nearest facet, x = -0.5, is at distance 0.5.
+        let r = inner_distance(&cube).unwrap();
+        assert!((r.offset - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn origin_outside_gives_a_negative_certificate() {
+        let tri = [
+            Vector2::new(1.0, 0.0),
+            Vector2::new(2.0, 0.0),
+            Vector2::new(1.0, 1.0),
+        ];
+        assert!(inner_distance(&tri).unwrap().offset < 0.0);
+        let flat = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 1.0, 0.0), Vector3::new(0.0, 0.0, 0.0)];
+        assert_eq!(inner_distance(&flat), None);
+    }
+}

@@ -1,0 +1,32 @@
+//! Grasp quality from contacts: wrenches, contact models, the grasp map and the
+//! metrics of its wrench hull (thesis chapter 2).
+//!
+//! This crate owns the mathematics only. It knows nothing of files, the bus or the
+//! simulator: callers hand it contacts (positions and unit normals pointing into the
+//! object) or wrenches, and get metrics back.
+//!
+//! - [`wrench`]: wrench vectors and frame changes (eq. 2.1-2.3).
+//! - [`contact`]: contacts, contact models (frictionless, friction cone, soft finger)
+//!   and the wrenches each produces (eq. 2.4-2.11).
+//! - [`cloud`]: preprocessing of a raw contact cloud into its mean contact (eq. 2.12).
+//! - [`grasp_map`]: the grasp map, the set of all contact wrenches (eq. 2.13-2.14).
+//! - [`hull`]: convex-hull queries in wrench space (affine rank, minimum-norm point,
+//!   expanding polytope, full hull).
+//! - [`metrics`]: force closure, Largest Sphere, Grasp Wrench Volume, distance and the
+//!   Bimodal Wrench metric (section 2.6).
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod cloud;
+pub mod contact;
+pub mod error;
+pub mod grasp_map;
+pub mod hull;
+pub mod metrics;
+pub mod wrench;
+
+pub use cloud::{MeanContact, mean_contact};
+pub use contact::{Contact, ContactModel, GraspModel};
+pub use error::QualityError;
+pub use grasp_map::GraspMap;
+pub use metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
+pub use wrench::Wrench;

@@ -1,0 +1,138 @@
+//! Metrics of a grasp's wrench set (thesis sections 2.5-2.6, conventions in
+//! `shared/spec/metric-conventions.md`):
+//!
+//! - `rank`: affine rank of the wrenches; below 6 there is no force closure.
+//! - `distance`: distance from the origin to the wrench hull (0 when inside).
+//! - `force_closure`: the origin strictly inside the hull, every facet farther than
+//!   [`FORCE_CLOSURE_MARGIN`].
+//! - `epsilon`: the Largest Sphere (Ferrari-Canny) radius, 0 without force closure.
+//! - `volume`: the Grasp Wrench Volume, the 6-volume of the hull.
+//! - `bw`: the Bimodal Wrench metric, `epsilon` with force closure, else `-distance`;
+//!   continuous across the boundary, where both are zero.
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::{Contact, GraspModel};
+use crate::error::QualityError;
+use crate::grasp_map::{GraspMap, check_wrenches};
+use crate::hull::{affine, coordinate_scale, epa, min_norm, qp, quickhull};
+use crate::wrench::Wrench;
+
+/// A facet must be farther than this from the origin for force closure.
+pub const FORCE_CLOSURE_MARGIN: f64 = 1e-9;
+/// Below this distance (relative to the coordinate scale) the origin counts as touching
+/// the hull, and the inscribed radius is computed to decide.
+const INSIDE_TOLERANCE: f64 = 1e-10;
+
+/// How the distance from the origin to the hull is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DistanceSolver {
+    /// Wolfe's minimum-norm-point algorithm (exact, fast): the default.
+    #[default]
+    MinNorm,
+    /// The second-order cone program solved by Clarabel.
+    Clarabel,
+}
+
+/// Which metrics to compute and how.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MetricsOptions {
+    /// Compute the Grasp Wrench Volume (needs the full hull: slow for surface models).
+    pub volume: bool,
+    pub distance_solver: DistanceSolver,
+}
+
+impl Default for MetricsOptions {
+    fn default() -> Self {
+        Self {
+            volume: true,
+            distance_solver: DistanceSolver::MinNorm,
+        }
+    }
+}
+
+impl MetricsOptions {
+    /// Everything but the volume: what an optimiser scoring by BW needs.
+    pub fn without_volume() -> Self {
+        Self {
+            volume: false,
+            ..Self::default()
+        }
+    }
+}
+
+/// The metrics of one wrench set.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    pub rank: usize,
+    pub force_closure: bool,
+    pub epsilon: f64,
+    /// `None` when not asked for.
+    pub volume: Option<f64>,
+    pub distance: f64,
+    pub bw: f64,
+}
+
+/// All metrics of a grasp map.
+pub fn evaluate(grasp: &GraspMap, options: &MetricsOptions) -> Result<Metrics, QualityError> {
+    evaluate_wrenches(grasp.wrenches(), options)
+}
+
+/// All metrics of the grasp given by contacts under a model.
+pub fn evaluate_contacts(
+    contacts: &[Contact],
+    model: &GraspModel,
+    options: &MetricsOptions,
+) -> Result<Metrics, QualityError> {
+    evaluate(&GraspMap::from_contacts(contacts, model)?, options)
+}
+
+/// All metrics of a wrench set; errors on an empty set or a non-finite wrench.
+pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metrics, QualityError> {
+    check_wrenches(w)?;
+    let rank = affine::affine_rank(w);
+    let distance = distance_to_hull(w, options.distance_solver)?;
+    let epsilon = if rank == 6 && distance <= INSIDE_TOLERANCE * coordinate_scale(w) {
+        epa::inner_distance(w).map_or(0.0, |r| r.offset.max(0.0))
+    } else {
+        0.0
+    };
+    let force_closure = epsilon > FORCE_CLOSURE_MARGIN;
+    let epsilon = if force_closure { epsilon } else { 0.0 };
+    let volume = options.volume.then(|| grasp_wrench_volume(w));
+    Ok(Metrics {
+        rank,
+        force_closure,
+        epsilon,
+        volume,
+        distance,
+        bw: if force_closure { epsilon } else { -distance },
+    })
+}
+
+/// The distance from the origin to the hull of `w`.
+pub fn distance_to_hull(w: &[Wrench], solver: DistanceSolver) -> Result<f64, QualityError> {
+    match solver {
+        DistanceSolver::MinNorm => Ok(min_norm::min_norm_point(w).distance),
+        DistanceSolver::Clarabel => qp::distance_to_hull(w),
+    }
+}
+
+/// The Grasp Wrench Volume: the 6-volume of the hull of `w` (0 below rank 6).
+pub fn grasp_wrench_volume(w: &[Wrench]) -> f64 {
+    match quickhull::Hull::new(w) {
+        Ok(h) => h.volume(),
+        Err(_) => 0.0,
+    }
+}
+
+/// The Largest Sphere radius (0 without force closure).
+pub fn largest_sphere(w: &[Wrench]) -> Result<f64, QualityError> {
+    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.epsilon)
+}
+
+/// The Bimodal Wrench metric.
+pub fn bimodal_wrench(w: &[Wrench]) -> Result<f64, QualityError> {
+    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.bw)
+}

@@ -1,0 +1,140 @@
+//! The 100 reference cases of `shared/reference/metric-cases.json` (a copy lives in
+//! `tests/data/`): every metric within 1e-7 absolute or 1e-6 relative, rank and force
+//! closure exactly; the wrenches generated from the contacts equal the file's; Clarabel
+//! agrees with the min-norm solver; the expanding polytope agrees with the full hull.
+
+use graspopt_quality::hull::{epa, quickhull};
+use graspopt_quality::metrics::{DistanceSolver, MetricsOptions, distance_to_hull, evaluate};
+use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, Wrench};
+use nalgebra::Vector3;
+use serde_json::Value;
+
+fn cases() -> Vec<Value> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/metric-cases.json");
+    let text = std::fs::read_to_string(path).expect("reference file");
+    let doc: Value = serde_json::from_str(&text).expect("json");
+    doc["cases"].as_array().expect("cases").clone()
+}
+
+fn v3(v: &Value) -> Vector3<f64> {
+    let a = v.as_array().expect("array");
+    Vector3::new(a[0].as_f64().unwrap(), a[1].as_f64().unwrap(), a[2].as_f64().unwrap())
+}
+
+fn model(params: &Value) -> GraspModel {
+    let mu = params["mu"].as_f64().unwrap();
+    let edges = params["edges"].as_u64().unwrap() as usize;
+    let gamma = params["gamma"].as_f64().unwrap();
+    let contact = match params["model"].as_str().unwrap() {
+        "frictionless" => ContactModel::Frictionless,
+        "point_friction" => ContactModel::PointFriction { mu, edges },
+        "soft_finger" => ContactModel::SoftFinger { mu, edges, gamma },
+        other => panic!("unknown model {other}"),
+    };
+    GraspModel::new(contact)
+        .with_reference_point(v3(&params["reference_point"]))
+        .with_torque_scale(params["torque_scale"].as_f64().unwrap())
+}
+
+fn grasp(case: &Value) -> GraspMap {
+    let contacts: Vec<Contact> = case["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| Contact::new(v3(&c["position"]), v3(&c["normal"])))
+        .collect();
+    GraspMap::from_contacts(&contacts, &model(&case["params"])).unwrap()
+}
+
+fn reference_wrenches(case: &Value) -> Vec<Wrench> {
+    case["wrenches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| Wrench::from_iterator(w.as_array().unwrap().iter().map(|x| x.as_f64().unwrap())))
+        .collect()
+}
+
+fn close(actual: f64, expected: f64) -> bool {
+    (actual - expected).abs() <= 1e-7 || (actual - expected).abs() <= 1e-6 * expected.abs()
+}
+
+#[test]
+fn all_reference_cases_match() {
+    let cases = cases();
+    assert_eq!(cases.len(), 100);
+    let mut failures = Vec::new();
+    for (i, case) in cases.iter().enumerate() {
+        let g = grasp(case);
+        let m = evaluate(&g, &MetricsOptions::default()).unwrap();
+        let e = &case["expected"];
+        let mut bad = Vec::new();
+        if m.rank as u64 != e["rank"].as_u64().unwrap() {
+            bad.push(format!("rank {} vs {}", m.rank, e["rank"]));
+        }
+        if m.force_closure != e["force_closure"].as_bool().unwrap() {
+            bad.push(format!("force_closure {} vs {}", m.force_closure, e["force_closure"]));
+        }
+        for (name, value) in [
+            ("epsilon", m.epsilon),
+            ("volume", m.volume.unwrap()),
+            ("distance", m.distance),
+            ("bw", m.bw),
+        ] {
+            let expected = e[name].as_f64().unwrap();
+            if !close(value, expected) {
+                bad.push(format!("{name} {value:e} vs {expected:e}"));
+            }
+        }
+        if !bad.is_empty() {
+            failures.push(format!("case {i} ({}): {}", case["kind"], bad.join(", ")));
+        }
+    }
+    assert!(failures.is_empty(), "{} cases differ:\n{}", failures.len(), failures.join("\n"));
+}
+
+#[test]
+fn generated_wrenches_equal_the_reference_wrenches() {
+    for (i, case) in cases().iter().enumerate() {
+        let ours = grasp(case);
+        let theirs = reference_wrenches(case);
+        assert_eq!(ours.wrenches().len(), theirs.len(), "case {i}");
+        for (k, (a, b)) in ours.wrenches().iter().zip(&theirs).enumerate() {
+            assert!((a - b).norm() < 1e-12, "case {i} wrench {k}: {a} vs {b}");
+        }
+        // The wrenches alone give the same metrics as the contacts.
+        let from_wrenches = GraspMap::from_wrenches(theirs).unwrap();
+        let a = evaluate(&ours, &MetricsOptions::without_volume()).unwrap();
+        let b = evaluate(&from_wrenches, &MetricsOptions::without_volume()).unwrap();
+        assert!(close(a.bw, b.bw), "case {i}");
+    }
+}
+
+#[test]
+fn clarabel_agrees_with_the_min_norm_solver() {
+    for (i, case) in cases().iter().enumerate() {
+        let g = grasp(case);
+        let fast = distance_to_hull(g.wrenches(), DistanceSolver::MinNorm).unwrap();
+        let qp = distance_to_hull(g.wrenches(), DistanceSolver::Clarabel).unwrap();
+        assert!((fast - qp).abs() < 1e-7, "case {i}: min-norm {fast:e}, clarabel {qp:e}");
+    }
+}
+
+#[test]
+fn expanding_polytope_agrees_with_the_full_hull() {
+    let mut checked = 0;
+    for (i, case) in cases().iter().enumerate() {
+        let g = grasp(case);
+        let Ok(hull) = quickhull::Hull::new(g.wrenches()) else {
+            continue;
+        };
+        let full = hull.min_offset();
+        if full <= 0.0 {
+            continue; // origin outside: the expanding polytope only certifies that
+        }
+        let inner = epa::inner_distance(g.wrenches()).unwrap();
+        assert!((inner.offset - full).abs() < 1e-9, "case {i}: epa {} vs hull {full}", inner.offset);
+        checked += 1;
+    }
+    assert!(checked >= 40, "only {checked} force-closure cases");
+}

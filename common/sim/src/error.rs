@@ -1,0 +1,93 @@
+//! Typed errors of the simulator. Every fallible public function returns [`SimError`]; no input
+//! (pose, mesh, name) can make this crate panic.
+
+use thiserror::Error;
+
+/// Everything that can go wrong while building objects, hands or running a trial.
+#[derive(Debug, Error)]
+pub enum SimError {
+    /// An object name that is not one of the built-in objects.
+    #[error("unknown object `{name}`; valid names are: {valid}")]
+    UnknownObject {
+        /// The name that was asked for.
+        name: String,
+        /// The valid names, comma separated.
+        valid: String,
+    },
+    /// A hand name that is not one of the built-in hands.
+    #[error("unknown hand `{name}`; valid names are: {valid}")]
+    UnknownHand {
+        /// The name that was asked for.
+        name: String,
+        /// The valid names, comma separated.
+        valid: String,
+    },
+    /// A pose, parameter or setting with a NaN or infinite component.
+    #[error("non-finite value in {what}")]
+    NonFinite {
+        /// Which input was not finite.
+        what: String,
+    },
+    /// A mesh with no vertices or no triangles.
+    #[error("mesh `{name}` is empty ({vertices} vertices, {triangles} triangles)")]
+    EmptyMesh {
+        /// Mesh name (file name or object name).
+        name: String,
+        /// Vertex count.
+        vertices: usize,
+        /// Triangle count.
+        triangles: usize,
+    },
+    /// A mesh that does not enclose a volume.
+    #[error("mesh `{name}` is not watertight: {reason}")]
+    NotWatertight {
+        /// Mesh name.
+        name: String,
+        /// The first defect found (e.g. an edge used by one triangle only).
+        reason: String,
+    },
+    /// A malformed mesh file or buffer.
+    #[error("cannot parse mesh `{name}`: {reason}")]
+    MeshParse {
+        /// Mesh name (usually the path).
+        name: String,
+        /// What was wrong, with a line number when there is one.
+        reason: String,
+    },
+    /// A mesh file whose extension is not `.obj` or `.stl`.
+    #[error("unsupported mesh format `{path}`: expected .obj or .stl")]
+    UnsupportedFormat {
+        /// The path.
+        path: String,
+    },
+    /// An I/O error while reading a mesh file.
+    #[error("cannot read mesh file `{path}`: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A parameter vector of the wrong length or outside its bounds, or an invalid setting.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    /// A collision query that parry does not support for the shapes involved.
+    #[error("unsupported collision query between {0}")]
+    UnsupportedQuery(String),
+    /// The hand could not be placed clear of the object by retreating along its approach axis.
+    #[error("hand still intersects the object after retreating {0:.3} m along the approach axis")]
+    CannotClear(f64),
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = SimError> = std::result::Result<T, E>;
+
+/// Errors unless every value is finite.
+pub(crate) fn ensure_finite(values: &[f64], what: &str) -> Result<()> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SimError::NonFinite { what: what.to_string() })
+    }
+}

@@ -1,0 +1,260 @@
+//! A Barrett BH8-style hand: a palm disc and three fingers (F1, F2 spreading about the palm
+//! normal in opposite senses, F3 fixed), two links each, sizes and limits from the BH8-280
+//! kinematic description (see the constants).
+//!
+//! Palm frame: `z` out of the palm (the approach direction), F1/F2 bases on the `x` axis, F3 on
+//! `+y`. With spread 0, F1 and F2 stand side by side at `y = -0.05` facing F3 at `y = +0.05`.
+//!
+//! Closing: the medial (proximal) joint advances from 0 with the distal joint coupled at one
+//! third of it. If the medial link touches, it stops and the distal joint continues alone (the
+//! TorqueSwitch breakaway) until the distal link touches or reaches its limit. If the distal link
+//! touches first, the whole finger stops. Simplifications: the knuckle housings between the palm
+//! and the flexion joints, the 0.003 m lateral offset of the distal joint and the fixed distal
+//! bend of the real hand are not modelled; links are boxes.
+
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use parry3d_f64::math::Pose;
+
+use super::{
+    CONTACT_TOLERANCE, Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact, clear_hand, final_contacts,
+    world_link_poses,
+};
+use crate::convert::iso2pose;
+use crate::error::{Result, SimError, ensure_finite};
+use crate::object::Object;
+
+/// Palm disc radius.
+pub const PALM_RADIUS: f64 = 0.045;
+/// Palm disc thickness (below the finger bases).
+pub const PALM_THICKNESS: f64 = 0.02;
+/// Height of the palm's top face (the finger bases' plane).
+pub const PALM_TOP: f64 = 0.0415;
+/// F1 spread-joint base on the palm (F2 mirrored in `x`).
+pub const F1_BASE: [f64; 3] = [-0.025, 0.0, 0.0415];
+/// F3 base (its flexion joint; F3 has no spread).
+pub const F3_BASE: [f64; 3] = [0.0, 0.05, 0.0754];
+/// From the spread-joint frame to the flexion joint: along the finger.
+pub const KNUCKLE_OUT: f64 = 0.05;
+/// From the spread-joint frame to the flexion joint: up (palm `z`).
+pub const KNUCKLE_UP: f64 = 0.0339;
+/// Medial link, joint to joint.
+pub const MEDIAL_LENGTH: f64 = 0.06994;
+/// Distal link, joint to fingertip.
+pub const DISTAL_LENGTH: f64 = 0.059;
+/// Finger width (along the flexion axis).
+pub const FINGER_WIDTH: f64 = 0.025;
+/// Finger thickness (in the closing direction).
+pub const FINGER_THICKNESS: f64 = 0.02;
+/// Flexion range of the medial joint: `[0, FLEX_MAX]` (140 degrees).
+pub const FLEX_MAX: f64 = 2.44346;
+/// Distal joint range `[0, FLEX_MAX / 3]` (the coupled motion's end; breakaway stays within it).
+pub const DISTAL_MAX: f64 = FLEX_MAX / 3.0;
+/// Spread range `[0, pi]`.
+pub const SPREAD_MAX: f64 = std::f64::consts::PI;
+
+/// A Barrett BH8-style hand with a fixed spread angle.
+#[derive(Debug)]
+pub struct BarrettHand {
+    spread: f64,
+    links: Vec<LinkSpec>,
+    geometry: LinkGeometry,
+}
+
+impl Default for BarrettHand {
+    /// Spread 0: F1 and F2 side by side facing F3.
+    fn default() -> Self {
+        Self::build(0.0)
+    }
+}
+
+impl BarrettHand {
+    /// A hand whose F1/F2 spread joint is at `spread` (radians, `[0, pi]`) during the grasp.
+    pub fn new(spread: f64) -> Result<Self> {
+        ensure_finite(&[spread], "Barrett spread angle")?;
+        if !(0.0..=SPREAD_MAX).contains(&spread) {
+            return Err(SimError::InvalidInput(format!("Barrett spread {spread} outside [0, pi]")));
+        }
+        Ok(Self::build(spread))
+    }
+
+    fn build(spread: f64) -> Self {
+        let palm = LinkSpec {
+            name: "palm".to_string(),
+            finger: None,
+            shape: LinkShape::Cylinder { radius: PALM_RADIUS, half_height: PALM_THICKNESS / 2.0 },
+        };
+        let mut links = vec![palm];
+        for f in 0..3 {
+            for (part, len) in [("medial", MEDIAL_LENGTH), ("distal", DISTAL_LENGTH)] {
+                links.push(LinkSpec {
+                    name: format!("f{}_{part}", f + 1),
+                    finger: Some(f),
+                    shape: LinkShape::Box {
+                        half_extents: Vector3::new(FINGER_WIDTH / 2.0, FINGER_THICKNESS / 2.0, len / 2.0),
+                    },
+                });
+            }
+        }
+        let geometry = LinkGeometry::new(&links);
+        Self { spread, links, geometry }
+    }
+
+    /// The spread angle used.
+    pub fn spread(&self) -> f64 {
+        self.spread
+    }
+
+    /// Frame of finger `f`'s flexion joint in the palm frame: `x` the flexion axis, `y` pointing
+    /// away from the palm centre (closing moves the finger towards `-y`), `z` the palm normal.
+    pub fn finger_frame(&self, f: usize) -> Isometry3<f64> {
+        Self::frame_at(f, self.spread)
+    }
+
+    fn frame_at(f: usize, spread: f64) -> Isometry3<f64> {
+        let (joint, out) = match f {
+            0 | 1 => {
+                let sign = if f == 0 { -1.0 } else { 1.0 };
+                let base = Vector3::new(sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]);
+                let out = Rotation3::from_axis_angle(&Vector3::z_axis(), sign * spread) * -Vector3::y();
+                (base + KNUCKLE_OUT * out + KNUCKLE_UP * Vector3::z(), out)
+            }
+            _ => (Vector3::new(F3_BASE[0], F3_BASE[1], F3_BASE[2]), Vector3::y()),
+        };
+        let axis = out.cross(&Vector3::z());
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[axis, out, Vector3::z()]));
+        Isometry3::from_parts(Translation3::from(joint), UnitQuaternion::from_rotation_matrix(&rot))
+    }
+
+    /// Medial and distal link frames relative to the finger frame.
+    fn finger_links(medial: f64, distal: f64) -> (Isometry3<f64>, Isometry3<f64>) {
+        let r1 = Isometry3::rotation(Vector3::x() * medial);
+        let m = r1 * Translation3::new(0.0, 0.0, MEDIAL_LENGTH / 2.0);
+        let d = r1
+            * Translation3::new(0.0, 0.0, MEDIAL_LENGTH)
+            * Isometry3::rotation(Vector3::x() * distal)
+            * Translation3::new(0.0, 0.0, DISTAL_LENGTH / 2.0);
+        (m, d)
+    }
+
+    /// Fingertip (centre of the distal link's end face) in the palm frame.
+    pub fn fingertip(&self, f: usize, medial: f64, distal: f64) -> Point3<f64> {
+        let (_, d) = Self::finger_links(medial, distal);
+        self.finger_frame(f) * d * Point3::new(0.0, 0.0, DISTAL_LENGTH / 2.0)
+    }
+}
+
+impl Hand for BarrettHand {
+    fn name(&self) -> &str {
+        "barrett"
+    }
+
+    fn links(&self) -> &[LinkSpec] {
+        &self.links
+    }
+
+    fn finger_count(&self) -> usize {
+        3
+    }
+
+    /// `spread, f1_medial, f1_distal, f2_medial, f2_distal, f3_medial, f3_distal`.
+    fn joint_names(&self) -> Vec<String> {
+        let mut v = vec!["spread".to_string()];
+        for f in 1..=3 {
+            v.push(format!("f{f}_medial"));
+            v.push(format!("f{f}_distal"));
+        }
+        v
+    }
+
+    fn joint_limits(&self) -> Vec<(f64, f64)> {
+        let mut v = vec![(0.0, SPREAD_MAX)];
+        for _ in 0..3 {
+            v.push((0.0, FLEX_MAX));
+            v.push((0.0, DISTAL_MAX));
+        }
+        v
+    }
+
+    fn open_configuration(&self) -> Vec<f64> {
+        vec![self.spread, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    }
+
+    fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>> {
+        if joints.len() != 7 {
+            return Err(SimError::InvalidInput(format!("Barrett hand needs 7 joint values, got {}", joints.len())));
+        }
+        ensure_finite(joints, "Barrett joint values")?;
+        let palm = Isometry3::translation(0.0, 0.0, PALM_TOP - PALM_THICKNESS / 2.0);
+        let mut out = vec![palm];
+        // The spread value of the joint vector is used for F1/F2 (it may differ from self.spread).
+        for f in 0..3 {
+            let frame = Self::frame_at(f, joints[0]);
+            let (m, d) = Self::finger_links(joints[1 + 2 * f], joints[2 + 2 * f]);
+            out.push(frame * m);
+            out.push(frame * d);
+        }
+        Ok(out)
+    }
+
+    fn close(&self, object: &Object, palm_pose: &Isometry3<f64>) -> Result<Grasp> {
+        let (palm, retreat) = clear_hand(self, &self.geometry, object, palm_pose)?;
+        let mut joints = self.open_configuration();
+        let half = Vector3::new(FINGER_WIDTH / 2.0, FINGER_THICKNESS / 2.0, 0.0);
+        let r_medial = (half + Vector3::z() * MEDIAL_LENGTH).norm();
+        let r_distal = (half + Vector3::z() * DISTAL_LENGTH).norm();
+        for f in 0..3 {
+            let frame = palm * self.finger_frame(f);
+            let (im, id) = (1 + 2 * f, 2 + 2 * f);
+            let poses = |m: f64, d: f64| -> (Pose, Pose) {
+                let (lm, ld) = Self::finger_links(m, d);
+                (iso2pose(&(frame * lm)), iso2pose(&(frame * ld)))
+            };
+            // Phase 1: medial and distal coupled (distal = medial / 3).
+            let adv = advance_until_contact(
+                |t| {
+                    let (pm, pd) = poses(t, t / 3.0);
+                    Ok(vec![
+                        self.geometry.distance(object, im, &pm, 0.05)?,
+                        self.geometry.distance(object, id, &pd, 0.05)?,
+                    ])
+                },
+                0.0,
+                FLEX_MAX,
+                &[r_medial, MEDIAL_LENGTH + r_distal + r_distal / 3.0],
+            )?;
+            let medial = adv.t;
+            let mut distal = adv.t / 3.0;
+            if adv.touched == Some(0) {
+                // Phase 2: medial blocked, distal continues alone (unless already touching).
+                let (_, pm) = poses(medial, distal);
+                let d_now = self.geometry.distance(object, id, &pm, 0.05)?;
+                if d_now > CONTACT_TOLERANCE {
+                    let adv2 = advance_until_contact(
+                        |t| {
+                            let (_, pd) = poses(medial, t);
+                            Ok(vec![self.geometry.distance(object, id, &pd, 0.05)?])
+                        },
+                        distal,
+                        DISTAL_MAX.max(distal),
+                        &[r_distal],
+                    )?;
+                    distal = adv2.t;
+                }
+            }
+            joints[im] = medial;
+            joints[id] = distal;
+        }
+        let world = world_link_poses(self, &palm, &joints)?;
+        let (link_distances, link_touching) = final_contacts(&self.geometry, object, &world)?;
+        Ok(Grasp {
+            hand: self.name().to_string(),
+            requested_palm_pose: *palm_pose,
+            palm_pose: palm,
+            retreat,
+            joints,
+            link_poses: world.iter().map(crate::convert::pose2iso).collect(),
+            link_touching,
+            link_distances,
+        })
+    }
+}

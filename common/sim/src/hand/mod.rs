@@ -1,0 +1,367 @@
+//! Hands: the [`Hand`] trait (links as collision shapes, their poses as a function of the joint
+//! values, an open configuration and an auto-grasp `close`), the shared closing machinery, and two
+//! implementations: [`BarrettHand`] (BH8-style, three fingers) and [`ParallelJawGripper`].
+//!
+//! A new hand is a new implementation of [`Hand`]; the helpers here ([`LinkGeometry`],
+//! [`advance_until_contact`], [`clear_hand`]) do the collision work.
+//!
+//! Closing (as GraspIt!/OpenRAVE auto-grasp): from the open configuration each finger's joints
+//! advance; a link that touches the object stops, the links after it keep closing until they touch
+//! or reach their limit. Advancement is *conservative*: each step moves no point of the moving
+//! links farther than their current distance to the object (minus half the tolerance), using a
+//! bound on how fast any link point moves per unit joint motion. Links therefore never penetrate
+//! the object: a link is declared in contact, and stops, when its distance falls to
+//! [`CONTACT_TOLERANCE`] or less, i.e. it rests between `CONTACT_TOLERANCE / 2` and
+//! `CONTACT_TOLERANCE` from the surface (a penetration of zero, up to floating-point round-off).
+
+mod barrett;
+mod gripper;
+
+pub use barrett::BarrettHand;
+pub use gripper::ParallelJawGripper;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use parry3d_f64::math::Pose;
+use parry3d_f64::shape::{Cuboid, Cylinder, Shape};
+
+use crate::convert::{iso2pose, v2g};
+use crate::error::{Result, SimError, ensure_finite};
+use crate::mesh::{self, TriangleMesh};
+use crate::object::Object;
+
+/// A link stops when its distance to the object is at most this (metres). Links never
+/// penetrate: their final gap lies in `[CONTACT_TOLERANCE / 2, CONTACT_TOLERANCE]`.
+pub const CONTACT_TOLERANCE: f64 = 2e-4;
+
+/// Upper bound on conservative-advancement iterations for one motion (a safety net for grazing
+/// approaches; the motion then stops where it is and the link is reported as touching).
+pub const MAX_ADVANCE_ITERATIONS: usize = 400;
+
+/// How far back (metres) a hand placed in collision is retreated along its approach axis at most.
+pub const MAX_RETREAT: f64 = 0.5;
+
+/// Collision shape of a link, centred in the link frame.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum LinkShape {
+    /// A box with these half extents along the link frame's axes.
+    Box {
+        /// Half extents (x, y, z).
+        half_extents: Vector3<f64>,
+    },
+    /// A cylinder (disc) whose axis is the link frame's `z`.
+    Cylinder {
+        /// Radius.
+        radius: f64,
+        /// Half of the height along `z`.
+        half_height: f64,
+    },
+}
+
+impl LinkShape {
+    /// A triangle mesh of the shape in the link frame.
+    pub fn mesh(&self) -> TriangleMesh {
+        match self {
+            LinkShape::Box { half_extents } => mesh::box_mesh(half_extents),
+            LinkShape::Cylinder { radius, half_height } => mesh::revolve(
+                &[(0.0, -half_height), (*radius, -half_height), (*radius, *half_height), (0.0, *half_height)],
+                48,
+            ),
+        }
+    }
+
+    /// Largest distance from the link frame origin to a point of the shape.
+    pub fn bounding_radius(&self) -> f64 {
+        match self {
+            LinkShape::Box { half_extents } => half_extents.norm(),
+            LinkShape::Cylinder { radius, half_height } => radius.hypot(*half_height),
+        }
+    }
+}
+
+/// Static description of one link.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LinkSpec {
+    /// Link name, e.g. `f1_medial`.
+    pub name: String,
+    /// Finger index, `None` for the palm.
+    pub finger: Option<usize>,
+    /// Collision shape in the link frame.
+    pub shape: LinkShape,
+}
+
+/// The result of closing a hand on an object.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Grasp {
+    /// The hand's name.
+    pub hand: String,
+    /// The palm pose asked for (world).
+    pub requested_palm_pose: Isometry3<f64>,
+    /// The palm pose used (world): the requested one, retreated along `-z` (approach axis) by
+    /// `retreat` if the open hand intersected the object there.
+    pub palm_pose: Isometry3<f64>,
+    /// Distance retreated along the approach axis (0 if the open hand was clear of the object).
+    pub retreat: f64,
+    /// Final joint values (the hand's own order, see [`Hand::joint_names`]).
+    pub joints: Vec<f64>,
+    /// Final link frames in the world, in [`Hand::links`] order.
+    pub link_poses: Vec<Isometry3<f64>>,
+    /// Per link: stopped by (or resting within [`CONTACT_TOLERANCE`] of) the object.
+    pub link_touching: Vec<bool>,
+    /// Per link: final distance to the object (0 would mean intersecting; never below 0).
+    pub link_distances: Vec<f64>,
+}
+
+impl Grasp {
+    /// Whether any link (palm included) touches the object.
+    pub fn touches(&self) -> bool {
+        self.link_touching.iter().any(|t| *t)
+    }
+}
+
+/// A robot hand. Link frames are given relative to the palm frame, whose `z` axis is the approach
+/// direction (out of the palm).
+pub trait Hand: Send + Sync + std::fmt::Debug {
+    /// Short name (`barrett`, `parallel_jaw`).
+    fn name(&self) -> &str;
+    /// The links, palm first.
+    fn links(&self) -> &[LinkSpec];
+    /// Number of fingers (links carry their finger index).
+    fn finger_count(&self) -> usize;
+    /// Joint names, in the order of joint vectors.
+    fn joint_names(&self) -> Vec<String>;
+    /// Joint limits `(min, max)`.
+    fn joint_limits(&self) -> Vec<(f64, f64)>;
+    /// The open configuration from which `close` starts.
+    fn open_configuration(&self) -> Vec<f64>;
+    /// Link frames in the palm frame for the given joint values.
+    fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>>;
+    /// Places the open hand at `palm_pose` (retreating along the approach axis if it intersects
+    /// the object) and closes it until contact.
+    fn close(&self, object: &Object, palm_pose: &Isometry3<f64>) -> Result<Grasp>;
+}
+
+/// The built-in hand names.
+pub fn hand_names() -> Vec<&'static str> {
+    vec!["barrett", "parallel_jaw"]
+}
+
+/// A built-in hand by name (`barrett`, `parallel_jaw`).
+pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
+    match name.trim().to_ascii_lowercase().replace('-', "_").as_str() {
+        "barrett" | "bh8" => Ok(Box::new(BarrettHand::default())),
+        "parallel_jaw" | "gripper" => Ok(Box::new(ParallelJawGripper::default())),
+        _ => Err(SimError::UnknownHand { name: name.to_string(), valid: hand_names().join(", ") }),
+    }
+}
+
+/// parry shapes of a hand's links, built once.
+pub struct LinkGeometry {
+    shapes: Vec<(Box<dyn Shape>, Pose, f64)>,
+}
+
+impl std::fmt::Debug for LinkGeometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "LinkGeometry({} links)", self.shapes.len())
+    }
+}
+
+impl LinkGeometry {
+    /// Builds the parry shapes for `links`.
+    pub fn new(links: &[LinkSpec]) -> Self {
+        let shapes = links
+            .iter()
+            .map(|l| {
+                let r = l.shape.bounding_radius();
+                match l.shape {
+                    LinkShape::Box { half_extents } => {
+                        (Box::new(Cuboid::new(v2g(&half_extents))) as Box<dyn Shape>, Pose::IDENTITY, r)
+                    }
+                    LinkShape::Cylinder { radius, half_height } => (
+                        Box::new(Cylinder::new(half_height, radius)) as Box<dyn Shape>,
+                        // parry cylinders are along y; the link's axis is z.
+                        iso2pose(&Isometry3::from_parts(
+                            Translation3::identity(),
+                            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+                        )),
+                        r,
+                    ),
+                }
+            })
+            .collect();
+        Self { shapes }
+    }
+
+    /// The parry shape and its pose for link `i` whose frame is at `link_world`.
+    pub(crate) fn shape_at(&self, i: usize, link_world: &Pose) -> Option<(&dyn Shape, Pose)> {
+        self.shapes.get(i).map(|(s, off, _)| (s.as_ref(), *link_world * *off))
+    }
+
+    /// Distance (0 if intersecting) from link `i` at `link_world` to the object. Uses the cheap
+    /// bounding-sphere bound when it already exceeds `far` (the bound is conservative).
+    pub fn distance(&self, object: &Object, i: usize, link_world: &Pose, far: f64) -> Result<f64> {
+        let Some((shape, pose)) = self.shape_at(i, link_world) else {
+            return Err(SimError::InvalidInput(format!("no link {i}")));
+        };
+        let bound = object.distance_lower_bound(link_world.translation, self.shapes[i].2);
+        if bound > far {
+            return Ok(bound);
+        }
+        object.distance_to_shape(&pose, shape)
+    }
+}
+
+/// Outcome of [`advance_until_contact`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Advance {
+    /// Where the motion parameter stopped.
+    pub t: f64,
+    /// Index (into the `links` argument) of the first link found in contact, if any.
+    pub touched: Option<usize>,
+}
+
+/// Conservative advancement of a one-parameter motion from `t0` to `t1` (`t1 >= t0`).
+///
+/// `distances(t)` returns, for each moving link, its distance to the object at parameter `t`
+/// (0 when intersecting); `rates[k]` bounds how far any point of link `k` moves per unit of `t`.
+/// Stops at the first `t` where some link is within [`CONTACT_TOLERANCE`] (and not
+/// intersecting), or at `t1`.
+///
+/// Each step is the larger of the safe step (no point moves farther than the link's distance
+/// minus half the tolerance) and a secant extrapolation of the measured approach speed; a step
+/// that ends intersecting the object is undone by bisection between the last clear `t` and it,
+/// so the result never intersects.
+pub fn advance_until_contact(
+    mut distances: impl FnMut(f64) -> Result<Vec<f64>>,
+    t0: f64,
+    t1: f64,
+    rates: &[f64],
+) -> Result<Advance> {
+    let tol = CONTACT_TOLERANCE;
+    let touching = |d: &[f64]| d.iter().position(|&di| di > 0.0 && di <= tol);
+    let intersecting = |d: &[f64]| d.iter().any(|&di| di <= 0.0);
+    let mut t = t0;
+    let mut d = distances(t)?;
+    if let Some(k) = touching(&d).or_else(|| d.iter().position(|&di| di <= 0.0)) {
+        // Already touching (or, if the caller allowed it, intersecting) at the start.
+        return Ok(Advance { t, touched: Some(k) });
+    }
+    let mut prev: Option<(f64, Vec<f64>)> = None;
+    for _ in 0..MAX_ADVANCE_ITERATIONS {
+        if t >= t1 {
+            return Ok(Advance { t: t1, touched: None });
+        }
+        let safe = d
+            .iter()
+            .zip(rates)
+            .map(|(&di, &r)| (di - 0.5 * tol) / r.max(1e-12))
+            .fold(f64::INFINITY, f64::min);
+        let mut step = safe;
+        if let Some((tp, dp)) = &prev {
+            let dt = t - tp;
+            let secant = d
+                .iter()
+                .zip(dp)
+                .filter_map(|(&di, &dpi)| {
+                    let slope = (dpi - di) / dt;
+                    (slope > 0.0).then(|| 0.9 * (di - 0.6 * tol) / slope)
+                })
+                .fold(f64::INFINITY, f64::min);
+            if secant.is_finite() {
+                step = step.max(secant);
+            }
+        }
+        let t_new = (t + step).min(t1);
+        let d_new = distances(t_new)?;
+        if !intersecting(&d_new) {
+            prev = Some((t, std::mem::replace(&mut d, d_new)));
+            t = t_new;
+            if let Some(k) = touching(&d) {
+                return Ok(Advance { t, touched: Some(k) });
+            }
+            continue;
+        }
+        // Overshot into the object: bisect between the clear t and t_new.
+        let (mut lo, mut hi) = (t, t_new);
+        let max_rate = rates.iter().fold(0.0_f64, |a, &r| a.max(r));
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            let dm = distances(mid)?;
+            if intersecting(&dm) {
+                hi = mid;
+            } else if let Some(k) = touching(&dm) {
+                return Ok(Advance { t: mid, touched: Some(k) });
+            } else {
+                lo = mid;
+                d = dm;
+            }
+            if (hi - lo) * max_rate < 1e-9 {
+                break;
+            }
+        }
+        // Round-off limits: stop at the last clear parameter, reporting the nearest link.
+        let k = d.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| k);
+        return Ok(Advance { t: lo, touched: k });
+    }
+    // Grazing approach: stop here and report the nearest link.
+    let k = d.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| k);
+    Ok(Advance { t, touched: k })
+}
+
+/// World poses of all links for `joints` with the palm at `palm`.
+pub(crate) fn world_link_poses(hand: &dyn Hand, palm: &Isometry3<f64>, joints: &[f64]) -> Result<Vec<Pose>> {
+    Ok(hand.link_poses(joints)?.iter().map(|l| iso2pose(&(palm * l))).collect())
+}
+
+/// Final distances and touching flags of all links at `world` poses.
+pub(crate) fn final_contacts(geometry: &LinkGeometry, object: &Object, world: &[Pose]) -> Result<(Vec<f64>, Vec<bool>)> {
+    let d = world
+        .iter()
+        .enumerate()
+        .map(|(i, p)| geometry.distance(object, i, p, 0.01))
+        .collect::<Result<Vec<f64>>>()?;
+    let touching = d.iter().map(|&x| x <= CONTACT_TOLERANCE).collect();
+    Ok((d, touching))
+}
+
+/// Checks the palm pose, then retreats the open hand along `-z` until it is clear of the object
+/// and advances it back until some link is within [`CONTACT_TOLERANCE`]. Returns the palm pose
+/// to use and the retreat distance (0 when the requested pose is already clear).
+pub fn clear_hand(
+    hand: &dyn Hand,
+    geometry: &LinkGeometry,
+    object: &Object,
+    palm_pose: &Isometry3<f64>,
+) -> Result<(Isometry3<f64>, f64)> {
+    ensure_finite(palm_pose.to_homogeneous().as_slice(), "palm pose")?;
+    let open = hand.open_configuration();
+    let rel = hand.link_poses(&open)?;
+    let n = rel.len();
+    let at = |s: f64| -> Isometry3<f64> { palm_pose * Translation3::new(0.0, 0.0, -s) };
+    let dists = |s: f64| -> Result<Vec<f64>> {
+        let palm = at(s);
+        (0..n)
+            .map(|i| geometry.distance(object, i, &iso2pose(&(palm * rel[i])), 0.05))
+            .collect()
+    };
+    let d0 = dists(0.0)?;
+    if d0.iter().all(|&d| d > 0.0) {
+        return Ok((*palm_pose, 0.0));
+    }
+    // Retreat in 5 mm steps until clear by more than the tolerance.
+    let step = 0.005;
+    let mut s = step;
+    loop {
+        if s > MAX_RETREAT {
+            return Err(SimError::CannotClear(MAX_RETREAT));
+        }
+        if dists(s)?.iter().all(|&d| d > CONTACT_TOLERANCE) {
+            break;
+        }
+        s += step;
+    }
+    // Advance back (translation: every point moves 1 m per m).
+    let rates = vec![1.0; n];
+    let adv = advance_until_contact(|u| dists(s - u), 0.0, s, &rates)?;
+    let retreat = s - adv.t;
+    Ok((at(retreat), retreat))
+}

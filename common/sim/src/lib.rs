@@ -1,0 +1,33 @@
+//! # graspopt-sim: simulated grasp trials
+//!
+//! The geometric core of graspopt's simulator: the seven test objects of the thesis (and user
+//! meshes), hands that close their fingers until contact (a Barrett BH8-style hand and a
+//! parallel-jaw gripper, both implementations of one [`hand::Hand`] trait), the raw contact clouds
+//! per finger and the three contact models of thesis section 4.3 (mean point, circular patch and
+//! the surface model of section 2.3), trial parameter spaces, and scene meshes for export.
+//!
+//! This crate owns geometry only: it knows nothing of grasp-quality metrics, plotting, files on the
+//! bus or networks. Collision queries use `parry3d-f64` (f64 throughout); the public API uses
+//! nalgebra types, and the single conversion boundary is the private `convert` module.
+//!
+//! Conventions: lengths in metres, angles in radians, world `z` up. Contact normals returned by this
+//! crate point INTO the object (the direction in which a finger pushes).
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod contact;
+mod convert;
+pub mod error;
+pub mod hand;
+pub mod mesh;
+pub mod object;
+pub mod pose;
+pub mod scene;
+pub mod trial;
+
+pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint, NoiseSettings};
+pub use error::SimError;
+pub use hand::{BarrettHand, Grasp, Hand, LinkShape, LinkSpec, ParallelJawGripper};
+pub use mesh::TriangleMesh;
+pub use object::{Object, ObjectKind};
+pub use pose::{ParamKind, ParamSpec, TrialSpace};
+pub use trial::{FingerOutcome, TrialOutcome, run_trial};

@@ -1,0 +1,135 @@
+//! One simulated grasp trial: place the hand, close it on the object, extract each finger's raw
+//! contact cloud and its three contact models. A trial that touches nothing is a valid outcome
+//! with empty clouds (the scorer decides its score).
+
+use nalgebra::Isometry3;
+
+use crate::contact::{
+    ContactCloud, ContactModel, ContactModelSettings, ContactPoint, add_noise, circular_patch, link_cloud, mean_point,
+    surface_model,
+};
+use crate::error::{Result, ensure_finite};
+use crate::hand::{Grasp, Hand, LinkGeometry};
+use crate::object::Object;
+
+/// Contacts of one finger (or of the palm).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FingerOutcome {
+    /// Finger index, `None` for the palm.
+    pub finger: Option<usize>,
+    /// Names of the links that make up this finger.
+    pub links: Vec<String>,
+    /// The raw contact cloud (empty when the finger touches nothing).
+    pub cloud: ContactCloud,
+    /// Mean-point model (`None` when the cloud is empty).
+    pub mean_point: Option<ContactPoint>,
+    /// Circular-patch model.
+    pub circular_patch: Vec<ContactPoint>,
+    /// Surface model (section 2.3).
+    pub surface: Vec<ContactPoint>,
+}
+
+impl FingerOutcome {
+    /// Whether this finger touches the object.
+    pub fn touches(&self) -> bool {
+        !self.cloud.is_empty()
+    }
+
+    /// The contacts of the given model.
+    pub fn contacts(&self, model: ContactModel) -> Vec<ContactPoint> {
+        match model {
+            ContactModel::MeanPoint => self.mean_point.into_iter().collect(),
+            ContactModel::CircularPatch => self.circular_patch.clone(),
+            ContactModel::Surface => self.surface.clone(),
+        }
+    }
+}
+
+/// Everything a trial produced.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TrialOutcome {
+    /// Object name.
+    pub object: String,
+    /// The closed hand: joints, link poses, effective palm pose.
+    pub grasp: Grasp,
+    /// Per finger, in finger order.
+    pub fingers: Vec<FingerOutcome>,
+    /// The palm's contacts.
+    pub palm: FingerOutcome,
+}
+
+impl TrialOutcome {
+    /// Whether anything (a finger or the palm) touches the object.
+    pub fn touched(&self) -> bool {
+        self.palm.touches() || self.fingers.iter().any(FingerOutcome::touches)
+    }
+
+    /// Number of fingers (palm excluded) that touch the object.
+    pub fn fingers_in_contact(&self) -> usize {
+        self.fingers.iter().filter(|f| f.touches()).count()
+    }
+
+    /// All contacts of a model, fingers first, then (optionally) the palm.
+    pub fn contacts(&self, model: ContactModel, include_palm: bool) -> Vec<ContactPoint> {
+        let mut v: Vec<ContactPoint> = self.fingers.iter().flat_map(|f| f.contacts(model)).collect();
+        if include_palm {
+            v.extend(self.palm.contacts(model));
+        }
+        v
+    }
+}
+
+/// Runs one trial: `hand.close(object, palm_pose)`, then contact clouds and models.
+///
+/// Noise (if configured) is added to the modelled contacts, never to the raw clouds, with one
+/// random stream per finger and model derived from the seed.
+pub fn run_trial(
+    object: &Object,
+    hand: &dyn Hand,
+    palm_pose: &Isometry3<f64>,
+    settings: &ContactModelSettings,
+) -> Result<TrialOutcome> {
+    ensure_finite(palm_pose.to_homogeneous().as_slice(), "palm pose")?;
+    settings.validate()?;
+    let grasp = hand.close(object, palm_pose)?;
+    let links = hand.links();
+    let geometry = LinkGeometry::new(links);
+    let d_c = settings.cloud.contact_distance;
+    // Raw points per link (only links within the contact distance are sampled).
+    let mut per_link: Vec<Vec<ContactPoint>> = Vec::with_capacity(links.len());
+    for (i, (spec, pose)) in links.iter().zip(&grasp.link_poses).enumerate() {
+        let near = grasp.link_distances.get(i).is_some_and(|&d| d <= d_c);
+        per_link.push(if near { link_cloud(object, &geometry, i, spec, pose, &settings.cloud)? } else { Vec::new() });
+    }
+    let group = |finger: Option<usize>, stream: u64| -> FingerOutcome {
+        let mut names = Vec::new();
+        let mut points = Vec::new();
+        for (spec, pts) in links.iter().zip(&per_link) {
+            if spec.finger == finger {
+                names.push(spec.name.clone());
+                points.extend_from_slice(pts);
+            }
+        }
+        let mut mean = mean_point(&points);
+        let mut patch = circular_patch(&points, settings);
+        let mut surface = surface_model(&points, object, settings);
+        if let Some(noise) = &settings.noise {
+            if let Some(m) = mean.as_mut() {
+                add_noise(std::slice::from_mut(m), noise, 3 * stream);
+            }
+            add_noise(&mut patch, noise, 3 * stream + 1);
+            add_noise(&mut surface, noise, 3 * stream + 2);
+        }
+        FingerOutcome {
+            finger,
+            links: names,
+            cloud: ContactCloud { points },
+            mean_point: mean,
+            circular_patch: patch,
+            surface,
+        }
+    };
+    let fingers = (0..hand.finger_count()).map(|f| group(Some(f), f as u64 + 1)).collect();
+    let palm = group(None, 0);
+    Ok(TrialOutcome { object: object.name().to_string(), grasp, fingers, palm })
+}

@@ -1,0 +1,414 @@
+//! Trials on known geometry: contact positions and normals, non-penetration, contact models,
+//! every object at its reference pose, empty trials and bad input.
+
+use graspopt_sim::contact::{ContactPoint, surface_model};
+use graspopt_sim::hand::{BarrettHand, CONTACT_TOLERANCE, Hand, LinkShape, ParallelJawGripper, hand_by_name};
+use graspopt_sim::mesh::{self, TriangleMesh};
+use graspopt_sim::pose::{TrialSpace, reference_pose};
+use graspopt_sim::scene;
+use graspopt_sim::{ContactModel, ContactModelSettings, NoiseSettings, Object, SimError, TrialOutcome, run_trial};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+
+const SPHERE_RADIUS: f64 = 0.035;
+
+fn sphere_centre() -> Point3<f64> {
+    Point3::new(0.0, 0.0, SPHERE_RADIUS)
+}
+
+fn trial(object: &Object, hand: &dyn Hand, pose: &Isometry3<f64>) -> TrialOutcome {
+    run_trial(object, hand, pose, &ContactModelSettings::default()).unwrap()
+}
+
+/// Angle between two vectors in degrees, accurate for tiny angles.
+fn angle_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b)).to_degrees()
+}
+
+/// Distance from a point to a link's box (0 inside), for an independent penetration check.
+fn point_box_distance(p: &Point3<f64>, link: &Isometry3<f64>, half: &Vector3<f64>) -> f64 {
+    let local = link.inverse_transform_point(p);
+    let clamped = Point3::new(
+        local.x.clamp(-half.x, half.x),
+        local.y.clamp(-half.y, half.y),
+        local.z.clamp(-half.z, half.z),
+    );
+    (local - clamped).norm()
+}
+
+#[test]
+fn sphere_grasped_at_its_centre() {
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let pose = reference_pose(&sphere);
+    // The approach axis passes through the sphere's centre.
+    let axis_point = pose.inverse_transform_point(&sphere_centre());
+    assert!(axis_point.x.abs() < 1e-12 && axis_point.y.abs() < 1e-12);
+    let out = trial(&sphere, &hand, &pose);
+    assert_eq!(out.fingers_in_contact(), 3, "{:?}", out.grasp.joints);
+    let c = sphere_centre();
+    for f in &out.fingers {
+        assert!(f.cloud.len() >= 3, "finger {:?}: a cloud, not a point ({})", f.finger, f.cloud.len());
+        for p in &f.cloud.points {
+            let r = (p.position - c).norm();
+            assert!((r - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS, "off the surface by {}", r - SPHERE_RADIUS);
+            assert!((p.normal.norm() - 1.0).abs() < 1e-12);
+            assert!(angle_deg(&p.normal, &(c - p.position)) < 1e-6, "normal not towards the centre");
+        }
+        let m = f.mean_point.unwrap();
+        assert!(angle_deg(&m.normal, &(c - m.position)) < 1.0);
+        for s in &f.surface {
+            assert!(((s.position - c).norm() - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS);
+            assert!(angle_deg(&s.normal, &(c - s.position)) < 1e-6, "surface-model normal not radial");
+        }
+    }
+    // No link penetrates: an independent box-vs-sphere distance for every link.
+    for (spec, link) in hand.links().iter().zip(&out.grasp.link_poses) {
+        if let LinkShape::Box { half_extents } = spec.shape {
+            let gap = point_box_distance(&c, link, &half_extents) - SPHERE_RADIUS;
+            assert!(gap >= -1e-9, "{} penetrates by {}", spec.name, -gap);
+            assert!(gap <= CONTACT_TOLERANCE || !out.grasp.link_touching.iter().any(|t| *t) || gap > 0.0);
+        }
+    }
+    for (i, d) in out.grasp.link_distances.iter().enumerate() {
+        assert!(*d > 0.0, "link {i} intersects");
+        if out.grasp.link_touching[i] {
+            assert!(*d <= CONTACT_TOLERANCE);
+        }
+    }
+    // By symmetry F1 and F2 close identically.
+    assert!((out.grasp.joints[1] - out.grasp.joints[3]).abs() < 1e-9);
+}
+
+#[test]
+fn barrett_coupling_and_breakaway() {
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let space = TrialSpace::approach_1d(&sphere);
+    // Far: only the fingertips reach the sphere, the distal link stops the finger (coupled 1/3).
+    let far = trial(&sphere, &hand, &space.palm_pose(&[-0.1]).unwrap());
+    for f in 0..3 {
+        let (m, d) = (far.grasp.joints[1 + 2 * f], far.grasp.joints[2 + 2 * f]);
+        assert!(m > 0.0 && (d - m / 3.0).abs() < 1e-12, "finger {f}: {m} {d}");
+        assert!(far.grasp.link_touching[2 + 2 * f], "distal of finger {f} touches");
+    }
+    // Near: the medial link is blocked and the distal continues past the coupling ratio.
+    let near = trial(&sphere, &hand, &space.palm_pose(&[0.0]).unwrap());
+    for f in 0..3 {
+        let (m, d) = (near.grasp.joints[1 + 2 * f], near.grasp.joints[2 + 2 * f]);
+        assert!(near.grasp.link_touching[1 + 2 * f], "medial of finger {f} touches");
+        assert!(d > m / 3.0 + 1e-3, "finger {f}: distal {d} continued beyond medial/3 = {}", m / 3.0);
+    }
+}
+
+#[test]
+fn surface_model_on_a_flat_face_and_on_a_sphere() {
+    let settings = ContactModelSettings::default();
+    // Cuboid: a small cloud on the +y face (y = 0.025, object frame = world here).
+    let cuboid = Object::by_name("cuboid").unwrap();
+    let cloud: Vec<ContactPoint> = [(-0.004, 0.05), (0.003, 0.052), (0.0, 0.047), (0.002, 0.049)]
+        .iter()
+        .map(|&(x, z)| ContactPoint { position: Point3::new(x, 0.025, z), normal: -Vector3::y() })
+        .collect();
+    let surf = surface_model(&cloud, &cuboid, &settings);
+    assert_eq!(surf.len(), 21);
+    for s in &surf {
+        assert!((s.normal + Vector3::y()).norm() < 1e-12, "{:?}", s.normal);
+        assert!((s.position.y - 0.025).abs() < 1e-12);
+    }
+    // Sphere: a cloud around a point of the surface; every surface-model normal is radial.
+    let sphere = Object::by_name("sphere").unwrap();
+    let c = sphere_centre();
+    let dir = Vector3::new(-1.0, 0.3, 0.2).normalize();
+    let cloud: Vec<ContactPoint> = [0.0, 0.05, -0.05]
+        .iter()
+        .map(|&e| {
+            let d = (dir + Vector3::new(0.0, e, -e)).normalize();
+            ContactPoint { position: c + d * SPHERE_RADIUS, normal: -d }
+        })
+        .collect();
+    let surf = surface_model(&cloud, &sphere, &settings);
+    assert_eq!(surf.len(), 21);
+    for s in &surf {
+        assert!(((s.position - c).norm() - SPHERE_RADIUS).abs() < 1e-12);
+        assert!(angle_deg(&s.normal, &(c - s.position)) < 1e-6);
+    }
+    // Circular patch: flat, on the plane through the mean point, all with the mean normal.
+    let m = graspopt_sim::contact::mean_point(&cloud).unwrap();
+    let patch = graspopt_sim::contact::circular_patch(&cloud, &settings);
+    assert_eq!(patch.len(), 21);
+    for p in &patch {
+        assert_eq!(p.normal, m.normal);
+        assert!((p.position - m.position).dot(&m.normal).abs() < 1e-15);
+        assert!((p.position - m.position).norm() < settings.radius);
+    }
+}
+
+#[test]
+fn parallel_jaw_on_the_cuboid_faces() {
+    let cuboid = Object::by_name("cuboid").unwrap();
+    let hand = ParallelJawGripper::default();
+    let out = trial(&cuboid, &hand, &reference_pose(&cuboid));
+    assert_eq!(out.fingers_in_contact(), 2);
+    for (f, expect) in out.fingers.iter().zip([Vector3::y(), -Vector3::y()]) {
+        for p in f.cloud.points.iter().chain(&f.surface) {
+            assert!((p.normal - expect).norm() < 1e-9, "{:?} vs {expect:?}", p.normal);
+            assert!((p.position.y.abs() - 0.025).abs() < 1e-9);
+        }
+        assert_eq!(f.surface.len(), 21);
+    }
+}
+
+#[test]
+fn every_object_is_touched_at_its_reference_pose() {
+    let hand = BarrettHand::default();
+    for name in Object::names() {
+        let o = Object::by_name(name).unwrap();
+        let out = trial(&o, &hand, &reference_pose(&o));
+        assert!(out.fingers_in_contact() >= 2, "{name}: {} fingers", out.fingers_in_contact());
+        assert!(out.touched());
+        // Every raw contact lies on the object's surface; on the smooth objects its normal is the
+        // opposite of the outward surface normal there.
+        let smooth = matches!(name, "sphere" | "cylinder" | "mug" | "wine_glass");
+        for f in &out.fingers {
+            for p in &f.cloud.points {
+                let sp = o.closest_point(&p.position).unwrap();
+                assert!(sp.signed_distance.abs() < 1e-9, "{name}: contact off the surface by {}", sp.signed_distance);
+                assert!((p.normal.norm() - 1.0).abs() < 1e-12);
+                if smooth {
+                    assert!(p.normal.dot(&sp.outward_normal) < -0.9, "{name}: normal must point into the object");
+                }
+            }
+        }
+        assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0), "{name}: a link intersects");
+    }
+}
+
+#[test]
+fn gripper_touches_the_objects_it_can_reach() {
+    let hand = hand_by_name("parallel_jaw").unwrap();
+    for name in Object::names() {
+        let o = Object::by_name(name).unwrap();
+        let out = trial(&o, hand.as_ref(), &(reference_pose(&o) * Translation3::new(0.0, 0.0, 0.02)));
+        assert!(out.fingers_in_contact() >= 1, "{name}");
+    }
+}
+
+#[test]
+fn a_far_pose_touches_nothing() {
+    let cyl = Object::by_name("cylinder").unwrap();
+    let far = reference_pose(&cyl) * Translation3::new(0.0, 0.0, -0.5);
+    for hand in [hand_by_name("barrett").unwrap(), hand_by_name("parallel_jaw").unwrap()] {
+        let out = trial(&cyl, hand.as_ref(), &far);
+        assert!(!out.touched());
+        assert_eq!(out.fingers_in_contact(), 0);
+        for f in out.fingers.iter().chain([&out.palm]) {
+            assert!(f.cloud.is_empty() && f.mean_point.is_none() && f.circular_patch.is_empty() && f.surface.is_empty());
+        }
+        assert!(out.contacts(ContactModel::Surface, true).is_empty());
+        assert_eq!(out.grasp.retreat, 0.0);
+        // Every finger joint closed to its limit (the spread is not a closing joint).
+        let limits = hand.joint_limits();
+        for ((name, j), (_, hi)) in hand.joint_names().iter().zip(&out.grasp.joints).zip(&limits) {
+            if name != "spread" {
+                assert!((j - hi).abs() < 1e-12, "joint {name} = {j}, limit {hi}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_hand_placed_inside_the_object_retreats() {
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let inside = reference_pose(&sphere) * Translation3::new(0.0, 0.0, 0.05);
+    let out = trial(&sphere, &hand, &inside);
+    assert!(out.grasp.retreat > 0.03, "retreat {}", out.grasp.retreat);
+    assert!(out.palm.touches(), "the palm rests on the sphere");
+    assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0));
+}
+
+#[test]
+fn bad_input_gives_clear_errors() {
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let mut nan = reference_pose(&sphere);
+    nan.translation.vector.x = f64::NAN;
+    let e = run_trial(&sphere, &hand, &nan, &ContactModelSettings::default()).unwrap_err();
+    assert!(matches!(e, SimError::NonFinite { .. }), "{e}");
+    assert!(e.to_string().contains("pose"));
+
+    let e = Object::by_name("banana").unwrap_err();
+    assert!(e.to_string().contains("banana") && e.to_string().contains("cylinder"), "{e}");
+    assert!(hand_by_name("shadow").is_err());
+
+    let e = Object::from_mesh("empty", TriangleMesh::default()).unwrap_err();
+    assert!(matches!(e, SimError::EmptyMesh { .. }), "{e}");
+    let mut open = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02));
+    open.triangles.truncate(10);
+    let e = Object::from_mesh("open box", open).unwrap_err();
+    assert!(matches!(e, SimError::NotWatertight { .. }), "{e}");
+    assert!(e.to_string().contains("open box"));
+
+    let bad = ContactModelSettings { radius: -1.0, ..Default::default() };
+    assert!(run_trial(&sphere, &hand, &reference_pose(&sphere), &bad).is_err());
+    assert!(BarrettHand::new(4.0).is_err());
+    assert!(hand.link_poses(&[0.0; 3]).is_err());
+    assert!(sphere.clone().with_pose(nan).is_err());
+}
+
+fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("graspopt-sim-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn obj_and_stl_meshes_load_and_can_be_grasped() {
+    let dir = temp_dir("meshes");
+    // A 4 cm cube standing on z = 0, as OBJ with quads (1-based indices, one `v/vt/vn` face).
+    let obj = "# cube\nv -0.02 -0.02 0\nv 0.02 -0.02 0\nv 0.02 0.02 0\nv -0.02 0.02 0\n\
+               v -0.02 -0.02 0.04\nv 0.02 -0.02 0.04\nv 0.02 0.02 0.04\nv -0.02 0.02 0.04\n\
+               f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2/1/1 3/1/1 7/1/1 6/1/1\nf 3 4 8 7\nf 4 1 5 8\n";
+    let obj_path = dir.join("cube.obj");
+    std::fs::write(&obj_path, obj).unwrap();
+    // The same cube as binary and ASCII STL (triangles from the generator, each corner repeated).
+    let cube = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02)).transformed(&Isometry3::translation(0.0, 0.0, 0.02));
+    let mut bin = vec![0u8; 80];
+    bin.extend_from_slice(&(cube.triangles.len() as u32).to_le_bytes());
+    let mut ascii = String::from("solid cube\n");
+    for t in &cube.triangles {
+        bin.extend_from_slice(&[0u8; 12]);
+        ascii.push_str(" facet normal 0 0 0\n  outer loop\n");
+        for &i in t {
+            let v = cube.vertices[i as usize];
+            for c in [v.x, v.y, v.z] {
+                bin.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+            ascii.push_str(&format!("   vertex {} {} {}\n", v.x, v.y, v.z));
+        }
+        bin.extend_from_slice(&[0u8; 2]);
+        ascii.push_str("  endloop\n endfacet\n");
+    }
+    ascii.push_str("endsolid cube\n");
+    let bin_path = dir.join("cube_bin.stl");
+    let ascii_path = dir.join("cube_ascii.STL");
+    std::fs::write(&bin_path, &bin).unwrap();
+    std::fs::write(&ascii_path, &ascii).unwrap();
+
+    let hand = BarrettHand::default();
+    for path in [&obj_path, &bin_path, &ascii_path] {
+        let o = Object::from_file(path).unwrap();
+        let (lo, hi) = o.aabb();
+        assert!((lo - Point3::new(-0.02, -0.02, 0.0)).norm() < 1e-6, "{path:?}: {lo:?}");
+        assert!((hi - Point3::new(0.02, 0.02, 0.04)).norm() < 1e-6, "{path:?}: {hi:?}");
+        assert!((o.centre_of_mass() - Point3::new(0.0, 0.0, 0.02)).norm() < 1e-6);
+        let out = trial(&o, &hand, &reference_pose(&o));
+        assert!(out.fingers_in_contact() >= 2, "{path:?}");
+    }
+    // Errors: unknown extension, missing file, garbage, an open mesh.
+    let txt = dir.join("cube.txt");
+    std::fs::write(&txt, obj).unwrap();
+    assert!(matches!(Object::from_file(&txt).unwrap_err(), SimError::UnsupportedFormat { .. }));
+    assert!(matches!(Object::from_file(&dir.join("missing.obj")).unwrap_err(), SimError::Io { .. }));
+    let junk = dir.join("junk.stl");
+    std::fs::write(&junk, b"not a mesh").unwrap();
+    assert!(matches!(Object::from_file(&junk).unwrap_err(), SimError::MeshParse { .. }));
+    let holey = dir.join("holey.obj");
+    std::fs::write(&holey, obj.replace("f 5 6 7 8\n", "")).unwrap();
+    assert!(matches!(Object::from_file(&holey).unwrap_err(), SimError::NotWatertight { .. }));
+    let empty = dir.join("empty.obj");
+    std::fs::write(&empty, "# nothing\n").unwrap();
+    assert!(matches!(Object::from_file(&empty).unwrap_err(), SimError::EmptyMesh { .. }));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_non_convex_user_mesh_works_through_the_mesh_path() {
+    // An L-shaped prism (not convex: collision uses the triangle mesh itself).
+    let l = [(0.03, -0.03), (0.03, 0.0), (0.0, 0.0), (0.0, 0.03), (-0.03, 0.03), (-0.03, -0.03)];
+    // Star-shaped about the origin? No (the notch); build it as an explicit closed mesh.
+    let n = l.len() as u32;
+    let mut m = TriangleMesh::default();
+    for &(x, y) in &l {
+        m.vertices.push(Point3::new(x, y, 0.0));
+    }
+    for &(x, y) in &l {
+        m.vertices.push(Point3::new(x, y, 0.08));
+    }
+    // Caps (fan from the convex corner 4, whose diagonals stay inside the L), then the sides.
+    for i in 0..n {
+        let j = (i + 1) % n;
+        if i != 4 && j != 4 {
+            m.triangles.push([4, j, i]);
+            m.triangles.push([n + 4, n + i, n + j]);
+        }
+        m.triangles.push([i, j, n + j]);
+        m.triangles.push([i, n + j, n + i]);
+    }
+    let o = Object::from_mesh("l_prism", m).unwrap();
+    let hand = BarrettHand::default();
+    let out = trial(&o, &hand, &reference_pose(&o));
+    assert!(out.fingers_in_contact() >= 2);
+    assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0));
+}
+
+#[test]
+fn noise_is_seeded_and_keeps_normals_unit() {
+    let mug = Object::by_name("mug").unwrap();
+    let hand = BarrettHand::default();
+    let pose = reference_pose(&mug);
+    let noisy = |seed| ContactModelSettings {
+        noise: Some(NoiseSettings { position_std: 5e-4, normal_std: 0.05, seed }),
+        ..Default::default()
+    };
+    let a = run_trial(&mug, &hand, &pose, &noisy(1)).unwrap();
+    let b = run_trial(&mug, &hand, &pose, &noisy(1)).unwrap();
+    let c = run_trial(&mug, &hand, &pose, &noisy(2)).unwrap();
+    let clean = trial(&mug, &hand, &pose);
+    assert_eq!(a, b);
+    assert_ne!(a.contacts(ContactModel::Surface, false), c.contacts(ContactModel::Surface, false));
+    assert_ne!(a.contacts(ContactModel::MeanPoint, false), clean.contacts(ContactModel::MeanPoint, false));
+    assert_eq!(a.fingers[0].cloud, clean.fingers[0].cloud, "raw clouds stay noise-free");
+    for p in a.contacts(ContactModel::Surface, true) {
+        assert!((p.normal.norm() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn scene_meshes_and_json() {
+    let mug = Object::by_name("mug").unwrap();
+    let hand = BarrettHand::default();
+    let out = trial(&mug, &hand, &reference_pose(&mug));
+    let meshes = scene::scene_meshes(&mug, &hand, &out.grasp).unwrap();
+    assert_eq!(meshes.len(), 1 + hand.links().len());
+    for m in &meshes[1..] {
+        m.mesh.validate_closed(&m.name).unwrap();
+    }
+    assert!(meshes[0].mesh.triangles.len() > 100);
+    let json = serde_json::to_string(&out).unwrap();
+    let back: TrialOutcome = serde_json::from_str(&json).unwrap();
+    assert_eq!(back.fingers.len(), 3);
+    assert_eq!(back.grasp.joints, out.grasp.joints);
+}
+
+#[test]
+fn two_dimensional_space_covers_touching_and_empty_trials() {
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let space = TrialSpace::approach_vertical_2d(&sphere);
+    let (lo, hi) = (space.params[1].lower, space.params[1].upper);
+    let mut touched = 0;
+    let mut empty = 0;
+    for i in 0..5 {
+        let v = lo + (hi - lo) * i as f64 / 4.0;
+        for a in [space.params[0].lower, 0.0] {
+            let out = trial(&sphere, &hand, &space.palm_pose(&[a, v]).unwrap());
+            if out.touched() {
+                touched += 1;
+            } else {
+                empty += 1;
+            }
+        }
+    }
+    assert!(touched >= 3 && empty >= 1, "touched {touched}, empty {empty}");
+}
