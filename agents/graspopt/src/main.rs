@@ -8,7 +8,11 @@ use clap::{Parser, Subcommand};
 mod commands;
 
 #[derive(Parser, Debug)]
-#[command(name = "graspopt", version, about = "Find good robotic grasps by trial")]
+#[command(
+    name = "graspopt",
+    version,
+    about = "Find good robotic grasps by trial"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -23,12 +23,25 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn reference_file_matches_expected_values() {
     let path = reference_file();
-    let out = graspopt(&["quality", "--input", path.to_str().unwrap(), "--format", "json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = graspopt(&[
+        "quality",
+        "--input",
+        path.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let cases = doc["cases"].as_array().unwrap();
     let stdout = String::from_utf8(out.stdout).unwrap();
-    let rows: Vec<Value> = stdout.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let rows: Vec<Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
     assert_eq!(rows.len(), cases.len());
     for (i, (row, case)) in rows.iter().zip(cases).enumerate() {
         let e = &case["expected"];
@@ -70,11 +83,20 @@ fn timing_and_table_output() {
     assert!(rows[0]["micros"].as_f64().unwrap() > 0.0);
     // Contacts win over wrenches: one contact at distance 1.
     assert!((rows[1]["bw"].as_f64().unwrap() + 1.0).abs() < 1e-12);
-    let out = graspopt(&["quality", "--input", file.to_str().unwrap(), "--format", "table"]);
+    let out = graspopt(&[
+        "quality",
+        "--input",
+        file.to_str().unwrap(),
+        "--format",
+        "table",
+    ]);
     let text = String::from_utf8(out.stdout).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 3);
-    assert!(lines[0].contains("epsilon") && lines[2].contains("-1.000000000e0"), "{text}");
+    assert!(
+        lines[0].contains("epsilon") && lines[2].contains("-1.000000000e0"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -103,11 +125,25 @@ fn bad_cases_name_the_case_and_field_and_the_rest_still_run() {
     let stdout = String::from_utf8(out.stdout).unwrap();
     if stderr.contains("is not valid JSON") {
         // serde_json refuses 1e999: drop that case and try again.
-        let cases: Vec<String> = cases.iter().filter(|c| !c.contains("1e999")).cloned().collect();
+        let cases: Vec<String> = cases
+            .iter()
+            .filter(|c| !c.contains("1e999"))
+            .cloned()
+            .collect();
         std::fs::write(&file, format!("{{\"cases\": [{}]}}", cases.join(","))).unwrap();
-        return check_bad_output(&graspopt(&["quality", "--input", file.to_str().unwrap()]), false);
+        return check_bad_output(
+            &graspopt(&["quality", "--input", file.to_str().unwrap()]),
+            false,
+        );
     }
-    check_bad_output(&Output { status: out.status, stdout: stdout.into(), stderr: stderr.into() }, true);
+    check_bad_output(
+        &Output {
+            status: out.status,
+            stdout: stdout.into(),
+            stderr: stderr.into(),
+        },
+        true,
+    );
 }
 
 fn check_bad_output(out: &Output, with_infinity: bool) {
@@ -140,9 +176,15 @@ fn check_bad_output(out: &Output, with_infinity: bool) {
     }
     if with_infinity {
         let message = rows[11]["error"].as_str().unwrap_or_default();
-        assert!(message.contains("case 11") && message.contains("not finite"), "{message}");
+        assert!(
+            message.contains("case 11") && message.contains("not finite"),
+            "{message}"
+        );
     }
-    assert!(stderr.contains(&format!("{} of {n} cases failed", n - 2)), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{} of {n} cases failed", n - 2)),
+        "{stderr}"
+    );
 }
 
 #[test]
@@ -157,11 +199,16 @@ fn unreadable_input_is_a_clear_error() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("is not valid JSON"));
     std::fs::write(&file, "[]").unwrap();
     let out = graspopt(&["quality", "--input", file.to_str().unwrap()]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("expected an object with a `cases` array"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("expected an object with a `cases` array")
+    );
 }
 
 fn tempdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("graspopt-quality-cli-{}-{name}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!(
+        "graspopt-quality-cli-{}-{name}",
+        std::process::id()
+    ));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }

@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use graspopt_bayesopt::benchmark::{
-    aggregate, recommended_settings, run_seed_with, summarize, SeedSummary,
+    SeedSummary, aggregate, recommended_settings, run_seed_with, summarize,
 };
 use graspopt_bayesopt::{TestFunction, XiRule};
 
@@ -73,6 +73,12 @@ fn main() {
     if let Some(v) = env("BO_PMQ").and_then(|v| v.parse::<f64>().ok()) {
         settings.prior_mean_quantile = Some(v);
     }
+    if let Some(v) = env("BO_DIV").and_then(|v| v.parse::<usize>().ok()) {
+        settings.diversify_every = v;
+    }
+    if let Some(v) = env("BO_DEPTH").and_then(|v| v.parse::<usize>().ok()) {
+        settings.diversify_depth = v;
+    }
     if let Some(v) = env("BO_WARP") {
         settings.output_transform = match v.as_str() {
             "1" => graspopt_bayesopt::OutputTransform::TailLog,
@@ -95,8 +101,12 @@ fn main() {
             let s = settings.clone();
             std::thread::spawn(move || {
                 let mut out = Vec::new();
-                let mut seed = t;
-                while seed < seeds {
+                let seed0: u64 = std::env::var("BO_SEED0")
+                    .ok()
+                    .and_then(|v| v.parse().ok())
+                    .unwrap_or(0);
+                let mut seed = seed0 + t;
+                while seed < seed0 + seeds {
                     let ts = Instant::now();
                     match run_seed_with(f, seed, budget, q, s.clone()) {
                         Ok(trace) => {

@@ -14,10 +14,11 @@ use crate::special::{dlog_h, h, log_h};
 pub const LOG_EI_FLOOR: f64 = -1e200;
 
 /// Which acquisition the optimizer maximises.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum AcquisitionKind {
     /// Expected improvement, maximised through its logarithm (log-EI) for numerical
     /// robustness: the same maximiser as EI.
+    #[default]
     ExpectedImprovement,
     /// Upper confidence bound `mu + sqrt(beta) sigma`.
     Ucb {
@@ -26,28 +27,17 @@ pub enum AcquisitionKind {
     },
 }
 
-impl Default for AcquisitionKind {
-    fn default() -> Self {
-        AcquisitionKind::ExpectedImprovement
-    }
-}
-
 /// How `xi` is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum XiRule {
     /// Thesis eq. 3.16: `xi = sigma_f^2 / 100` (sigma_f^2 the fitted signal variance of the
     /// standardised outputs).
+    #[default]
     ThesisSignalVariance,
     /// `xi = sigma_f^2 * factor` (factor 0.01 reproduces the thesis rule).
     SignalVarianceTimes(f64),
     /// A fixed `xi` on the standardised-output scale (0 = plain EI).
     Fixed(f64),
-}
-
-impl Default for XiRule {
-    fn default() -> Self {
-        XiRule::ThesisSignalVariance
-    }
 }
 
 impl XiRule {
@@ -80,7 +70,11 @@ pub fn log_expected_improvement(mean: f64, var: f64, best: f64, xi: f64) -> f64 
     let sigma = var.sqrt();
     let z = (mean - best - xi) / sigma;
     let v = sigma.ln() + log_h(z);
-    if v.is_finite() { v.max(LOG_EI_FLOOR) } else { LOG_EI_FLOOR }
+    if v.is_finite() {
+        v.max(LOG_EI_FLOOR)
+    } else {
+        LOG_EI_FLOOR
+    }
 }
 
 /// log-EI and its gradient from the posterior mean/variance and their gradients.
@@ -106,7 +100,11 @@ pub fn log_ei_with_grad(
         *g = d_mu * dm + d_sigma * dv / (2.0 * sigma);
     }
     let v = sigma.ln() + log_h(z);
-    if v.is_finite() { v.max(LOG_EI_FLOOR) } else { LOG_EI_FLOOR }
+    if v.is_finite() {
+        v.max(LOG_EI_FLOOR)
+    } else {
+        LOG_EI_FLOOR
+    }
 }
 
 /// Upper confidence bound `mu + sqrt(beta * var)`.
@@ -126,7 +124,12 @@ pub fn ucb_with_grad(
     let sigma = var.max(0.0).sqrt();
     let k = beta.sqrt();
     for ((g, dm), dv) in grad.iter_mut().zip(dmean).zip(dvar) {
-        *g = dm + if sigma > 1e-150 { k * dv / (2.0 * sigma) } else { 0.0 };
+        *g = dm
+            + if sigma > 1e-150 {
+                k * dv / (2.0 * sigma)
+            } else {
+                0.0
+            };
     }
     mean + k * sigma
 }
@@ -157,11 +160,20 @@ mod tests {
 
     #[test]
     fn log_ei_finite_and_consistent() {
-        for &(m, v) in &[(0.0, 1.0), (-3.0, 0.25), (2.0, 0.01), (-8.0, 1.0), (-1.0, 0.04)] {
+        for &(m, v) in &[
+            (0.0, 1.0),
+            (-3.0, 0.25),
+            (2.0, 0.01),
+            (-8.0, 1.0),
+            (-1.0, 0.04),
+        ] {
             let ei = expected_improvement(m, v, 0.0, 0.01);
             let lei = log_expected_improvement(m, v, 0.0, 0.01);
             assert!(ei > 0.0);
-            assert!((lei - ei.ln()).abs() < 1e-8 * ei.ln().abs().max(1.0), "{m} {v}");
+            assert!(
+                (lei - ei.ln()).abs() < 1e-8 * ei.ln().abs().max(1.0),
+                "{m} {v}"
+            );
         }
         // plateau: EI underflows to 0, log-EI still finite and ordered
         let a = log_expected_improvement(-100.0, 1e-4, 0.0, 0.0);
@@ -176,10 +188,22 @@ mod tests {
         let f = |x: f64| log_expected_improvement(2.0 * x - 1.0, 0.1 + x * x, 0.3, 0.01);
         for &x in &[-3.0, -0.5, 0.2, 1.5] {
             let mut g = [0.0];
-            log_ei_with_grad(2.0 * x - 1.0, 0.1 + x * x, &[2.0], &[2.0 * x], 0.3, 0.01, &mut g);
+            log_ei_with_grad(
+                2.0 * x - 1.0,
+                0.1 + x * x,
+                &[2.0],
+                &[2.0 * x],
+                0.3,
+                0.01,
+                &mut g,
+            );
             let e = 1e-6;
             let fd = (f(x + e) - f(x - e)) / (2.0 * e);
-            assert!((fd - g[0]).abs() < 1e-5 * fd.abs().max(1.0), "{x} {fd} {}", g[0]);
+            assert!(
+                (fd - g[0]).abs() < 1e-5 * fd.abs().max(1.0),
+                "{x} {fd} {}",
+                g[0]
+            );
         }
     }
 

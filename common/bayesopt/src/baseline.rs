@@ -131,13 +131,17 @@ impl GridSearch {
     ) -> Result<Self> {
         let record = Record::new(bounds, minimize)?;
         if points_per_dim < 2 {
-            return Err(BoError::InvalidSetting("grid needs >= 2 points per dim".into()));
+            return Err(BoError::InvalidSetting(
+                "grid needs >= 2 points per dim".into(),
+            ));
         }
         let total = (0..bounds.len()).try_fold(1usize, |acc, _| {
             acc.checked_mul(points_per_dim).filter(|t| *t <= 10_000_000)
         });
         let Some(total) = total else {
-            return Err(BoError::InvalidSetting("grid larger than 10^7 points".into()));
+            return Err(BoError::InvalidSetting(
+                "grid larger than 10^7 points".into(),
+            ));
         };
         let mut order: Vec<usize> = (0..total).collect();
         if shuffle {

@@ -7,7 +7,8 @@
 //! two new centres have the best value being split first (eq. 3.18). [`polish`] optionally
 //! refines the result with a short bounded gradient search.
 
-use std::collections::BTreeMap;
+use std::cmp::{Ordering, Reverse};
+use std::collections::{BTreeMap, BinaryHeap};
 
 use crate::error::{BoError, Result};
 use crate::lbfgs;
@@ -47,6 +48,56 @@ pub struct DirectResult {
     pub top: Vec<(Vec<f64>, f64)>,
 }
 
+/// Heap entry: (value, index), ordered by value then index.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Entry(f64, usize);
+
+impl Eq for Entry {}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
+    }
+}
+
+/// Rectangles grouped by size, each group a min-heap on the value (stale entries, whose
+/// rectangle has since been divided, are dropped lazily).
+#[derive(Default)]
+struct Groups {
+    map: BTreeMap<u64, BinaryHeap<Reverse<Entry>>>,
+}
+
+impl Groups {
+    fn insert(&mut self, size: f64, f: f64, idx: usize) {
+        self.map
+            .entry(size.to_bits())
+            .or_default()
+            .push(Reverse(Entry(f, idx)));
+    }
+
+    /// Best rectangle of each size, sizes ascending.
+    fn representatives(&mut self, rects: &[Rect]) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.map.len());
+        self.map.retain(|key, heap| {
+            while let Some(Reverse(Entry(_, i))) = heap.peek() {
+                if rects[*i].size.to_bits() == *key {
+                    out.push(*i);
+                    return true;
+                }
+                heap.pop();
+            }
+            false
+        });
+        out
+    }
+}
+
 struct Rect {
     center: Vec<f64>,
     levels: Vec<u32>,
@@ -61,6 +112,9 @@ fn rect_size(levels: &[u32]) -> f64 {
     let s: f64 = ls.iter().map(|&l| 9f64.powi(-(l as i32))).sum();
     0.5 * s.sqrt()
 }
+
+/// The two new centres along one side: (side, c+, f(c+), c-, f(c-)).
+type Trial = (usize, Vec<f64>, f64, Vec<f64>, f64);
 
 /// Check bounds of a box.
 pub fn check_bounds(lower: &[f64], upper: &[f64]) -> Result<()> {
@@ -98,7 +152,7 @@ where
     F: FnMut(&[f64]) -> f64,
 {
     check_bounds(lower, upper)?;
-    if settings.max_evals == 0 || !(settings.epsilon >= 0.0) {
+    if settings.max_evals == 0 || settings.epsilon.is_nan() || settings.epsilon < 0.0 {
         return Err(BoError::InvalidSetting(
             "DIRECT needs max_evals >= 1 and epsilon >= 0".into(),
         ));
@@ -126,21 +180,13 @@ where
         f: f0,
     }];
     let mut best = 0usize;
+    let mut groups = Groups::default();
+    groups.insert(rects[0].size, rects[0].f, 0);
     loop {
-        // Best rectangle per size (ties: the earliest).
+        // Best rectangle per size (ties: the earliest); sizes ascending (positive f64 bit
+        // patterns order like the values).
         let fmin = rects[best].f;
-        let mut groups: BTreeMap<u64, usize> = BTreeMap::new();
-        for (i, r) in rects.iter().enumerate() {
-            let key = r.size.to_bits();
-            match groups.get(&key) {
-                Some(&j) if rects[j].f <= r.f => {}
-                _ => {
-                    groups.insert(key, i);
-                }
-            }
-        }
-        // Sizes ascending (positive f64 bit patterns order like the values).
-        let reps: Vec<usize> = groups.values().copied().collect();
+        let reps = groups.representatives(&rects);
         // Start at the group whose best value is the global minimum (largest such size).
         let mut start = 0;
         for (k, &i) in reps.iter().enumerate() {
@@ -193,7 +239,7 @@ where
                 break;
             }
             let delta = 3f64.powi(-(minl as i32 + 1));
-            let mut trial: Vec<(usize, Vec<f64>, f64, Vec<f64>, f64)> = Vec::new();
+            let mut trial: Vec<Trial> = Vec::new();
             for &i in &dims {
                 let mut cp = rects[j].center.clone();
                 cp[i] += delta;
@@ -215,6 +261,7 @@ where
                         f: fv,
                         size,
                     });
+                    groups.insert(size, fv, rects.len() - 1);
                     if fv < rects[best].f {
                         best = rects.len() - 1;
                     }
@@ -222,6 +269,7 @@ where
             }
             rects[j].size = rect_size(&levels);
             rects[j].levels = levels;
+            groups.insert(rects[j].size, rects[j].f, j);
         }
         if stop || evals >= settings.max_evals {
             break;
@@ -349,8 +397,14 @@ mod tests {
         assert!(maximize(|_| 0.0, &[0.0, 0.0], &[1.0], &s, 1).is_err());
         assert!(maximize(|_| 0.0, &[f64::NAN], &[1.0], &s, 1).is_err());
         // NaN objective values do not break the run
-        let r = maximize(|x| if x[0] > 0.6 { f64::NAN } else { x[0] }, &[0.0], &[1.0], &s, 1)
-            .unwrap();
+        let r = maximize(
+            |x| if x[0] > 0.6 { f64::NAN } else { x[0] },
+            &[0.0],
+            &[1.0],
+            &s,
+            1,
+        )
+        .unwrap();
         assert!(r.value.is_finite());
     }
 }

@@ -9,7 +9,9 @@ pub enum BoError {
     #[error("bounds are empty: at least one dimension is needed")]
     EmptyBounds,
     /// A bound is not finite or lower >= upper.
-    #[error("invalid bound in dimension {dim}: lower {lower} must be finite and below upper {upper}")]
+    #[error(
+        "invalid bound in dimension {dim}: lower {lower} must be finite and below upper {upper}"
+    )]
     InvalidBound {
         /// Offending dimension.
         dim: usize,

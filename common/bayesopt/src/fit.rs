@@ -159,9 +159,8 @@ impl<'a> Objective<'a> {
         let mut diff2 = Vec::with_capacity(n * n.saturating_sub(1) / 2 * d);
         for i in 0..n {
             for j in 0..i {
-                for k in 0..d {
-                    let t = x[i][k] - x[j][k];
-                    diff2.push(t * t);
+                for (a, b) in x[i].iter().zip(&x[j]).take(d) {
+                    diff2.push((a - b) * (a - b));
                 }
             }
         }
@@ -267,7 +266,9 @@ pub fn fit_map(
     settings.validate()?;
     let d = x.first().map_or(0, |p| p.len());
     if x.is_empty() || d == 0 {
-        return Err(BoError::NotEnoughData("fit needs at least one point".into()));
+        return Err(BoError::NotEnoughData(
+            "fit needs at least one point".into(),
+        ));
     }
     if x.len() != y.len() {
         return Err(BoError::DimensionMismatch {
@@ -362,9 +363,13 @@ mod tests {
                 let mut tm = theta.clone();
                 tm[i] -= e;
                 let mut dummy = vec![0.0; 4];
-                let fd = (obj.value_grad(&tp, &mut dummy) - obj.value_grad(&tm, &mut dummy))
-                    / (2.0 * e);
-                assert!((fd - g[i]).abs() < 1e-4 * fd.abs().max(1.0), "{kind:?} {i} {fd} {}", g[i]);
+                let fd =
+                    (obj.value_grad(&tp, &mut dummy) - obj.value_grad(&tm, &mut dummy)) / (2.0 * e);
+                assert!(
+                    (fd - g[i]).abs() < 1e-4 * fd.abs().max(1.0),
+                    "{kind:?} {i} {fd} {}",
+                    g[i]
+                );
             }
         }
     }
@@ -392,7 +397,18 @@ mod tests {
         let st = FitSettings::default();
         let mut rng = Rng::new(1);
         let x = vec![vec![0.1], vec![0.2]];
-        assert!(fit_map(KernelKind::Matern32, &st, &x, &[1.0, f64::NAN], None, 0, &mut rng).is_err());
+        assert!(
+            fit_map(
+                KernelKind::Matern32,
+                &st,
+                &x,
+                &[1.0, f64::NAN],
+                None,
+                0,
+                &mut rng
+            )
+            .is_err()
+        );
         assert!(fit_map(KernelKind::Matern32, &st, &x, &[1.0], None, 0, &mut rng).is_err());
         assert!(fit_map(KernelKind::Matern32, &st, &[], &[], None, 0, &mut rng).is_err());
     }

@@ -165,12 +165,7 @@ impl Gp {
     }
 
     /// Posterior mean and variance with their gradients with respect to `xs`.
-    pub fn predict_with_grad(
-        &self,
-        xs: &[f64],
-        dmean: &mut [f64],
-        dvar: &mut [f64],
-    ) -> (f64, f64) {
+    pub fn predict_with_grad(&self, xs: &[f64], dmean: &mut [f64], dvar: &mut [f64]) -> (f64, f64) {
         let n = self.x.len();
         let d = self.dim;
         let mut dk = vec![0.0; n * d];
@@ -307,7 +302,10 @@ mod tests {
         assert!((m - mean_expected).abs() < 1e-12, "{m} {mean_expected}");
         assert!((v - var_expected).abs() < 1e-12, "{v} {var_expected}");
         // Numerical values, for the record.
-        assert!((mean_expected - 0.675_106_854).abs() < 1e-8, "{mean_expected}");
+        assert!(
+            (mean_expected - 0.675_106_854).abs() < 1e-8,
+            "{mean_expected}"
+        );
         // log marginal likelihood: -0.5 y^T K^{-1} y - 0.5 log|K| - 1.5 log(2 pi)
         let lml = -0.5 * q - 0.5 * dk.ln() - 1.5 * LN_2PI;
         assert!((gp.log_marginal_likelihood() - lml).abs() < 1e-10);

@@ -80,7 +80,11 @@ where
         } else {
             // First step: unit-ish length.
             let norm = dot(&pg, &pg).sqrt();
-            let scale = if iter == 0 { (1.0 / norm).min(1.0) } else { 1.0 };
+            let scale = if iter == 0 {
+                (1.0 / norm).min(1.0)
+            } else {
+                1.0
+            };
             q.iter_mut().for_each(|v| *v *= scale);
         }
         for j in 0..k {
@@ -163,7 +167,11 @@ mod tests {
             (1.0 - a).powi(2) + 100.0 * (b - a * a).powi(2)
         };
         let m = minimize_box(rosen, &[-1.2, 1.0], &[-5.0, -5.0], &[5.0, 5.0], 500, 1e-10);
-        assert!((m.x[0] - 1.0).abs() < 1e-5 && (m.x[1] - 1.0).abs() < 1e-5, "{:?}", m);
+        assert!(
+            (m.x[0] - 1.0).abs() < 1e-5 && (m.x[1] - 1.0).abs() < 1e-5,
+            "{:?}",
+            m
+        );
         // optimum of a quadratic outside the box lands on the bound
         let q = |x: &[f64], g: &mut [f64]| {
             g[0] = 2.0 * (x[0] - 3.0);
@@ -171,6 +179,10 @@ mod tests {
             (x[0] - 3.0).powi(2) + (x[1] + 0.5).powi(2)
         };
         let m = minimize_box(q, &[0.5, 0.5], &[0.0, 0.0], &[1.0, 1.0], 100, 1e-10);
-        assert!((m.x[0] - 1.0).abs() < 1e-12 && m.x[1].abs() < 1e-12, "{:?}", m);
+        assert!(
+            (m.x[0] - 1.0).abs() < 1e-12 && m.x[1].abs() < 1e-12,
+            "{:?}",
+            m
+        );
     }
 }

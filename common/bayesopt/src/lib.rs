@@ -29,5 +29,7 @@ pub use error::{BoError, Result};
 pub use fit::{FitSettings, Hyperparameters};
 pub use gp::Gp;
 pub use kernel::{Kernel, KernelKind};
-pub use optimizer::{BatchStrategy, OutputTransform, Optimizer, RoundInfo, Settings, StopReason, StopRule};
+pub use optimizer::{
+    BatchStrategy, Optimizer, OutputTransform, RoundInfo, Settings, StopReason, StopRule,
+};
 pub use testfunctions::TestFunction;

@@ -67,7 +67,11 @@ pub fn cholesky_jitter(k: &[f64], n: usize) -> Result<(Vec<f64>, f64)> {
     } else {
         (0..n).map(|i| k[i * n + i].abs()).sum::<f64>() / n as f64
     };
-    let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
+    let scale = if scale > 0.0 && scale.is_finite() {
+        scale
+    } else {
+        1.0
+    };
     let mut jitter = JITTER_START;
     while jitter <= JITTER_MAX * 1.0001 {
         l.copy_from_slice(k);

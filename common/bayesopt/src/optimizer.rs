@@ -106,6 +106,13 @@ pub struct Settings {
     /// GP prior mean at this quantile of the (transformed) observations instead of their
     /// mean (None: the mean). Low quantiles are pessimistic away from data.
     pub prior_mean_quantile: Option<f64>,
+    /// Every this many proposal rounds (0 = never), the first point of the round is the
+    /// second point of a pessimistic constant-liar batch: the EI maximiser is assumed to be as
+    /// bad as the worst observation and the next EI maximiser is proposed instead, which
+    /// moves the search away from an exhausted local optimum.
+    pub diversify_every: usize,
+    /// How many pessimistic fantasies a diversification round stacks (>= 1).
+    pub diversify_depth: usize,
     /// Monotone transform of the outputs applied before standardising.
     pub output_transform: OutputTransform,
     /// Stopping rule.
@@ -122,12 +129,14 @@ impl Default for Settings {
             xi: XiRule::ThesisSignalVariance,
             fit: FitSettings::default(),
             full_refit_every: 5,
-            direct_evals_per_dim: 250,
+            direct_evals_per_dim: 150,
             polish_starts: 3,
             polish_iters: 30,
             batch: BatchStrategy::KrigingBeliever,
             output_transform: OutputTransform::None,
             prior_mean_quantile: None,
+            diversify_every: 0,
+            diversify_depth: 1,
             explore_below_ei: None,
             stop: StopRule::default(),
         }
@@ -156,10 +165,14 @@ impl Settings {
         if let AcquisitionKind::Ucb { beta } = self.acquisition
             && !(beta > 0.0 && beta.is_finite())
         {
-            return Err(BoError::InvalidSetting(format!("UCB beta must be > 0, got {beta}")));
+            return Err(BoError::InvalidSetting(format!(
+                "UCB beta must be > 0, got {beta}"
+            )));
         }
-        if !(self.stop.relative_ei_threshold >= 0.0) {
-            return Err(BoError::InvalidSetting("relative_ei_threshold must be >= 0".into()));
+        if self.stop.relative_ei_threshold.is_nan() || self.stop.relative_ei_threshold < 0.0 {
+            return Err(BoError::InvalidSetting(
+                "relative_ei_threshold must be >= 0".into(),
+            ));
         }
         Ok(())
     }
@@ -405,7 +418,10 @@ impl Optimizer {
 
     /// Observations `(x, y)` so far, in the order told.
     pub fn observations(&self) -> impl Iterator<Item = (&[f64], f64)> {
-        self.xs.iter().map(|x| x.as_slice()).zip(self.ys.iter().copied())
+        self.xs
+            .iter()
+            .map(|x| x.as_slice())
+            .zip(self.ys.iter().copied())
     }
 
     /// Number of observations.
@@ -472,7 +488,7 @@ impl Optimizer {
             .collect()
     }
 
-    fn from_unit(&self, u: &[f64]) -> Vec<f64> {
+    fn unit_to_box(&self, u: &[f64]) -> Vec<f64> {
         u.iter()
             .zip(self.lower.iter().zip(&self.upper))
             .map(|(v, (l, h))| (l + v * (h - l)).clamp(*l, *h))
@@ -514,11 +530,11 @@ impl Optimizer {
                 what: "observation",
             });
         }
-        if let Some(i) = self
-            .pending
-            .iter()
-            .position(|p| p.iter().zip(x).all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs())))
-        {
+        if let Some(i) = self.pending.iter().position(|p| {
+            p.iter()
+                .zip(x)
+                .all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs()))
+        }) {
             self.pending.remove(i);
         }
         self.xs.push(x.to_vec());
@@ -534,8 +550,7 @@ impl Optimizer {
             return Some(StopReason::Budget);
         }
         let min_evals = self.settings.stop.min_evals.unwrap_or(10 * self.dim());
-        if self.xs.len() >= min_evals && self.low_ei_streak >= self.settings.stop.patience.max(1)
-        {
+        if self.xs.len() >= min_evals && self.low_ei_streak >= self.settings.stop.patience.max(1) {
             return Some(StopReason::SmallExpectedImprovement);
         }
         None
@@ -639,16 +654,15 @@ impl Optimizer {
         let mut info = RoundInfo::default();
         // Initial design (and fallback while fewer than 2 observations exist).
         while out.len() < q
-            && (self.xs.len() + self.pending.len() + out.len() < self.n_init()
-                || self.xs.len() < 2)
+            && (self.xs.len() + self.pending.len() + out.len() < self.n_init() || self.xs.len() < 2)
         {
             let u = self.rng.unit_point(d);
-            out.push(self.from_unit(&u));
+            out.push(self.unit_to_box(&u));
             info.random_points += 1;
         }
         if out.len() < q {
             let data = self.standardised();
-            let full = self.rounds % self.settings.full_refit_every == 0;
+            let full = self.rounds.is_multiple_of(self.settings.full_refit_every);
             let mut gp = self.fit_model(&data, full)?;
             let signal = gp.kernel().signal_variance;
             let xi = self.settings.xi.xi(signal);
@@ -670,9 +684,25 @@ impl Optimizer {
                 taken.push(u);
             }
             while out.len() < q {
-                let (u, ei) = self.maximize_acquisition(&gp, incumbent, xi)?;
+                let (mut u, mut ei) = self.maximize_acquisition(&gp, incumbent, xi)?;
+                let k = self.settings.diversify_every;
+                if k > 0 && out.is_empty() && self.rounds % k == k - 1 {
+                    // Diversification round: assume the EI maximiser is as bad as the worst
+                    // observation (constant liar, min) and propose the next EI maximiser.
+                    let mut g2 = gp.clone();
+                    for _ in 0..self.settings.diversify_depth.max(1) {
+                        g2.push(u.clone(), y_min_std)?;
+                        let (u2, ei2) = self.maximize_acquisition(&g2, incumbent, xi)?;
+                        u = u2;
+                        ei = ei.max(ei2);
+                    }
+                }
                 let duplicate = taken.iter().any(|t| {
-                    t.iter().zip(&u).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() < 1e-16
+                    t.iter()
+                        .zip(&u)
+                        .map(|(a, b)| (a - b) * (a - b))
+                        .sum::<f64>()
+                        < 1e-16
                 });
                 let explore = matches!(self.settings.explore_below_ei, Some(th) if ei < th);
                 let u = if explore {
@@ -701,7 +731,7 @@ impl Optimizer {
                     gp.push(u.clone(), lie)?;
                 }
                 taken.push(u.clone());
-                out.push(self.from_unit(&u));
+                out.push(self.unit_to_box(&u));
             }
             if let Some(rel) = info.relative_ei {
                 if rel < self.settings.stop.relative_ei_threshold {
@@ -774,9 +804,9 @@ impl Optimizer {
                     |u, g| {
                         let (m, var) = gp.predict_with_grad(u, &mut dm, &mut dv);
                         match acq {
-                            AcquisitionKind::ExpectedImprovement => acquisition::log_ei_with_grad(
-                                m, var, &dm, &dv, incumbent, xi, g,
-                            ),
+                            AcquisitionKind::ExpectedImprovement => {
+                                acquisition::log_ei_with_grad(m, var, &dm, &dv, incumbent, xi, g)
+                            }
                             AcquisitionKind::Ucb { beta } => {
                                 acquisition::ucb_with_grad(m, var, &dm, &dv, beta, g)
                             }
@@ -817,5 +847,35 @@ impl AskTell for Optimizer {
     }
     fn best(&self) -> Option<(Vec<f64>, f64)> {
         Optimizer::best(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warps_are_monotone_and_invertible() {
+        let z = vec![-300.0, -120.0, -50.0, -20.0, -5.0, -1.0, -0.5, -0.4];
+        let t = TailWarp::fit(&z).unwrap();
+        let r = RankWarp::fit(&z).unwrap();
+        for w in [Warp::Tail(t), Warp::Rank(r)] {
+            let mut prev = f64::NEG_INFINITY;
+            for &v in &z {
+                let f = w.forward(v);
+                assert!(f > prev);
+                prev = f;
+                assert!(
+                    (w.inverse(f) - v).abs() < 1e-9 * v.abs().max(1.0),
+                    "{w:?} {v}"
+                );
+                assert!(w.slope_at_image(f) > 0.0);
+            }
+        }
+        // the tail warp leaves the good half unchanged and compresses the bad tail
+        assert_eq!(t.forward(-0.4), -0.4);
+        assert!(t.forward(-5.0) - t.forward(-300.0) < 295.0 / 5.0);
+        assert!(TailWarp::fit(&[1.0, 1.0, 1.0]).is_none());
+        assert!(RankWarp::fit(&[1.0, 1.0, 1.0]).is_none());
     }
 }

@@ -179,7 +179,10 @@ mod tests {
     fn log_h_matches_direct_and_stays_finite() {
         for &z in &[-30.0, -10.0, -5.0, -2.0, -1.0001, -0.5, 0.0, 1.0, 3.0] {
             let direct = h(z).ln();
-            assert!((log_h(z) - direct).abs() < 1e-9 * direct.abs().max(1.0), "z={z}");
+            assert!(
+                (log_h(z) - direct).abs() < 1e-9 * direct.abs().max(1.0),
+                "z={z}"
+            );
         }
         for &z in &[-50.0, -1e3, -1e5, -1e7, -1e150] {
             let l = log_h(z);
@@ -200,7 +203,11 @@ mod tests {
         for &z in &[-40.0, -8.0, -2.0, -0.5, 0.3, 2.0] {
             let e = 1e-6;
             let fd = (log_h(z + e) - log_h(z - e)) / (2.0 * e);
-            assert!((fd - dlog_h(z)).abs() < 1e-5 * fd.abs().max(1.0), "z={z} {fd} {}", dlog_h(z));
+            assert!(
+                (fd - dlog_h(z)).abs() < 1e-5 * fd.abs().max(1.0),
+                "z={z} {fd} {}",
+                dlog_h(z)
+            );
         }
     }
 }

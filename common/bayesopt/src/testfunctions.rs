@@ -135,13 +135,17 @@ impl TestFunction {
             }
             TestFunction::Hartmann3 => -(0..4)
                 .map(|i| {
-                    let s: f64 = (0..3).map(|j| H3_A[i][j] * (at(j) - H3_P[i][j]).powi(2)).sum();
+                    let s: f64 = (0..3)
+                        .map(|j| H3_A[i][j] * (at(j) - H3_P[i][j]).powi(2))
+                        .sum();
                     H_ALPHA[i] * (-s).exp()
                 })
                 .sum::<f64>(),
             TestFunction::Hartmann6 => -(0..4)
                 .map(|i| {
-                    let s: f64 = (0..6).map(|j| H6_A[i][j] * (at(j) - H6_P[i][j]).powi(2)).sum();
+                    let s: f64 = (0..6)
+                        .map(|j| H6_A[i][j] * (at(j) - H6_P[i][j]).powi(2))
+                        .sum();
                     H_ALPHA[i] * (-s).exp()
                 })
                 .sum::<f64>(),

@@ -151,14 +151,20 @@ fn stops_at_budget_and_on_small_ei() {
         let y = -(p[0][0] - 0.3).powi(2);
         opt.observe(&p[0], y).unwrap();
     }
-    assert_eq!(opt.stop_reason(), Some(StopReason::SmallExpectedImprovement));
+    assert_eq!(
+        opt.stop_reason(),
+        Some(StopReason::SmallExpectedImprovement)
+    );
     assert!(opt.len() >= 8 && opt.len() < 60, "{}", opt.len());
 }
 
 #[test]
 fn bad_input_gives_errors() {
     let s = Settings::default;
-    assert_eq!(Optimizer::new(&[], s(), 0).unwrap_err(), BoError::EmptyBounds);
+    assert_eq!(
+        Optimizer::new(&[], s(), 0).unwrap_err(),
+        BoError::EmptyBounds
+    );
     assert!(matches!(
         Optimizer::new(&[(1.0, 1.0)], s(), 0),
         Err(BoError::InvalidBound { .. })
@@ -194,4 +200,64 @@ fn bad_input_gives_errors() {
     let p = opt.suggest(2).unwrap();
     assert_eq!(p.len(), 2);
     assert!(AskTell::best(&opt).is_some());
+}
+
+#[test]
+fn transforms_prior_mean_exploration_and_ucb_run_and_stay_in_bounds() {
+    use graspopt_bayesopt::{AcquisitionKind, BatchStrategy, OutputTransform};
+    let variants = vec![
+        Settings {
+            output_transform: OutputTransform::TailLog,
+            prior_mean_quantile: Some(0.0),
+            ..fast_settings()
+        },
+        Settings {
+            output_transform: OutputTransform::Rank,
+            batch: BatchStrategy::ConstantLiarMin,
+            ..fast_settings()
+        },
+        Settings {
+            explore_below_ei: Some(1e9),
+            batch: BatchStrategy::ConstantLiarMean,
+            ..fast_settings()
+        },
+        Settings {
+            acquisition: AcquisitionKind::Ucb { beta: 4.0 },
+            batch: BatchStrategy::ConstantLiarMax,
+            xi: XiRule::ThesisSignalVariance,
+            ..fast_settings()
+        },
+    ];
+    for s in variants {
+        let mut opt = Optimizer::new(&branin_bounds(), s.clone(), 11).unwrap();
+        for _ in 0..4 {
+            for p in step(&mut opt, 2) {
+                assert!((-5.0..=10.0).contains(&p[0]) && (0.0..=15.0).contains(&p[1]));
+            }
+        }
+        if s.explore_below_ei.is_some() {
+            assert_eq!(opt.last_round().exploration_points, 2);
+        }
+        // predictions come back on the raw scale and interpolate the data roughly
+        let (x, y) = opt.best().unwrap();
+        let (m, sd) = opt.predict(&x).unwrap();
+        assert!(sd.is_finite() && sd >= 0.0);
+        assert!((m - y).abs() < 0.2 * y.abs().max(1.0), "{s:?}: {m} vs {y}");
+    }
+}
+
+#[test]
+fn branin_quick_run_finds_the_basin() {
+    // Short smoke run of the recommended engine: 25 evaluations reach 1% regret.
+    let trace = graspopt_bayesopt::benchmark::run_seed(
+        TestFunction::Branin,
+        0,
+        25,
+        5,
+        1,
+        graspopt_bayesopt::Method::Bo,
+    )
+    .unwrap();
+    let best = trace.last().copied().unwrap();
+    assert!(TestFunction::Branin.regret(best) < 0.01, "{best}");
 }

@@ -30,7 +30,10 @@ fn patch(lon: f64, lat: f64, r: f64) -> Vec<Contact> {
     for (ring, count) in [(0.5, 8), (1.0, 12)] {
         for k in 0..count {
             let a = std::f64::consts::TAU * k as f64 / count as f64;
-            out.push(on_sphere(lon + ring * r * a.cos(), lat + ring * r * a.sin()));
+            out.push(on_sphere(
+                lon + ring * r * a.cos(),
+                lat + ring * r * a.sin(),
+            ));
         }
     }
     out
@@ -40,7 +43,11 @@ fn bench(c: &mut Criterion) {
     let model = GraspModel::new(SOFT);
     let third = std::f64::consts::TAU / 3.0;
     let cases = [
-        ("3 soft contacts, force closure", [0.0, third, 2.0 * third], 0.0),
+        (
+            "3 soft contacts, force closure",
+            [0.0, third, 2.0 * third],
+            0.0,
+        ),
         ("3 soft contacts, no force closure", [0.0, 0.6, 1.2], 0.0),
     ];
     for (name, lons, lat) in cases {

@@ -79,7 +79,10 @@ mod tests {
 
     #[test]
     fn degenerate_clouds_are_errors() {
-        assert_eq!(mean_contact(&[]), Err(QualityError::Empty("contact points")));
+        assert_eq!(
+            mean_contact(&[]),
+            Err(QualityError::Empty("contact points"))
+        );
         let opposed = [
             Contact::new(Vector3::zeros(), Vector3::z()),
             Contact::new(Vector3::zeros(), -Vector3::z()),

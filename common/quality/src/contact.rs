@@ -282,10 +282,7 @@ mod tests {
     #[test]
     fn invalid_parameters_are_named() {
         let bad = [
-            ContactModel::PointFriction {
-                mu: -0.1,
-                edges: 8,
-            },
+            ContactModel::PointFriction { mu: -0.1, edges: 8 },
             ContactModel::PointFriction { mu: 0.5, edges: 2 },
             ContactModel::SoftFinger {
                 mu: 0.5,
@@ -330,7 +327,11 @@ mod tests {
                 ..
             })
         ));
-        assert!(Contact::new(p, Vector3::new(f64::INFINITY, 0.0, 0.0)).validate(0).is_err());
+        assert!(
+            Contact::new(p, Vector3::new(f64::INFINITY, 0.0, 0.0))
+                .validate(0)
+                .is_err()
+        );
         let c = Contact::normalized(p, Vector3::new(0.0, 3.0, 4.0)).unwrap();
         assert!((c.normal - Vector3::new(0.0, 0.6, 0.8)).norm() < 1e-15);
     }

@@ -21,7 +21,8 @@ impl GraspMap {
             return Err(QualityError::Empty("contacts"));
         }
         model.validate()?;
-        let mut wrenches = Vec::with_capacity(contacts.len() * model.contact.wrenches_per_contact());
+        let mut wrenches =
+            Vec::with_capacity(contacts.len() * model.contact.wrenches_per_contact());
         for (i, c) in contacts.iter().enumerate() {
             c.validate(i)?;
             model.push_wrenches(c, &mut wrenches);
@@ -31,7 +32,10 @@ impl GraspMap {
 
     /// The grasp map of several fingers, each with its own contact cloud (indices in
     /// errors count contacts across fingers, in order).
-    pub fn from_fingers(fingers: &[Vec<Contact>], model: &GraspModel) -> Result<Self, QualityError> {
+    pub fn from_fingers(
+        fingers: &[Vec<Contact>],
+        model: &GraspModel,
+    ) -> Result<Self, QualityError> {
         let all: Vec<Contact> = fingers.iter().flatten().copied().collect();
         Self::from_contacts(&all, model)
     }

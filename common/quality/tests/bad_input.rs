@@ -29,20 +29,41 @@ fn non_finite_coordinates_are_named() {
         let mut g = sphere_grasp();
         g[1].position.y = bad;
         let err = eval(&g, &model()).unwrap_err();
-        assert!(matches!(err, QualityError::NotFinite { index: 1, field: "position", .. }));
-        assert!(err.to_string().contains("contact 1: position is not finite"), "{err}");
+        assert!(matches!(
+            err,
+            QualityError::NotFinite {
+                index: 1,
+                field: "position",
+                ..
+            }
+        ));
+        assert!(
+            err.to_string()
+                .contains("contact 1: position is not finite"),
+            "{err}"
+        );
         let mut g = sphere_grasp();
         g[2].normal.x = bad;
         assert!(matches!(
             eval(&g, &model()),
-            Err(QualityError::NotFinite { index: 2, field: "normal", .. })
+            Err(QualityError::NotFinite {
+                index: 2,
+                field: "normal",
+                ..
+            })
         ));
     }
     let mut w = Wrench::zeros();
     w[4] = f64::INFINITY;
     let err = evaluate_wrenches(&[Wrench::zeros(), w], &MetricsOptions::default()).unwrap_err();
-    assert!(matches!(err, QualityError::WrenchNotFinite { index: 1, .. }));
-    assert!(err.to_string().starts_with("wrench 1 is not finite"), "{err}");
+    assert!(matches!(
+        err,
+        QualityError::WrenchNotFinite { index: 1, .. }
+    ));
+    assert!(
+        err.to_string().starts_with("wrench 1 is not finite"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -62,10 +83,20 @@ fn bad_normals_are_named() {
 #[test]
 fn bad_parameters_are_named() {
     let cases = [
-        (GraspModel::new(ContactModel::PointFriction { mu: -0.1, edges: 8 }), "mu"),
-        (GraspModel::new(ContactModel::PointFriction { mu: 0.5, edges: 2 }), "edges"),
         (
-            GraspModel::new(ContactModel::SoftFinger { mu: 0.5, edges: 8, gamma: -1.0 }),
+            GraspModel::new(ContactModel::PointFriction { mu: -0.1, edges: 8 }),
+            "mu",
+        ),
+        (
+            GraspModel::new(ContactModel::PointFriction { mu: 0.5, edges: 2 }),
+            "edges",
+        ),
+        (
+            GraspModel::new(ContactModel::SoftFinger {
+                mu: 0.5,
+                edges: 8,
+                gamma: -1.0,
+            }),
             "gamma",
         ),
         (model().with_torque_scale(0.0), "torque_scale"),
@@ -78,8 +109,11 @@ fn bad_parameters_are_named() {
             other => panic!("{expected}: {other:?}"),
         }
     }
-    let err = eval(&sphere_grasp(), &model().with_reference_point(Vector3::new(0.0, f64::NAN, 0.0)))
-        .unwrap_err();
+    let err = eval(
+        &sphere_grasp(),
+        &model().with_reference_point(Vector3::new(0.0, f64::NAN, 0.0)),
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("reference_point"), "{err}");
 }
 

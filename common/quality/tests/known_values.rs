@@ -36,7 +36,11 @@ fn three_equator_contacts_epsilon_and_volume() {
         assert!(m.distance < 1e-12);
     }
     let m = metrics(&grasp, friction(0.5));
-    assert!((m.volume.unwrap() - 0.0788798).abs() < 1e-7, "{:?}", m.volume);
+    assert!(
+        (m.volume.unwrap() - 0.0788798).abs() < 1e-7,
+        "{:?}",
+        m.volume
+    );
 }
 
 #[test]

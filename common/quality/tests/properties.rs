@@ -135,12 +135,22 @@ fn bw_is_continuous_across_the_force_closure_boundary() {
         values.push(m.bw);
     }
     assert!(values[0] > 0.1, "starts in force closure: {}", values[0]);
-    assert!(*values.last().unwrap() < -0.01, "ends outside: {:?}", values.last());
-    let max_jump = values.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+    assert!(
+        *values.last().unwrap() < -0.01,
+        "ends outside: {:?}",
+        values.last()
+    );
+    let max_jump = values
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
     // The path moves 110 degrees in 400 steps (0.0048 rad per step): BW is Lipschitz in
     // the contact position, so no step may move it by more than a few times that.
     assert!(max_jump < 0.01, "largest jump {max_jump}");
-    let crossing = values.windows(2).position(|w| w[0] > 0.0 && w[1] <= 0.0).unwrap();
+    let crossing = values
+        .windows(2)
+        .position(|w| w[0] > 0.0 && w[1] <= 0.0)
+        .unwrap();
     assert!(values[crossing].abs() < 0.01 && values[crossing + 1].abs() < 0.01);
 
     // The same in wrench space: sliding a hull across the origin.
@@ -150,7 +160,9 @@ fn bw_is_continuous_across_the_force_closure_boundary() {
     for i in 0..=200 {
         let t = 1.5 * i as f64 / 200.0;
         let moved: Vec<Wrench> = grasp.wrenches().iter().map(|w| w + dir * t).collect();
-        let bw = evaluate_wrenches(&moved, &MetricsOptions::without_volume()).unwrap().bw;
+        let bw = evaluate_wrenches(&moved, &MetricsOptions::without_volume())
+            .unwrap()
+            .bw;
         if let Some(prev) = last {
             // Moving the hull by dt changes both epsilon and the distance by at most dt.
             assert!((bw - prev) <= 1.5 / 200.0 + 1e-9 && (prev - bw) <= 1.5 / 200.0 + 1e-9);

@@ -10,7 +10,10 @@ use nalgebra::Vector3;
 use serde_json::Value;
 
 fn cases() -> Vec<Value> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/metric-cases.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/data/metric-cases.json"
+    );
     let text = std::fs::read_to_string(path).expect("reference file");
     let doc: Value = serde_json::from_str(&text).expect("json");
     doc["cases"].as_array().expect("cases").clone()
@@ -18,7 +21,11 @@ fn cases() -> Vec<Value> {
 
 fn v3(v: &Value) -> Vector3<f64> {
     let a = v.as_array().expect("array");
-    Vector3::new(a[0].as_f64().unwrap(), a[1].as_f64().unwrap(), a[2].as_f64().unwrap())
+    Vector3::new(
+        a[0].as_f64().unwrap(),
+        a[1].as_f64().unwrap(),
+        a[2].as_f64().unwrap(),
+    )
 }
 
 fn model(params: &Value) -> GraspModel {
@@ -73,7 +80,10 @@ fn all_reference_cases_match() {
             bad.push(format!("rank {} vs {}", m.rank, e["rank"]));
         }
         if m.force_closure != e["force_closure"].as_bool().unwrap() {
-            bad.push(format!("force_closure {} vs {}", m.force_closure, e["force_closure"]));
+            bad.push(format!(
+                "force_closure {} vs {}",
+                m.force_closure, e["force_closure"]
+            ));
         }
         for (name, value) in [
             ("epsilon", m.epsilon),
@@ -90,7 +100,12 @@ fn all_reference_cases_match() {
             failures.push(format!("case {i} ({}): {}", case["kind"], bad.join(", ")));
         }
     }
-    assert!(failures.is_empty(), "{} cases differ:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} cases differ:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -116,7 +131,10 @@ fn clarabel_agrees_with_the_min_norm_solver() {
         let g = grasp(case);
         let fast = distance_to_hull(g.wrenches(), DistanceSolver::MinNorm).unwrap();
         let qp = distance_to_hull(g.wrenches(), DistanceSolver::Clarabel).unwrap();
-        assert!((fast - qp).abs() < 1e-7, "case {i}: min-norm {fast:e}, clarabel {qp:e}");
+        assert!(
+            (fast - qp).abs() < 1e-7,
+            "case {i}: min-norm {fast:e}, clarabel {qp:e}"
+        );
     }
 }
 
@@ -133,7 +151,11 @@ fn expanding_polytope_agrees_with_the_full_hull() {
             continue; // origin outside: the expanding polytope only certifies that
         }
         let inner = epa::inner_distance(g.wrenches()).unwrap();
-        assert!((inner.offset - full).abs() < 1e-9, "case {i}: epa {} vs hull {full}", inner.offset);
+        assert!(
+            (inner.offset - full).abs() < 1e-9,
+            "case {i}: epa {} vs hull {full}",
+            inner.offset
+        );
         checked += 1;
     }
     assert!(checked >= 40, "only {checked} force-closure cases");

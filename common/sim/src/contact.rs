@@ -6,8 +6,12 @@
 //! - **circular patch**: the grid points of a disc of radius `r` centred at `p_m` on the plane
 //!   orthogonal to the mean normal, all carrying the mean normal;
 //! - **surface** (section 2.3): through each grid point of that disc, a line segment parallel to
-//!   the mean normal, bounded by the sphere of radius `r` centred at `p_m`; its intersection with
-//!   the object's surface closest to `p_m` becomes a contact with the object's inward normal there.
+//!   the mean normal, bounded by the sphere of radius `r` centred at `p_m` (on both sides of the
+//!   plane: the mean of a curved cloud lies inside the object, its surface outside the plane);
+//!   its intersection with the object's surface closest to `p_m` becomes a contact with the
+//!   object's inward normal there (the normal of the face hit). Segments that miss the object
+//!   contribute nothing; if all miss (e.g. a cloud spread over two separate contact regions, whose
+//!   mean lies in the air), the mean point alone is returned.
 //!
 //! Disc grid: a square grid of spacing `h = r / (k + 1/2)` with the points `(i h, j h)` such that
 //! `i^2 + j^2 <= k^2 + 1` (`k` = [`ContactModelSettings::grid_half`]); the default `k = 2` gives 21
@@ -19,9 +23,12 @@
 //! separate closest point, and each sample casts a ray along the link's outward surface normal:
 //! a hit within the contact distance is a cloud point, with the normal of the object's face that
 //! was hit (pointing into the object). The cloud is thus the object's surface facing the link
-//! within 1 mm of it. If no sample's ray hits (a contact at a link corner, between samples), the
-//! exact closest points are used. Contact regions farther apart than the window radius on the
-//! same convex piece are reported by their nearest region only.
+//! within 1 mm of it. When fewer than three rays hit (a link face against an object edge or tip),
+//! the samples' closest object points within the contact distance are used instead, each with the
+//! direction from the sample to that point as its inward normal; if there are none either (a
+//! contact at a link corner, between samples), the exact closest points are used. Contact regions
+//! farther apart than the window radius on the same convex piece are reported by their nearest
+//! region only.
 
 use nalgebra::{Point3, Vector3};
 use parry3d_f64::math::{Pose, Vector};
@@ -32,6 +39,9 @@ use crate::convert::{g2p, g2v, iso2pose, p2g, v2g};
 use crate::error::{Result, SimError, ensure_finite};
 use crate::hand::{LinkGeometry, LinkShape, LinkSpec};
 use crate::object::Object;
+
+/// Below this many ray hits on a link, the cloud falls back to closest points (edge contacts).
+const MIN_RAY_POINTS: usize = 3;
 
 /// Default radius `r` of the circular patch and of the surface model (metres).
 pub const DEFAULT_PATCH_RADIUS: f64 = 0.005;
@@ -94,7 +104,11 @@ pub struct CloudSettings {
 
 impl Default for CloudSettings {
     fn default() -> Self {
-        Self { contact_distance: 1e-3, window_radius: 0.010, spacing: 0.0025 }
+        Self {
+            contact_distance: 1e-3,
+            window_radius: 0.010,
+            spacing: 0.0025,
+        }
     }
 }
 
@@ -124,7 +138,12 @@ pub struct ContactModelSettings {
 
 impl Default for ContactModelSettings {
     fn default() -> Self {
-        Self { radius: DEFAULT_PATCH_RADIUS, grid_half: 2, noise: None, cloud: CloudSettings::default() }
+        Self {
+            radius: DEFAULT_PATCH_RADIUS,
+            grid_half: 2,
+            noise: None,
+            cloud: CloudSettings::default(),
+        }
     }
 }
 
@@ -132,15 +151,26 @@ impl ContactModelSettings {
     /// Checks that every setting is finite and positive where it must be.
     pub fn validate(&self) -> Result<()> {
         let c = &self.cloud;
-        ensure_finite(&[self.radius, c.contact_distance, c.window_radius, c.spacing], "contact model settings")?;
+        ensure_finite(
+            &[self.radius, c.contact_distance, c.window_radius, c.spacing],
+            "contact model settings",
+        )?;
         if let Some(n) = &self.noise {
             ensure_finite(&[n.position_std, n.normal_std], "noise settings")?;
             if n.position_std < 0.0 || n.normal_std < 0.0 {
-                return Err(SimError::InvalidInput("noise standard deviations must be >= 0".to_string()));
+                return Err(SimError::InvalidInput(
+                    "noise standard deviations must be >= 0".to_string(),
+                ));
             }
         }
-        if self.radius <= 0.0 || c.contact_distance <= 0.0 || c.window_radius <= 0.0 || c.spacing <= 0.0 {
-            return Err(SimError::InvalidInput("radius, distances and spacing must be > 0".to_string()));
+        if self.radius <= 0.0
+            || c.contact_distance <= 0.0
+            || c.window_radius <= 0.0
+            || c.spacing <= 0.0
+        {
+            return Err(SimError::InvalidInput(
+                "radius, distances and spacing must be > 0".to_string(),
+            ));
         }
         if self.grid_half > 50 || c.window_radius / c.spacing > 100.0 {
             return Err(SimError::InvalidInput("grid too dense".to_string()));
@@ -156,15 +186,25 @@ pub fn mean_point(cloud: &[ContactPoint]) -> Option<ContactPoint> {
         return None;
     }
     let n = cloud.len() as f64;
-    let pos = cloud.iter().fold(Vector3::zeros(), |a, c| a + c.position.coords) / n;
+    let pos = cloud
+        .iter()
+        .fold(Vector3::zeros(), |a, c| a + c.position.coords)
+        / n;
     let nrm = cloud.iter().fold(Vector3::zeros(), |a, c| a + c.normal);
     let nrm = nrm.try_normalize(1e-12)?;
-    Some(ContactPoint { position: Point3::from(pos), normal: nrm })
+    Some(ContactPoint {
+        position: Point3::from(pos),
+        normal: nrm,
+    })
 }
 
 /// Two unit vectors spanning the plane orthogonal to the unit vector `n`.
 fn plane_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let a = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let e1 = n.cross(&a).normalize();
     let e2 = n.cross(&e1);
     (e1, e2)
@@ -172,7 +212,12 @@ fn plane_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 
 /// Grid points `(point, distance from centre)` of the disc of radius `r` around `centre`
 /// orthogonal to `normal` (see the module doc).
-pub fn disc_grid(centre: &Point3<f64>, normal: &Vector3<f64>, r: f64, k: usize) -> Vec<(Point3<f64>, f64)> {
+pub fn disc_grid(
+    centre: &Point3<f64>,
+    normal: &Vector3<f64>,
+    r: f64,
+    k: usize,
+) -> Vec<(Point3<f64>, f64)> {
     let (e1, e2) = plane_basis(normal);
     let h = r / (k as f64 + 0.5);
     let k = k as i64;
@@ -189,19 +234,29 @@ pub fn disc_grid(centre: &Point3<f64>, normal: &Vector3<f64>, r: f64, k: usize) 
 }
 
 /// The circular-patch model of a cloud (empty for an empty cloud).
-pub fn circular_patch(cloud: &[ContactPoint], settings: &ContactModelSettings) -> Vec<ContactPoint> {
+pub fn circular_patch(
+    cloud: &[ContactPoint],
+    settings: &ContactModelSettings,
+) -> Vec<ContactPoint> {
     let Some(m) = mean_point(cloud) else {
         return Vec::new();
     };
     disc_grid(&m.position, &m.normal, settings.radius, settings.grid_half)
         .into_iter()
-        .map(|(p, _)| ContactPoint { position: p, normal: m.normal })
+        .map(|(p, _)| ContactPoint {
+            position: p,
+            normal: m.normal,
+        })
         .collect()
 }
 
 /// The surface model of a cloud (section 2.3). Segments that miss the object contribute nothing;
 /// if every segment misses (a degenerate cloud), the mean point alone is returned.
-pub fn surface_model(cloud: &[ContactPoint], object: &Object, settings: &ContactModelSettings) -> Vec<ContactPoint> {
+pub fn surface_model(
+    cloud: &[ContactPoint],
+    object: &Object,
+    settings: &ContactModelSettings,
+) -> Vec<ContactPoint> {
     let Some(m) = mean_point(cloud) else {
         return Vec::new();
     };
@@ -211,32 +266,36 @@ pub fn surface_model(cloud: &[ContactPoint], object: &Object, settings: &Contact
     for (g, rho) in disc_grid(&m.position, &m.normal, r, settings.grid_half) {
         let half = (r * r - rho * rho).max(0.0).sqrt();
         let origin = p2g(&g);
-        let fwd = object.cast_ray_g(origin, dir, half);
-        let back = object.cast_ray_g(origin, -dir, half);
+        let fwd = object.cast_ray_normal_g(origin, dir, half);
+        let back = object.cast_ray_normal_g(origin, -dir, half);
         let mut hit = match (fwd, back) {
-            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a.1 } else { b.1 }),
-            (Some(a), None) | (None, Some(a)) => Some(a.1),
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { (a.1, a.2) } else { (b.1, b.2) }),
+            (Some(a), None) | (None, Some(a)) => Some((a.1, a.2)),
             (None, None) => None,
         };
         if hit.is_none() && half > 0.0 {
             // A segment through a sharp edge may graze it exactly at `g`, where rays starting on
             // the surface are numerically fragile: cast again from both ends of the segment.
-            let from_out = object.cast_ray_g(origin - dir * half, dir, 2.0 * half).map(|h| h.1);
-            let from_in = object.cast_ray_g(origin + dir * half, -dir, 2.0 * half).map(|h| h.1);
+            let from_out = object.cast_ray_normal_g(origin - dir * half, dir, 2.0 * half);
+            let from_in = object.cast_ray_normal_g(origin + dir * half, -dir, 2.0 * half);
             hit = [from_out, from_in]
                 .into_iter()
                 .flatten()
-                .min_by(|a, b| (*a - origin).length().total_cmp(&(*b - origin).length()));
+                .map(|h| (h.1, h.2))
+                .min_by(|a, b| (a.0 - origin).length().total_cmp(&(b.0 - origin).length()));
         }
         if hit.is_none() {
             // Last resort for a segment passing exactly through an edge at `g`.
             hit = object
                 .closest_point_g(origin, 1e-7)
                 .filter(|(_, _, sd)| sd.abs() <= 1e-7)
-                .map(|(p, _, _)| p);
+                .map(|(p, n, _)| (p, n));
         }
-        if let Some(p) = hit {
-            out.push(ContactPoint { position: g2p(p), normal: -g2v(object.outward_normal_g(p)) });
+        if let Some((p, n_out)) = hit {
+            out.push(ContactPoint {
+                position: g2p(p),
+                normal: -g2v(n_out),
+            });
         }
     }
     if out.is_empty() {
@@ -269,10 +328,13 @@ fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
 /// Adds Gaussian noise to positions and normals (normals stay unit). `stream` separates the
 /// random streams of different fingers/models under one seed.
 pub fn add_noise(points: &mut [ContactPoint], noise: &NoiseSettings, stream: u64) {
-    let mut rng = ChaCha8Rng::seed_from_u64(noise.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(noise.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15));
     for p in points {
-        let dp = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * noise.position_std;
-        let dn = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * noise.normal_std;
+        let dp = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng))
+            * noise.position_std;
+        let dn = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng))
+            * noise.normal_std;
         p.position += dp;
         p.normal = (p.normal + dn).try_normalize(1e-12).unwrap_or(p.normal);
     }
@@ -292,7 +354,10 @@ fn sample_link_surface(
     let axis = |half: f64, lo: f64, hi: f64| -> Vec<f64> {
         let n = ((2.0 * half / h).ceil() as i64).max(1);
         let step = 2.0 * half / n as f64;
-        (0..=n).map(|i| -half + i as f64 * step).filter(|u| *u >= lo && *u <= hi).collect()
+        (0..=n)
+            .map(|i| -half + i as f64 * step)
+            .filter(|u| *u >= lo && *u <= hi)
+            .collect()
     };
     match shape {
         LinkShape::Box { half_extents } => {
@@ -321,7 +386,10 @@ fn sample_link_surface(
                 }
             }
         }
-        LinkShape::Cylinder { radius: cr, half_height } => {
+        LinkShape::Cylinder {
+            radius: cr,
+            half_height,
+        } => {
             for s in [-1.0, 1.0] {
                 let z = s * half_height;
                 for x in axis(*cr, centre.x - radius, centre.x + radius) {
@@ -368,33 +436,71 @@ pub(crate) fn link_cloud(
     let mut windows: Vec<(Point3<f64>, Vector)> = Vec::new();
     for (on_link, on_object, _) in pairs {
         let local = link_world.inverse_transform_point(&g2p(on_link));
-        if windows.iter().all(|(w, _)| (w - local).norm() > settings.window_radius) {
+        if windows
+            .iter()
+            .all(|(w, _)| (w - local).norm() > settings.window_radius)
+        {
             windows.push((local, on_object));
         }
     }
     let mut samples: Vec<(Point3<f64>, Vector3<f64>)> = windows
         .iter()
-        .flat_map(|(w, _)| sample_link_surface(&spec.shape, w, settings.window_radius, settings.spacing))
+        .flat_map(|(w, _)| {
+            sample_link_surface(&spec.shape, w, settings.window_radius, settings.spacing)
+        })
         .collect();
     if windows.len() > 1 {
         let key = |s: &(Point3<f64>, Vector3<f64>)| [s.0.x, s.0.y, s.0.z, s.1.x, s.1.y, s.1.z];
-        samples.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap_or(std::cmp::Ordering::Equal));
+        samples.sort_by(|a, b| {
+            key(a)
+                .partial_cmp(&key(b))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
         samples.dedup_by(|a, b| (a.0 - b.0).norm() < 1e-12 && (a.1 - b.1).norm() < 1e-12);
     }
     // Each sample looks along its link-surface normal: the object's surface within the contact
     // distance in that direction is where this piece of the link touches (or nearly touches) it.
     let mut out = Vec::new();
-    for (s, n) in samples {
+    for (s, n) in &samples {
         let q: Vector = p2g(&(link_world * s));
         let dir: Vector = v2g(&(link_world * n));
         if let Some((_, p, n_out)) = object.cast_ray_normal_g(q, dir, d_c) {
-            out.push(ContactPoint { position: g2p(p), normal: -g2v(n_out) });
+            out.push(ContactPoint {
+                position: g2p(p),
+                normal: -g2v(n_out),
+            });
+        }
+    }
+    if out.len() < MIN_RAY_POINTS {
+        // A link face against an object edge or tip (few rays hit): use the object's points
+        // within the contact distance of the samples instead, with the direction from the
+        // sample to its closest object point as the inward normal (the contact normal of an
+        // edge against a face).
+        let mut near = Vec::new();
+        for (s, _) in &samples {
+            let q: Vector = p2g(&(link_world * s));
+            if let Some((p, n_out, sd)) = object.closest_point_g(q, d_c)
+                && sd > 0.0
+                && sd <= d_c
+            {
+                let inward = (p - q).normalize_or(-n_out);
+                near.push(ContactPoint {
+                    position: g2p(p),
+                    normal: g2v(inward),
+                });
+            }
+        }
+        if near.len() > out.len() {
+            out = near;
         }
     }
     if out.is_empty() {
         // Contacts between samples only: keep the exact closest points.
         for (_, on_object) in windows {
-            out.push(ContactPoint { position: g2p(on_object), normal: -g2v(object.outward_normal_g(on_object)) });
+            out.push(ContactPoint {
+                position: g2p(on_object),
+                normal: -g2v(object.outward_normal_g(on_object)),
+            });
         }
     }
     Ok(out)
@@ -408,14 +514,22 @@ mod tests {
     fn default_grid_has_21_points_inside_the_disc() {
         let g = disc_grid(&Point3::origin(), &Vector3::z(), 0.005, 2);
         assert_eq!(g.len(), 21);
-        assert!(g.iter().all(|(p, rho)| p.z.abs() < 1e-15 && *rho < 0.005 && (p.coords.norm() - rho).abs() < 1e-15));
+        assert!(g.iter().all(|(p, rho)| p.z.abs() < 1e-15
+            && *rho < 0.005
+            && (p.coords.norm() - rho).abs() < 1e-15));
     }
 
     #[test]
     fn mean_point_and_noise_keep_unit_normals() {
         let cloud = vec![
-            ContactPoint { position: Point3::new(0.0, 0.0, 0.0), normal: Vector3::x() },
-            ContactPoint { position: Point3::new(0.0, 0.002, 0.0), normal: Vector3::y() },
+            ContactPoint {
+                position: Point3::new(0.0, 0.0, 0.0),
+                normal: Vector3::x(),
+            },
+            ContactPoint {
+                position: Point3::new(0.0, 0.002, 0.0),
+                normal: Vector3::y(),
+            },
         ];
         let m = mean_point(&cloud).unwrap();
         assert!((m.position.y - 0.001).abs() < 1e-15);
@@ -423,10 +537,18 @@ mod tests {
         assert!(mean_point(&[]).is_none());
         let mut pts = circular_patch(&cloud, &ContactModelSettings::default());
         let before = pts.clone();
-        let noise = NoiseSettings { position_std: 1e-3, normal_std: 0.1, seed: 7 };
+        let noise = NoiseSettings {
+            position_std: 1e-3,
+            normal_std: 0.1,
+            seed: 7,
+        };
         add_noise(&mut pts, &noise, 1);
         assert!(pts.iter().all(|p| (p.normal.norm() - 1.0).abs() < 1e-12));
-        assert!(pts.iter().zip(&before).any(|(a, b)| (a.position - b.position).norm() > 1e-5));
+        assert!(
+            pts.iter()
+                .zip(&before)
+                .any(|(a, b)| (a.position - b.position).norm() > 1e-5)
+        );
         let mut again = before.clone();
         add_noise(&mut again, &noise, 1);
         assert_eq!(pts, again, "same seed, same noise");

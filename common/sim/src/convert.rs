@@ -1,6 +1,6 @@
 //! The one boundary between nalgebra (the public API) and parry's glam-based math types.
 
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use parry3d_f64::math::{Pose, Rotation, Vector};
 
 /// nalgebra point to parry vector.
@@ -34,7 +34,9 @@ pub(crate) fn iso2pose(iso: &Isometry3<f64>) -> Pose {
 }
 
 /// parry pose to nalgebra isometry.
+#[cfg(test)]
 pub(crate) fn pose2iso(pose: &Pose) -> Isometry3<f64> {
+    use nalgebra::{Quaternion, Translation3, UnitQuaternion};
     let r = pose.rotation;
     let t = pose.translation;
     Isometry3::from_parts(

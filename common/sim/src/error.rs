@@ -88,6 +88,8 @@ pub(crate) fn ensure_finite(values: &[f64], what: &str) -> Result<()> {
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err(SimError::NonFinite { what: what.to_string() })
+        Err(SimError::NonFinite {
+            what: what.to_string(),
+        })
     }
 }

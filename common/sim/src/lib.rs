@@ -12,6 +12,22 @@
 //!
 //! Conventions: lengths in metres, angles in radians, world `z` up. Contact normals returned by this
 //! crate point INTO the object (the direction in which a finger pushes).
+//!
+//! Typical use:
+//! ```
+//! use graspopt_sim::{BarrettHand, ContactModel, ContactModelSettings, Object, TrialSpace, run_trial};
+//! let mug = Object::by_name("mug")?;
+//! let space = TrialSpace::approach_vertical_2d(&mug);
+//! let palm = space.palm_pose(&[0.0, 0.0])?;
+//! let out = run_trial(&mug, &BarrettHand::default(), &palm, &ContactModelSettings::default())?;
+//! assert_eq!(out.fingers_in_contact(), 3);
+//! let contacts = out.contacts(ContactModel::Surface, true); // positions + inward unit normals
+//! assert!(!contacts.is_empty());
+//! # Ok::<(), graspopt_sim::SimError>(())
+//! ```
+//!
+//! Not modelled: the table (nothing stops a finger below the object), friction, dynamics (the
+//! object never moves), self-collision between links.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod contact;
@@ -26,8 +42,11 @@ pub mod trial;
 
 pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint, NoiseSettings};
 pub use error::SimError;
-pub use hand::{BarrettHand, Grasp, Hand, LinkShape, LinkSpec, ParallelJawGripper};
+pub use hand::{
+    BarrettHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec, ParallelJawGripper,
+    hand_by_name, hand_names,
+};
 pub use mesh::TriangleMesh;
-pub use object::{Object, ObjectKind};
-pub use pose::{ParamKind, ParamSpec, TrialSpace};
+pub use object::{Object, ObjectKind, RayHit, SurfacePoint};
+pub use pose::{ParamKind, ParamSpec, TrialSpace, reference_pose};
 pub use trial::{FingerOutcome, TrialOutcome, run_trial};

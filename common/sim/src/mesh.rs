@@ -25,7 +25,10 @@ pub struct TriangleMesh {
 impl TriangleMesh {
     /// A mesh from its parts (no validation; see [`TriangleMesh::validate_closed`]).
     pub fn new(vertices: Vec<Point3<f64>>, triangles: Vec<[u32; 3]>) -> Self {
-        Self { vertices, triangles }
+        Self {
+            vertices,
+            triangles,
+        }
     }
 
     /// The mesh with every vertex transformed by `iso`.
@@ -40,8 +43,12 @@ impl TriangleMesh {
     pub fn append(&mut self, other: &TriangleMesh) {
         let base = self.vertices.len() as u32;
         self.vertices.extend_from_slice(&other.vertices);
-        self.triangles
-            .extend(other.triangles.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
+        self.triangles.extend(
+            other
+                .triangles
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
     }
 
     fn corners(&self, t: &[u32; 3]) -> [Point3<f64>; 3] {
@@ -82,7 +89,10 @@ impl TriangleMesh {
         match self.triangles.get(i) {
             Some(t) => {
                 let [a, b, c] = self.corners(t);
-                (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or_else(Vector3::zeros)
+                (b - a)
+                    .cross(&(c - a))
+                    .try_normalize(0.0)
+                    .unwrap_or_else(Vector3::zeros)
             }
             None => Vector3::zeros(),
         }
@@ -91,9 +101,11 @@ impl TriangleMesh {
     /// Axis-aligned bounds `(min, max)`, `None` for a mesh without vertices.
     pub fn bounds(&self) -> Option<(Point3<f64>, Point3<f64>)> {
         let first = *self.vertices.first()?;
-        Some(self.vertices.iter().fold((first, first), |(lo, hi), v| {
-            (lo.inf(v), hi.sup(v))
-        }))
+        Some(
+            self.vertices
+                .iter()
+                .fold((first, first), |(lo, hi), v| (lo.inf(v), hi.sup(v))),
+        )
     }
 
     /// Merges vertices with bit-identical coordinates (STL stores each triangle's corners
@@ -104,7 +116,11 @@ impl TriangleMesh {
         let mut remap = Vec::with_capacity(self.vertices.len());
         for v in &self.vertices {
             // +0.0 normalises -0.0 so that both weld together.
-            let key = [(v.x + 0.0).to_bits(), (v.y + 0.0).to_bits(), (v.z + 0.0).to_bits()];
+            let key = [
+                (v.x + 0.0).to_bits(),
+                (v.y + 0.0).to_bits(),
+                (v.z + 0.0).to_bits(),
+            ];
             let idx = *map.entry(key).or_insert_with(|| {
                 vertices.push(*v);
                 (vertices.len() - 1) as u32
@@ -123,7 +139,10 @@ impl TriangleMesh {
                 (r[0] != r[1] && r[1] != r[2] && r[0] != r[2]).then_some(r)
             })
             .collect();
-        Self { vertices, triangles }
+        Self {
+            vertices,
+            triangles,
+        }
     }
 
     /// Checks that the mesh is non-empty, finite, has valid indices and is closed and
@@ -136,8 +155,14 @@ impl TriangleMesh {
                 triangles: self.triangles.len(),
             });
         }
-        if let Some(i) = self.vertices.iter().position(|v| !v.coords.iter().all(|c| c.is_finite())) {
-            return Err(SimError::NonFinite { what: format!("vertex {i} of mesh `{name}`") });
+        if let Some(i) = self
+            .vertices
+            .iter()
+            .position(|v| !v.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(SimError::NonFinite {
+                what: format!("vertex {i} of mesh `{name}`"),
+            });
         }
         let n = self.vertices.len() as u32;
         let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(self.triangles.len() * 3);
@@ -283,7 +308,12 @@ pub fn revolve(profile: &[(f64, f64)], segments: usize) -> TriangleMesh {
 /// A closed tube of circular cross-section `radius` along the open polyline `path` (at least two
 /// points), with flat end caps. `binormal` must not be parallel to any path segment; it fixes the
 /// cross-section frame (use the normal of the plane the path lies in).
-pub fn tube(path: &[Point3<f64>], radius: f64, sides: usize, binormal: &Vector3<f64>) -> TriangleMesh {
+pub fn tube(
+    path: &[Point3<f64>],
+    radius: f64,
+    sides: usize,
+    binormal: &Vector3<f64>,
+) -> TriangleMesh {
     let sides = sides.max(3);
     let n = path.len();
     if n < 2 {
@@ -294,7 +324,9 @@ pub fn tube(path: &[Point3<f64>], radius: f64, sides: usize, binormal: &Vector3<
         let prev = path[j.saturating_sub(1)];
         let next = path[(j + 1).min(n - 1)];
         let t = (next - prev).try_normalize(0.0).unwrap_or_else(Vector3::z);
-        let b = (binormal - t * t.dot(binormal)).try_normalize(0.0).unwrap_or_else(Vector3::x);
+        let b = (binormal - t * t.dot(binormal))
+            .try_normalize(0.0)
+            .unwrap_or_else(Vector3::x);
         let nrm = t.cross(&b);
         for s in 0..sides {
             let a = std::f64::consts::TAU * s as f64 / sides as f64;
@@ -363,7 +395,10 @@ pub fn load(path: &Path) -> Result<TriangleMesh> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    let bytes = std::fs::read(path).map_err(|source| SimError::Io { path: name.clone(), source })?;
+    let bytes = std::fs::read(path).map_err(|source| SimError::Io {
+        path: name.clone(),
+        source,
+    })?;
     let mesh = match ext.as_str() {
         "obj" => {
             let text = String::from_utf8_lossy(&bytes);
@@ -392,8 +427,12 @@ pub fn parse_obj(name: &str, text: &str) -> Result<TriangleMesh> {
             Some("v") => {
                 let mut c = [0.0; 3];
                 for slot in &mut c {
-                    let tok = it.next().ok_or_else(|| err(line_no, "vertex with fewer than 3 coordinates"))?;
-                    *slot = tok.parse::<f64>().map_err(|_| err(line_no, "bad vertex coordinate"))?;
+                    let tok = it
+                        .next()
+                        .ok_or_else(|| err(line_no, "vertex with fewer than 3 coordinates"))?;
+                    *slot = tok
+                        .parse::<f64>()
+                        .map_err(|_| err(line_no, "bad vertex coordinate"))?;
                 }
                 vertices.push(Point3::new(c[0], c[1], c[2]));
             }
@@ -403,7 +442,13 @@ pub fn parse_obj(name: &str, text: &str) -> Result<TriangleMesh> {
                     let first = tok.split('/').next().unwrap_or("");
                     let i: i64 = first.parse().map_err(|_| err(line_no, "bad face index"))?;
                     let n = vertices.len() as i64;
-                    let resolved = if i > 0 { i - 1 } else if i < 0 { n + i } else { -1 };
+                    let resolved = if i > 0 {
+                        i - 1
+                    } else if i < 0 {
+                        n + i
+                    } else {
+                        -1
+                    };
                     if resolved < 0 || resolved >= n {
                         return Err(err(line_no, "face index out of range"));
                     }
@@ -424,7 +469,10 @@ pub fn parse_obj(name: &str, text: &str) -> Result<TriangleMesh> {
 
 /// Parses an STL buffer, binary (detected by its exact size) or ASCII. Corners are not welded.
 pub fn parse_stl(name: &str, bytes: &[u8]) -> Result<TriangleMesh> {
-    let err = |reason: String| SimError::MeshParse { name: name.to_string(), reason };
+    let err = |reason: String| SimError::MeshParse {
+        name: name.to_string(),
+        reason,
+    };
     if bytes.len() >= 84 {
         let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         if bytes.len() == 84 + 50 * count {
@@ -437,7 +485,8 @@ pub fn parse_stl(name: &str, bytes: &[u8]) -> Result<TriangleMesh> {
                 };
                 let base = mesh.vertices.len() as u32;
                 for c in 0..3 {
-                    mesh.vertices.push(Point3::new(f(3 * c), f(3 * c + 1), f(3 * c + 2)));
+                    mesh.vertices
+                        .push(Point3::new(f(3 * c), f(3 * c + 1), f(3 * c + 2)));
                 }
                 mesh.triangles.push([base, base + 1, base + 2]);
             }
@@ -447,7 +496,9 @@ pub fn parse_stl(name: &str, bytes: &[u8]) -> Result<TriangleMesh> {
     let text = std::str::from_utf8(bytes)
         .map_err(|_| err("neither a binary STL (size mismatch) nor ASCII text".to_string()))?;
     if !text.trim_start().starts_with("solid") {
-        return Err(err("neither a binary STL (size mismatch) nor an ASCII STL (no `solid`)".to_string()));
+        return Err(err(
+            "neither a binary STL (size mismatch) nor an ASCII STL (no `solid`)".to_string(),
+        ));
     }
     let mut mesh = TriangleMesh::default();
     let mut corners: Vec<Point3<f64>> = Vec::with_capacity(3);
@@ -466,7 +517,11 @@ pub fn parse_stl(name: &str, bytes: &[u8]) -> Result<TriangleMesh> {
             }
             Some("endfacet") => {
                 if corners.len() != 3 {
-                    return Err(err(format!("line {}: facet with {} vertices", ln + 1, corners.len())));
+                    return Err(err(format!(
+                        "line {}: facet with {} vertices",
+                        ln + 1,
+                        corners.len()
+                    )));
                 }
                 let base = mesh.vertices.len() as u32;
                 mesh.vertices.append(&mut corners);
@@ -492,14 +547,22 @@ mod tests {
         let exact = std::f64::consts::PI * 0.02 * 0.02 * 0.1;
         assert!((cyl.signed_volume() - exact).abs() / exact < 0.01);
         let t = tube(
-            &[Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.05, 0.0), Point3::new(0.0, 0.05, 0.05)],
+            &[
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(0.0, 0.05, 0.0),
+                Point3::new(0.0, 0.05, 0.05),
+            ],
             0.005,
             12,
             &Vector3::x(),
         );
         t.validate_closed("tube").unwrap();
         assert!(t.signed_volume() > 0.0);
-        let star = extrude_star_shaped(&[(0.02, 0.0), (0.0, 0.02), (-0.02, 0.0), (0.0, -0.02)], 0.0, 0.1);
+        let star = extrude_star_shaped(
+            &[(0.02, 0.0), (0.0, 0.02), (-0.02, 0.0), (0.0, -0.02)],
+            0.0,
+            0.1,
+        );
         star.validate_closed("star").unwrap();
         assert!((star.signed_volume() - 0.0008 * 0.1).abs() < 1e-12);
     }
@@ -511,7 +574,9 @@ mod tests {
         let e = b.into_closed_solid("holey").unwrap_err();
         assert!(matches!(e, SimError::NotWatertight { .. }), "{e}");
         assert!(e.to_string().contains("holey"));
-        let e = TriangleMesh::default().into_closed_solid("nothing").unwrap_err();
+        let e = TriangleMesh::default()
+            .into_closed_solid("nothing")
+            .unwrap_err();
         assert!(matches!(e, SimError::EmptyMesh { .. }), "{e}");
     }
 

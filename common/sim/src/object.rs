@@ -8,8 +8,8 @@
 //!
 //! Built-in objects (metres):
 //! - `sphere`: radius 0.035 (exact ball).
-//! - `wine_glass`: height 0.15, a solid revolved profile: foot (radius 0.035), stem (radius
-//!   0.005), bowl (largest radius 0.037); 48 segments.
+//! - `wine_glass`: height 0.15, a solid revolved profile (the bowl is closed and filled): foot
+//!   (radius 0.035), stem (radius 0.005), bowl (largest radius 0.037); 48 segments.
 //! - `cylinder`: radius 0.03, height 0.12 (exact cylinder).
 //! - `mug`: a hollow revolved cup (outer radius 0.035, height 0.095, wall 4 mm, bottom 6 mm, 32
 //!   segments) plus a handle (tube of radius 5 mm on a half-ellipse on the `+x` side, away from
@@ -19,9 +19,12 @@
 //! - `star_prism`: a five-pointed star (outer radius 0.04, inner 0.018, one point towards `-x`)
 //!   extruded to 0.10 high.
 //!
+//! User meshes (OBJ/STL, see [`crate::mesh`]) must be closed; a convex one collides through its
+//! convex hull, a non-convex one through its triangle mesh (correct, but slower).
+//!
 //! Unions: for the mug (two overlapping parts) distances and projections are the minimum over the
 //! parts, which is exact outside the object; a ray hit on one part that lies inside another part
-//! is discarded.
+//! is discarded (only each part's first hit is considered).
 //!
 //! Two representations: point queries (ray casts, projections, normals) use exact primitives or
 //! the triangle mesh; shape-vs-object queries (a hand link's distance and closest points) use a
@@ -33,7 +36,7 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Vector};
-use parry3d_f64::query::{self, PointQueryWithLocation, Ray};
+use parry3d_f64::query::{self, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, Shape, SharedShape, TriMesh, TriMeshFlags};
 
 use crate::convert::{g2p, iso2pose, p2g, v2g};
@@ -99,7 +102,15 @@ enum PartGeom {
     Cuboid(Cuboid),
     /// parry's cylinder axis is `y`; the part frame maps it to the object's `z`.
     Cylinder(Cylinder),
-    Mesh { shape: TriMesh, mesh: TriangleMesh, normals: Vec<Vector> },
+    Mesh(Box<MeshGeom>),
+}
+
+/// A triangle-mesh part: parry's mesh, the source mesh and its per-triangle outward normals.
+#[derive(Clone)]
+struct MeshGeom {
+    shape: TriMesh,
+    mesh: TriangleMesh,
+    normals: Vec<Vector>,
 }
 
 impl PartGeom {
@@ -108,7 +119,7 @@ impl PartGeom {
             PartGeom::Ball(s) => s,
             PartGeom::Cuboid(s) => s,
             PartGeom::Cylinder(s) => s,
-            PartGeom::Mesh { shape, .. } => shape,
+            PartGeom::Mesh(m) => &m.shape,
         }
     }
 }
@@ -121,11 +132,27 @@ struct Part {
     local: Isometry3<f64>,
     /// Part frame in the world (cached from the object pose).
     world: Pose,
+    /// World AABB `(mins, maxs)` (cached).
+    aabb: (Vector, Vector),
 }
 
 impl Part {
     fn new(geom: PartGeom, local: Isometry3<f64>) -> Self {
-        Self { geom, world: iso2pose(&local), local }
+        let mut part = Self {
+            geom,
+            world: iso2pose(&local),
+            local,
+            aabb: (Vector::ZERO, Vector::ZERO),
+        };
+        part.place(&Isometry3::identity());
+        part
+    }
+
+    /// Updates the cached world pose and AABB for the object at `object_pose`.
+    fn place(&mut self, object_pose: &Isometry3<f64>) {
+        self.world = iso2pose(&(object_pose * self.local));
+        let a = self.geom.shape().compute_aabb(&self.world);
+        self.aabb = (a.mins, a.maxs);
     }
 
     /// Projection of a world point on this part's surface within `max_dist`:
@@ -133,13 +160,17 @@ impl Part {
     fn project(&self, pt: Vector, max_dist: f64) -> Option<(Vector, Vector, bool)> {
         let local = self.world.inverse_transform_point(pt);
         let (proj, normal) = match &self.geom {
-            PartGeom::Mesh { shape, normals, .. } => {
+            PartGeom::Mesh(m) => {
+                let (shape, normals) = (&m.shape, &m.normals);
                 let (proj, (tri, _)) = if max_dist == f64::MAX {
                     Some(shape.project_local_point_and_get_location(local, false))
                 } else {
                     shape.project_local_point_and_get_location_with_max_dist(local, false, max_dist)
                 }?;
-                (proj, normals.get(tri as usize).copied().unwrap_or(Vector::Z))
+                (
+                    proj,
+                    normals.get(tri as usize).copied().unwrap_or(Vector::Z),
+                )
             }
             PartGeom::Cylinder(c) => {
                 // Analytic (parry's generic cylinder projection runs GJK).
@@ -147,13 +178,19 @@ impl Part {
                 if (p - local).length() > max_dist {
                     return None;
                 }
-                return Some((self.world.transform_point(p), self.world.transform_vector(n), inside));
+                return Some((
+                    self.world.transform_point(p),
+                    self.world.transform_vector(n),
+                    inside,
+                ));
             }
             other => {
                 let proj = if max_dist == f64::MAX {
                     Some(other.shape().project_local_point(local, false))
                 } else {
-                    other.shape().project_local_point_with_max_dist(local, false, max_dist)
+                    other
+                        .shape()
+                        .project_local_point_with_max_dist(local, false, max_dist)
                 }?;
                 (proj, self.local_normal(proj.point))
             }
@@ -191,9 +228,9 @@ impl Part {
                     radial / rho
                 }
             }
-            PartGeom::Mesh { shape, normals, .. } => {
-                let (_, (tri, _)) = shape.project_local_point_and_get_location(p, false);
-                normals.get(tri as usize).copied().unwrap_or(Vector::Z)
+            PartGeom::Mesh(m) => {
+                let (_, (tri, _)) = m.shape.project_local_point_and_get_location(p, false);
+                m.normals.get(tri as usize).copied().unwrap_or(Vector::Z)
             }
         }
     }
@@ -309,20 +346,34 @@ impl Object {
             ObjectKind::Sphere => {
                 let local = up(0.035);
                 let part = Part::new(PartGeom::Ball(Ball::new(0.035)), local);
-                (vec![part], vec![CollisionPart::new(SharedShape::ball(0.035), local)], id)
+                (
+                    vec![part],
+                    vec![CollisionPart::new(SharedShape::ball(0.035), local)],
+                    id,
+                )
             }
             ObjectKind::Cylinder => {
                 // parry's cylinder axis is y: rotate it onto z.
                 let local = Isometry3::from_parts(
                     Translation3::new(0.0, 0.0, 0.06),
-                    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+                    UnitQuaternion::from_axis_angle(
+                        &Vector3::x_axis(),
+                        std::f64::consts::FRAC_PI_2,
+                    ),
                 );
                 let part = Part::new(PartGeom::Cylinder(Cylinder::new(0.06, 0.03)), local);
-                (vec![part], vec![CollisionPart::new(SharedShape::cylinder(0.06, 0.03), local)], id)
+                (
+                    vec![part],
+                    vec![CollisionPart::new(SharedShape::cylinder(0.06, 0.03), local)],
+                    id,
+                )
             }
             ObjectKind::Cuboid | ObjectKind::RotatedCuboid => {
                 let local = up(0.06);
-                let part = Part::new(PartGeom::Cuboid(Cuboid::new(Vector::new(0.03, 0.025, 0.06))), local);
+                let part = Part::new(
+                    PartGeom::Cuboid(Cuboid::new(Vector::new(0.03, 0.025, 0.06))),
+                    local,
+                );
                 let coll = CollisionPart::new(SharedShape::cuboid(0.03, 0.025, 0.06), local);
                 let pose = if kind == ObjectKind::RotatedCuboid {
                     Isometry3::rotation(Vector3::z() * std::f64::consts::FRAC_PI_4)
@@ -363,13 +414,20 @@ impl Object {
             }
             ObjectKind::Mug => {
                 let (ro, ri, h, tb, seg) = (0.035, 0.031, 0.095, 0.006, 32);
-                let body = mesh::revolve(&[(0.0, 0.0), (ro, 0.0), (ro, h), (ri, h), (ri, tb), (0.0, tb)], seg);
+                let body = mesh::revolve(
+                    &[(0.0, 0.0), (ro, 0.0), (ro, h), (ri, h), (ri, tb), (0.0, tb)],
+                    seg,
+                );
                 let n = 12;
                 let sides = 10;
                 let path: Vec<Point3<f64>> = (0..=n)
                     .map(|j| {
                         let phi = std::f64::consts::PI * j as f64 / n as f64;
-                        Point3::new(ro - 0.002 + 0.025 * phi.sin(), 0.0, h / 2.0 + 0.028 * phi.cos())
+                        Point3::new(
+                            ro - 0.002 + 0.025 * phi.sin(),
+                            0.0,
+                            h / 2.0 + 0.028 * phi.cos(),
+                        )
                     })
                     .collect();
                 let handle = mesh::tube(&path, 0.005, sides, &Vector3::y());
@@ -395,7 +453,14 @@ impl Object {
                     let pts = &handle.vertices[j * sides..(j + 2) * sides];
                     coll.push(CollisionPart::hull(pts, "mug handle")?);
                 }
-                (vec![mesh_part(body, "mug body")?, mesh_part(handle, "mug handle")?], coll, id)
+                (
+                    vec![
+                        mesh_part(body, "mug body")?,
+                        mesh_part(handle, "mug handle")?,
+                    ],
+                    coll,
+                    id,
+                )
             }
             ObjectKind::StarPrism => {
                 let (outer, inner, h) = (0.04, 0.018, 0.10);
@@ -417,13 +482,24 @@ impl Object {
                 // Convex pieces: the inner pentagon and the five triangular points.
                 let mut coll = vec![CollisionPart::hull(&prism(&[1, 3, 5, 7, 9]), "star_prism")?];
                 for t in (0..10).step_by(2) {
-                    coll.push(CollisionPart::hull(&prism(&[t + 9, t, t + 1]), "star_prism")?);
+                    coll.push(CollisionPart::hull(
+                        &prism(&[t + 9, t, t + 1]),
+                        "star_prism",
+                    )?);
                 }
-                (vec![mesh_part(mesh::extrude_star_shaped(&polygon, 0.0, h), "star_prism")?], coll, id)
+                (
+                    vec![mesh_part(
+                        mesh::extrude_star_shaped(&polygon, 0.0, h),
+                        "star_prism",
+                    )?],
+                    coll,
+                    id,
+                )
             }
             ObjectKind::UserMesh => {
                 return Err(SimError::InvalidInput(
-                    "a user mesh object needs a mesh: use Object::from_mesh or Object::from_file".to_string(),
+                    "a user mesh object needs a mesh: use Object::from_mesh or Object::from_file"
+                        .to_string(),
                 ));
             }
         };
@@ -434,7 +510,13 @@ impl Object {
     pub fn from_mesh(name: &str, mesh: TriangleMesh) -> Result<Object> {
         let mesh = mesh.into_closed_solid(name)?;
         let (part, coll) = user_parts(mesh, name)?;
-        Object::assemble(name.to_string(), ObjectKind::UserMesh, vec![part], coll, Isometry3::identity())
+        Object::assemble(
+            name.to_string(),
+            ObjectKind::UserMesh,
+            vec![part],
+            coll,
+            Isometry3::identity(),
+        )
     }
 
     /// An object from an `.obj` or `.stl` file (see [`mesh::load`]); named after the file stem.
@@ -446,7 +528,13 @@ impl Object {
             .unwrap_or("user_mesh")
             .to_string();
         let (part, coll) = user_parts(mesh, &name)?;
-        Object::assemble(name, ObjectKind::UserMesh, vec![part], coll, Isometry3::identity())
+        Object::assemble(
+            name,
+            ObjectKind::UserMesh,
+            vec![part],
+            coll,
+            Isometry3::identity(),
+        )
     }
 
     fn assemble(
@@ -472,8 +560,10 @@ impl Object {
             lo = lo.inf(&g2p(aabb.mins));
             hi = hi.sup(&g2p(aabb.maxs));
         }
-        if !(mass > 0.0) || !mass.is_finite() {
-            return Err(SimError::InvalidInput(format!("object `{name}` has no volume")));
+        if mass.is_nan() || mass <= 0.0 || !mass.is_finite() {
+            return Err(SimError::InvalidInput(format!(
+                "object `{name}` has no volume"
+            )));
         }
         let centre = nalgebra::center(&lo, &hi);
         let radius = (hi - lo).norm() / 2.0;
@@ -496,7 +586,7 @@ impl Object {
         ensure_finite(pose.to_homogeneous().as_slice(), "object pose")?;
         self.pose = pose;
         for p in &mut self.parts {
-            p.world = iso2pose(&(pose * p.local));
+            p.place(&pose);
         }
         for c in &mut self.collision {
             c.world = iso2pose(&(pose * c.local));
@@ -562,44 +652,82 @@ impl Object {
 
     /// First intersection of the ray `origin + t * dir` (t in `[0, max_distance]`, `dir` need not
     /// be unit) with the object's surface. A ray starting inside hits the surface on its way out.
-    pub fn cast_ray(&self, origin: &Point3<f64>, dir: &Vector3<f64>, max_distance: f64) -> Result<Option<RayHit>> {
-        ensure_finite(&[origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, max_distance], "ray")?;
+    pub fn cast_ray(
+        &self,
+        origin: &Point3<f64>,
+        dir: &Vector3<f64>,
+        max_distance: f64,
+    ) -> Result<Option<RayHit>> {
+        ensure_finite(
+            &[
+                origin.x,
+                origin.y,
+                origin.z,
+                dir.x,
+                dir.y,
+                dir.z,
+                max_distance,
+            ],
+            "ray",
+        )?;
         let Some(u) = dir.try_normalize(1e-300) else {
             return Err(SimError::InvalidInput("ray direction is zero".to_string()));
         };
-        Ok(self.cast_ray_g(p2g(origin), v2g(&u), max_distance).map(|(t, p)| RayHit {
-            distance: t,
-            point: g2p(p),
-            outward_normal: crate::convert::g2v(self.outward_normal_g(p)),
-        }))
+        Ok(self
+            .cast_ray_normal_g(p2g(origin), v2g(&u), max_distance)
+            .map(|(t, p, n)| RayHit {
+                distance: t,
+                point: g2p(p),
+                outward_normal: crate::convert::g2v(n),
+            }))
     }
 
-    /// Ray cast in parry types with a unit direction: `(t, point)` of the first valid hit.
-    pub(crate) fn cast_ray_g(&self, origin: Vector, dir: Vector, max_t: f64) -> Option<(f64, Vector)> {
-        self.cast_ray_normal_g(origin, dir, max_t).map(|(t, p, _)| (t, p))
-    }
-
-    /// Ray cast in parry types with a unit direction: `(t, point, normal)` of the first valid
-    /// hit, the normal being the hit face's normal oriented against the ray (the outward normal
-    /// when the ray starts outside the object).
-    pub(crate) fn cast_ray_normal_g(&self, origin: Vector, dir: Vector, max_t: f64) -> Option<(f64, Vector, Vector)> {
+    /// Ray cast in parry types with a unit direction: `(t, point, outward normal)` of the first
+    /// valid hit (also for rays starting inside the object).
+    pub(crate) fn cast_ray_normal_g(
+        &self,
+        origin: Vector,
+        dir: Vector,
+        max_t: f64,
+    ) -> Option<(f64, Vector, Vector)> {
         let ray = Ray::new(origin, dir);
         let mut best: Option<(f64, Vector, Vector)> = None;
         for (i, p) in self.parts.iter().enumerate() {
+            let o = p.world.inverse_transform_point(origin);
+            let d = p.world.inverse_transform_vector(dir);
+            // Outward normals from the part's own geometry (the triangle's winding for meshes),
+            // so that hits from inside the object get outward normals too.
             let hit = match &p.geom {
-                PartGeom::Cylinder(c) => {
-                    let o = p.world.inverse_transform_point(origin);
-                    let d = p.world.inverse_transform_vector(dir);
-                    ray_cylinder(c.radius, c.half_height, o, d)
-                        .filter(|t| *t <= max_t)
-                        .map(|t| (t, p.world.transform_vector(p.local_normal(o + d * t))))
-                }
+                PartGeom::Cylinder(c) => ray_cylinder(c.radius, c.half_height, o, d)
+                    .filter(|t| *t <= max_t)
+                    .map(|t| (t, p.local_normal(o + d * t))),
+                PartGeom::Mesh(m) => m
+                    .shape
+                    .cast_local_ray_and_get_normal(&Ray::new(o, d), max_t, false)
+                    .map(|h| {
+                        let n = m
+                            .normals
+                            .get(h.subshape as usize)
+                            .copied()
+                            .unwrap_or(h.normal);
+                        (h.time_of_impact, n)
+                    }),
+                PartGeom::Cuboid(c) => c
+                    .cast_local_ray_and_get_normal(&Ray::new(o, d), max_t, false)
+                    .map(|h| {
+                        // The face the ray crossed (robust at edges), oriented outward.
+                        let hp = o + d * h.time_of_impact;
+                        let a = h.normal.abs().max_position();
+                        let mut n = Vector::ZERO;
+                        n[a] = if hp[a] >= 0.0 { 1.0 } else { -1.0 };
+                        (h.time_of_impact, n)
+                    }),
                 g => g
                     .shape()
-                    .cast_ray_and_get_normal(&p.world, &ray, max_t, false)
-                    .map(|h| (h.time_of_impact, h.normal)),
+                    .cast_local_ray(&Ray::new(o, d), max_t, false)
+                    .map(|t| (t, p.local_normal(o + d * t))),
             };
-            if let Some((t, n)) = hit {
+            if let Some((t, n_local)) = hit {
                 let point = ray.point_at(t);
                 if best.is_some_and(|(bt, _, _)| bt <= t) {
                     continue;
@@ -607,7 +735,7 @@ impl Object {
                 if self.parts.len() > 1 && self.inside_other_part(i, point) {
                     continue;
                 }
-                let n = if n.dot(dir) > 0.0 { -n } else { n };
+                let n = p.world.transform_vector(n_local);
                 best = Some((t, point, n));
             }
         }
@@ -616,7 +744,7 @@ impl Object {
 
     fn inside_other_part(&self, skip: usize, pt: Vector) -> bool {
         self.parts.iter().enumerate().any(|(j, q)| {
-            j != skip && {
+            j != skip && pt.cmpge(q.aabb.0).all() && pt.cmple(q.aabb.1).all() && {
                 let proj = q.geom.shape().project_point(&q.world, pt, false);
                 proj.is_inside && (proj.point - pt).length() > 1e-9
             }
@@ -626,9 +754,9 @@ impl Object {
     /// Closest surface point, outward normal there and signed distance of `p` (negative inside).
     pub fn closest_point(&self, p: &Point3<f64>) -> Result<SurfacePoint> {
         ensure_finite(&[p.x, p.y, p.z], "query point")?;
-        let (sp, n, d) = self.closest_point_g(p2g(p), f64::MAX).ok_or_else(|| {
-            SimError::InvalidInput("closest point query failed".to_string())
-        })?;
+        let (sp, n, d) = self
+            .closest_point_g(p2g(p), f64::MAX)
+            .ok_or_else(|| SimError::InvalidInput("closest point query failed".to_string()))?;
         Ok(SurfacePoint {
             point: g2p(sp),
             outward_normal: crate::convert::g2v(n),
@@ -642,7 +770,11 @@ impl Object {
     }
 
     /// Closest point within `max_dist` in parry types: `(surface point, outward normal, signed distance)`.
-    pub(crate) fn closest_point_g(&self, pt: Vector, max_dist: f64) -> Option<(Vector, Vector, f64)> {
+    pub(crate) fn closest_point_g(
+        &self,
+        pt: Vector,
+        max_dist: f64,
+    ) -> Option<(Vector, Vector, f64)> {
         let mut best: Option<(Vector, Vector, f64, bool)> = None;
         let mut inside_any = false;
         for p in &self.parts {
@@ -670,7 +802,9 @@ impl Object {
 
     /// Outward unit normal at a point on (or very near) the surface, in parry types.
     pub(crate) fn outward_normal_g(&self, pt: Vector) -> Vector {
-        self.closest_point_g(pt, f64::MAX).map(|(_, n, _)| n).unwrap_or(Vector::Z)
+        self.closest_point_g(pt, f64::MAX)
+            .map(|(_, n, _)| n)
+            .unwrap_or(Vector::Z)
     }
 
     /// Lower bound of the distance between the object and a ball (centre, radius), cheap.
@@ -706,7 +840,9 @@ impl Object {
             }
             let c = &self.collision[i];
             let d = query::distance(pose, shape, &c.world, c.shape.as_ref())
-                .map_err(|_| SimError::UnsupportedQuery(format!("a hand link and `{}`", self.name)))?
+                .map_err(|_| {
+                    SimError::UnsupportedQuery(format!("a hand link and `{}`", self.name))
+                })?
                 .distance;
             best = best.min(d);
             if best <= 0.0 {
@@ -728,14 +864,17 @@ impl Object {
         let aabb = shape.compute_aabb(pose);
         for (_, i) in self.candidates(aabb.mins, aabb.maxs, max_dist) {
             let c = &self.collision[i];
-            match query::closest_points(pose, shape, &c.world, c.shape.as_ref(), max_dist)
-                .map_err(|_| SimError::UnsupportedQuery(format!("a hand link and `{}`", self.name)))?
-            {
+            match query::closest_points(pose, shape, &c.world, c.shape.as_ref(), max_dist).map_err(
+                |_| SimError::UnsupportedQuery(format!("a hand link and `{}`", self.name)),
+            )? {
                 query::ClosestPoints::WithinMargin(a, b) => out.push((a, b, (a - b).length())),
                 query::ClosestPoints::Intersecting => {
                     // Touching within round-off: the piece's point nearest to the shape's centre
                     // and the shape's point nearest to that.
-                    let on_obj = c.shape.project_point(&c.world, pose.translation, false).point;
+                    let on_obj = c
+                        .shape
+                        .project_point(&c.world, pose.translation, false)
+                        .point;
                     let on_shape = shape.project_point(pose, on_obj, false).point;
                     out.push((on_shape, on_obj, 0.0));
                 }
@@ -765,12 +904,19 @@ impl Object {
                 PartGeom::Cylinder(c) => {
                     // Revolved about z, then mapped onto parry's y axis.
                     let m = mesh::revolve(
-                        &[(0.0, -c.half_height), (c.radius, -c.half_height), (c.radius, c.half_height), (0.0, c.half_height)],
+                        &[
+                            (0.0, -c.half_height),
+                            (c.radius, -c.half_height),
+                            (c.radius, c.half_height),
+                            (0.0, c.half_height),
+                        ],
                         ROUND_SEGMENTS,
                     );
-                    m.transformed(&Isometry3::rotation(Vector3::x() * -std::f64::consts::FRAC_PI_2))
+                    m.transformed(&Isometry3::rotation(
+                        Vector3::x() * -std::f64::consts::FRAC_PI_2,
+                    ))
                 }
-                PartGeom::Mesh { mesh, .. } => mesh.clone(),
+                PartGeom::Mesh(m) => m.mesh.clone(),
             };
             out.append(&local.transformed(&(self.pose * p.local)));
         }
@@ -782,7 +928,11 @@ impl Object {
 /// is inside.
 fn project_on_cylinder(r: f64, hh: f64, p: Vector) -> (Vector, Vector, bool) {
     let rho = p.x.hypot(p.z);
-    let radial = if rho > 1e-300 { Vector::new(p.x / rho, 0.0, p.z / rho) } else { Vector::X };
+    let radial = if rho > 1e-300 {
+        Vector::new(p.x / rho, 0.0, p.z / rho)
+    } else {
+        Vector::X
+    };
     let sy = if p.y >= 0.0 { 1.0 } else { -1.0 };
     let inside = rho <= r && p.y.abs() <= hh;
     if inside {
@@ -791,13 +941,21 @@ fn project_on_cylinder(r: f64, hh: f64, p: Vector) -> (Vector, Vector, bool) {
         if to_side <= to_cap {
             (Vector::new(radial.x * r, p.y, radial.z * r), radial, true)
         } else {
-            (Vector::new(p.x, sy * hh, p.z), Vector::new(0.0, sy, 0.0), true)
+            (
+                Vector::new(p.x, sy * hh, p.z),
+                Vector::new(0.0, sy, 0.0),
+                true,
+            )
         }
     } else {
         let cr = rho.min(r);
         let cy = p.y.clamp(-hh, hh);
         let q = Vector::new(radial.x * cr, cy, radial.z * cr);
-        let n = if p.y.abs() - hh > rho - r { Vector::new(0.0, sy, 0.0) } else { radial };
+        let n = if p.y.abs() - hh > rho - r {
+            Vector::new(0.0, sy, 0.0)
+        } else {
+            radial
+        };
         (q, n, false)
     }
 }
@@ -859,8 +1017,14 @@ fn user_parts(mesh: TriangleMesh, name: &str) -> Result<(Part, Vec<CollisionPart
     let coll = match hull {
         Some(h) => h,
         None => match &part.geom {
-            PartGeom::Mesh { shape, .. } => CollisionPart::new(SharedShape::new(shape.clone()), Isometry3::identity()),
-            _ => return Err(SimError::InvalidInput(format!("mesh `{name}` has no triangle mesh part"))),
+            PartGeom::Mesh(m) => {
+                CollisionPart::new(SharedShape::new(m.shape.clone()), Isometry3::identity())
+            }
+            _ => {
+                return Err(SimError::InvalidInput(format!(
+                    "mesh `{name}` has no triangle mesh part"
+                )));
+            }
         },
     };
     Ok((part, vec![coll]))
@@ -870,11 +1034,22 @@ fn user_parts(mesh: TriangleMesh, name: &str) -> Result<(Part, Vec<CollisionPart
 fn mesh_part(mesh: TriangleMesh, name: &str) -> Result<Part> {
     mesh.validate_closed(name)?;
     let vertices: Vec<Vector> = mesh.vertices.iter().map(p2g).collect();
-    let normals = (0..mesh.triangles.len()).map(|i| v2g(&mesh.triangle_normal(i))).collect();
-    let shape = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::ORIENTED).map_err(|e| {
-        SimError::NotWatertight { name: name.to_string(), reason: e.to_string() }
-    })?;
-    Ok(Part::new(PartGeom::Mesh { shape, mesh, normals }, Isometry3::identity()))
+    let normals = (0..mesh.triangles.len())
+        .map(|i| v2g(&mesh.triangle_normal(i)))
+        .collect();
+    let shape = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::ORIENTED)
+        .map_err(|e| SimError::NotWatertight {
+            name: name.to_string(),
+            reason: e.to_string(),
+        })?;
+    Ok(Part::new(
+        PartGeom::Mesh(Box::new(MeshGeom {
+            shape,
+            mesh,
+            normals,
+        })),
+        Isometry3::identity(),
+    ))
 }
 
 #[cfg(test)]
@@ -895,7 +1070,10 @@ mod tests {
         let e = Object::by_name("teapot").unwrap_err();
         let msg = e.to_string();
         assert!(matches!(e, SimError::UnknownObject { .. }));
-        assert!(msg.contains("teapot") && msg.contains("mug") && msg.contains("star_prism"), "{msg}");
+        assert!(
+            msg.contains("teapot") && msg.contains("mug") && msg.contains("star_prism"),
+            "{msg}"
+        );
         assert!(Object::by_name("Rotated-Cuboid").is_ok());
     }
 
@@ -903,7 +1081,10 @@ mod tests {
     fn sphere_queries_are_exact() {
         let s = Object::by_name("sphere").unwrap();
         let c = Point3::new(0.0, 0.0, 0.035);
-        let hit = s.cast_ray(&Point3::new(-1.0, 0.0, 0.035), &Vector3::x(), 10.0).unwrap().unwrap();
+        let hit = s
+            .cast_ray(&Point3::new(-1.0, 0.0, 0.035), &Vector3::x(), 10.0)
+            .unwrap()
+            .unwrap();
         assert!((hit.point - Point3::new(-0.035, 0.0, 0.035)).norm() < 1e-12);
         assert!((hit.outward_normal + Vector3::x()).norm() < 1e-12);
         assert!((hit.distance - 0.965).abs() < 1e-12);
@@ -912,32 +1093,87 @@ mod tests {
         let expect = (q - c).norm() - 0.035;
         assert!((sp.signed_distance - expect).abs() < 1e-12);
         assert!(((sp.point - c).norm() - 0.035).abs() < 1e-12);
-        assert!(s.cast_ray(&Point3::new(-1.0, 1.0, 0.0), &Vector3::x(), 10.0).unwrap().is_none());
+        assert!(
+            s.cast_ray(&Point3::new(-1.0, 1.0, 0.0), &Vector3::x(), 10.0)
+                .unwrap()
+                .is_none()
+        );
         assert!(s.closest_point(&Point3::new(f64::NAN, 0.0, 0.0)).is_err());
     }
 
     #[test]
     fn rotated_cuboid_normals_follow_the_frame() {
         let o = Object::by_name("rotated_cuboid").unwrap();
-        let hit = o.cast_ray(&Point3::new(0.0, -1.0, 0.06), &Vector3::y(), 2.0).unwrap().unwrap();
+        let hit = o
+            .cast_ray(&Point3::new(0.0, -1.0, 0.06), &Vector3::y(), 2.0)
+            .unwrap()
+            .unwrap();
         // The first hit from -y is the edge region; normals are one of the two rotated faces.
         let n = hit.outward_normal;
         assert!((n.z).abs() < 1e-12 && (n.norm() - 1.0).abs() < 1e-12);
         let c = std::f64::consts::FRAC_1_SQRT_2;
-        assert!((n.x.abs() - c).abs() < 1e-9 && (n.y.abs() - c).abs() < 1e-9, "{n:?}");
+        assert!(
+            (n.x.abs() - c).abs() < 1e-9 && (n.y.abs() - c).abs() < 1e-9,
+            "{n:?}"
+        );
     }
 
     #[test]
     fn mug_is_hollow_and_has_a_handle() {
         let o = Object::by_name("mug").unwrap();
         // Straight down into the cup: hits the inner bottom at z = 0.006.
-        let hit = o.cast_ray(&Point3::new(0.0, 0.0, 0.5), &-Vector3::z(), 1.0).unwrap().unwrap();
+        let hit = o
+            .cast_ray(&Point3::new(0.0, 0.0, 0.5), &-Vector3::z(), 1.0)
+            .unwrap()
+            .unwrap();
         assert!((hit.point.z - 0.006).abs() < 1e-9, "{hit:?}");
         // The handle on +x at mid height reaches out to x = 0.033 + 0.025 + 0.005 = 0.063.
-        let hit = o.cast_ray(&Point3::new(0.5, 0.0, 0.0475), &-Vector3::x(), 1.0).unwrap().unwrap();
+        let hit = o
+            .cast_ray(&Point3::new(0.5, 0.0, 0.0475), &-Vector3::x(), 1.0)
+            .unwrap()
+            .unwrap();
         assert!((hit.point.x - 0.063).abs() < 1e-3, "{hit:?}");
         // In the wall (radius 0.031..0.035): inside; in the cup's hollow: outside.
         assert!(o.signed_distance(&Point3::new(0.0, 0.033, 0.05)).unwrap() < 0.0);
         assert!(o.signed_distance(&Point3::new(0.0, 0.0, 0.05)).unwrap() > 0.0);
+    }
+
+    #[test]
+    fn convex_pieces_match_the_query_surface() {
+        // The distance from a tiny ball to the collision pieces must equal the distance to the
+        // (mesh) surface used by point queries, for points around each decomposed object.
+        let probe = Ball::new(1e-5);
+        for name in [
+            "wine_glass",
+            "mug",
+            "star_prism",
+            "cylinder",
+            "rotated_cuboid",
+        ] {
+            let o = Object::by_name(name).unwrap();
+            let (lo, hi) = o.aabb();
+            let mut checked = 0;
+            for i in 0..9 {
+                for j in 0..9 {
+                    for k in 0..9 {
+                        let f =
+                            |a: f64, b: f64, t: usize| a - 0.01 + (b - a + 0.02) * t as f64 / 8.0;
+                        let p = Point3::new(f(lo.x, hi.x, i), f(lo.y, hi.y, j), f(lo.z, hi.z, k));
+                        let sd = o.signed_distance(&p).unwrap();
+                        if sd <= 2e-3 {
+                            continue;
+                        }
+                        let pose = iso2pose(&Isometry3::translation(p.x, p.y, p.z));
+                        let d = o.distance_to_shape(&pose, &probe).unwrap() + 1e-5;
+                        assert!(
+                            (d - sd).abs() < 1e-6,
+                            "{name} at {p:?}: pieces {d}, surface {sd}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(checked > 100, "{name}: {checked}");
+        }
     }
 }

@@ -70,10 +70,16 @@ impl TrialSpace {
         for (i, p) in params.iter().enumerate() {
             ensure_finite(&[p.lower, p.upper], "parameter bounds")?;
             if p.lower > p.upper {
-                return Err(SimError::InvalidInput(format!("parameter {:?}: lower > upper", p.kind)));
+                return Err(SimError::InvalidInput(format!(
+                    "parameter {:?}: lower > upper",
+                    p.kind
+                )));
             }
             if params[..i].iter().any(|q| q.kind == p.kind) {
-                return Err(SimError::InvalidInput(format!("parameter {:?} given twice", p.kind)));
+                return Err(SimError::InvalidInput(format!(
+                    "parameter {:?} given twice",
+                    p.kind
+                )));
             }
         }
         Ok(Self { reference, params })
@@ -82,18 +88,27 @@ impl TrialSpace {
     /// 1D: the approach offset (the thesis's 1D scans).
     pub fn approach_1d(object: &Object) -> Self {
         let b = default_bounds(object);
-        Self { reference: reference_pose(object), params: vec![b[0]] }
+        Self {
+            reference: reference_pose(object),
+            params: vec![b[0]],
+        }
     }
 
     /// 2D: approach and vertical offsets (the thesis's 2D scans, figures 4.9-4.15).
     pub fn approach_vertical_2d(object: &Object) -> Self {
         let b = default_bounds(object);
-        Self { reference: reference_pose(object), params: vec![b[0], b[2]] }
+        Self {
+            reference: reference_pose(object),
+            params: vec![b[0], b[2]],
+        }
     }
 
     /// 6D: approach, lateral, vertical offsets and a rotation vector.
     pub fn full_6d(object: &Object) -> Self {
-        Self { reference: reference_pose(object), params: default_bounds(object).to_vec() }
+        Self {
+            reference: reference_pose(object),
+            params: default_bounds(object).to_vec(),
+        }
     }
 
     /// Number of parameters.
@@ -110,7 +125,12 @@ impl TrialSpace {
     pub fn from_unit(&self, u: &[f64]) -> Result<Vec<f64>> {
         self.check_len(u)?;
         ensure_finite(u, "unit-cube parameter vector")?;
-        Ok(self.params.iter().zip(u).map(|(p, t)| p.lower + t * (p.upper - p.lower)).collect())
+        Ok(self
+            .params
+            .iter()
+            .zip(u)
+            .map(|(p, t)| p.lower + t * (p.upper - p.lower))
+            .collect())
     }
 
     fn check_len(&self, x: &[f64]) -> Result<()> {
@@ -163,8 +183,15 @@ pub fn reference_pose(object: &Object) -> Isometry3<f64> {
         _ => centre.z,
     };
     let origin = Vector3::new(lo.x - REFERENCE_STANDOFF, centre.y, height);
-    let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[-Vector3::z(), Vector3::y(), Vector3::x()]));
-    Isometry3::from_parts(Translation3::from(origin), UnitQuaternion::from_rotation_matrix(&rot))
+    let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
+        -Vector3::z(),
+        Vector3::y(),
+        Vector3::x(),
+    ]));
+    Isometry3::from_parts(
+        Translation3::from(origin),
+        UnitQuaternion::from_rotation_matrix(&rot),
+    )
 }
 
 /// Default bounds for an object: approach `[-0.16, 0.02]` (from beyond the fingertips' reach,
@@ -206,7 +233,10 @@ mod tests {
         let base = s.palm_pose(&[0.0; 6]).unwrap();
         let moved = s.palm_pose(&[0.01, 0.002, 0.003, 0.0, 0.0, 0.0]).unwrap();
         let d = moved.translation.vector - base.translation.vector;
-        assert!((d - Vector3::new(0.01, 0.002, 0.003)).norm() < 1e-12, "{d:?}");
+        assert!(
+            (d - Vector3::new(0.01, 0.002, 0.003)).norm() < 1e-12,
+            "{d:?}"
+        );
         let rotated = s.palm_pose(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.3]).unwrap();
         // A rotation about the approach axis keeps the approach axis and the origin.
         assert!((rotated * Point3::origin() - base * Point3::origin()).norm() < 1e-12);
@@ -216,6 +246,9 @@ mod tests {
         assert!(s.palm_pose(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).is_err());
         let two = TrialSpace::approach_vertical_2d(&o);
         assert_eq!(two.dim(), 2);
-        assert_eq!(two.from_unit(&[0.0, 1.0]).unwrap(), vec![two.params[0].lower, two.params[1].upper]);
+        assert_eq!(
+            two.from_unit(&[0.0, 1.0]).unwrap(),
+            vec![two.params[0].lower, two.params[1].upper]
+        );
     }
 }

@@ -17,7 +17,10 @@ pub struct NamedMesh {
 
 /// The object's surface in the world frame.
 pub fn object_mesh(object: &Object) -> NamedMesh {
-    NamedMesh { name: object.name().to_string(), mesh: object.surface_mesh() }
+    NamedMesh {
+        name: object.name().to_string(),
+        mesh: object.surface_mesh(),
+    }
 }
 
 /// Each link of `hand` at the grasp's final pose, in the world frame.
@@ -34,7 +37,10 @@ pub fn hand_meshes(hand: &dyn Hand, grasp: &Grasp) -> Result<Vec<NamedMesh>> {
         .links()
         .iter()
         .zip(&grasp.link_poses)
-        .map(|(l, pose)| NamedMesh { name: l.name.clone(), mesh: l.shape.mesh().transformed(pose) })
+        .map(|(l, pose)| NamedMesh {
+            name: l.name.clone(),
+            mesh: l.shape.mesh().transformed(pose),
+        })
         .collect())
 }
 

@@ -5,8 +5,8 @@
 use nalgebra::Isometry3;
 
 use crate::contact::{
-    ContactCloud, ContactModel, ContactModelSettings, ContactPoint, add_noise, circular_patch, link_cloud, mean_point,
-    surface_model,
+    ContactCloud, ContactModel, ContactModelSettings, ContactPoint, add_noise, circular_patch,
+    link_cloud, mean_point, surface_model,
 };
 use crate::error::{Result, ensure_finite};
 use crate::hand::{Grasp, Hand, LinkGeometry};
@@ -56,12 +56,15 @@ pub struct TrialOutcome {
     pub fingers: Vec<FingerOutcome>,
     /// The palm's contacts.
     pub palm: FingerOutcome,
+    /// Whether anything (a finger or the palm) touches the object; a trial touching nothing has
+    /// empty clouds and models everywhere.
+    pub touched: bool,
 }
 
 impl TrialOutcome {
     /// Whether anything (a finger or the palm) touches the object.
     pub fn touched(&self) -> bool {
-        self.palm.touches() || self.fingers.iter().any(FingerOutcome::touches)
+        self.touched
     }
 
     /// Number of fingers (palm excluded) that touch the object.
@@ -71,7 +74,11 @@ impl TrialOutcome {
 
     /// All contacts of a model, fingers first, then (optionally) the palm.
     pub fn contacts(&self, model: ContactModel, include_palm: bool) -> Vec<ContactPoint> {
-        let mut v: Vec<ContactPoint> = self.fingers.iter().flat_map(|f| f.contacts(model)).collect();
+        let mut v: Vec<ContactPoint> = self
+            .fingers
+            .iter()
+            .flat_map(|f| f.contacts(model))
+            .collect();
         if include_palm {
             v.extend(self.palm.contacts(model));
         }
@@ -99,7 +106,11 @@ pub fn run_trial(
     let mut per_link: Vec<Vec<ContactPoint>> = Vec::with_capacity(links.len());
     for (i, (spec, pose)) in links.iter().zip(&grasp.link_poses).enumerate() {
         let near = grasp.link_distances.get(i).is_some_and(|&d| d <= d_c);
-        per_link.push(if near { link_cloud(object, &geometry, i, spec, pose, &settings.cloud)? } else { Vec::new() });
+        per_link.push(if near {
+            link_cloud(object, &geometry, i, spec, pose, &settings.cloud)?
+        } else {
+            Vec::new()
+        });
     }
     let group = |finger: Option<usize>, stream: u64| -> FingerOutcome {
         let mut names = Vec::new();
@@ -129,7 +140,32 @@ pub fn run_trial(
             surface,
         }
     };
-    let fingers = (0..hand.finger_count()).map(|f| group(Some(f), f as u64 + 1)).collect();
+    let fingers: Vec<FingerOutcome> = (0..hand.finger_count())
+        .map(|f| group(Some(f), f as u64 + 1))
+        .collect();
     let palm = group(None, 0);
-    Ok(TrialOutcome { object: object.name().to_string(), grasp, fingers, palm })
+    let touched = palm.touches() || fingers.iter().any(FingerOutcome::touches);
+    Ok(TrialOutcome {
+        object: object.name().to_string(),
+        grasp,
+        fingers,
+        palm,
+        touched,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trial_types_can_be_shared_across_threads() {
+        fn check<T: Send + Sync>() {}
+        check::<Object>();
+        check::<crate::hand::BarrettHand>();
+        check::<crate::hand::ParallelJawGripper>();
+        check::<Box<dyn Hand>>();
+        check::<TrialOutcome>();
+        check::<ContactModelSettings>();
+    }
 }

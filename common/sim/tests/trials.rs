@@ -2,11 +2,16 @@
 //! every object at its reference pose, empty trials and bad input.
 
 use graspopt_sim::contact::{ContactPoint, surface_model};
-use graspopt_sim::hand::{BarrettHand, CONTACT_TOLERANCE, Hand, LinkShape, ParallelJawGripper, hand_by_name};
+use graspopt_sim::hand::{
+    BarrettHand, CONTACT_TOLERANCE, Hand, LinkGeometry, LinkShape, LinkSpec, ParallelJawGripper,
+    advance_until_contact, clear_hand, finish_grasp, hand_by_name,
+};
 use graspopt_sim::mesh::{self, TriangleMesh};
 use graspopt_sim::pose::{TrialSpace, reference_pose};
 use graspopt_sim::scene;
-use graspopt_sim::{ContactModel, ContactModelSettings, NoiseSettings, Object, SimError, TrialOutcome, run_trial};
+use graspopt_sim::{
+    ContactModel, ContactModelSettings, NoiseSettings, Object, SimError, TrialOutcome, run_trial,
+};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 const SPHERE_RADIUS: f64 = 0.035;
@@ -47,18 +52,33 @@ fn sphere_grasped_at_its_centre() {
     assert_eq!(out.fingers_in_contact(), 3, "{:?}", out.grasp.joints);
     let c = sphere_centre();
     for f in &out.fingers {
-        assert!(f.cloud.len() >= 3, "finger {:?}: a cloud, not a point ({})", f.finger, f.cloud.len());
+        assert!(
+            f.cloud.len() >= 3,
+            "finger {:?}: a cloud, not a point ({})",
+            f.finger,
+            f.cloud.len()
+        );
         for p in &f.cloud.points {
             let r = (p.position - c).norm();
-            assert!((r - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS, "off the surface by {}", r - SPHERE_RADIUS);
+            assert!(
+                (r - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS,
+                "off the surface by {}",
+                r - SPHERE_RADIUS
+            );
             assert!((p.normal.norm() - 1.0).abs() < 1e-12);
-            assert!(angle_deg(&p.normal, &(c - p.position)) < 1e-6, "normal not towards the centre");
+            assert!(
+                angle_deg(&p.normal, &(c - p.position)) < 1e-6,
+                "normal not towards the centre"
+            );
         }
         let m = f.mean_point.unwrap();
         assert!(angle_deg(&m.normal, &(c - m.position)) < 1.0);
         for s in &f.surface {
             assert!(((s.position - c).norm() - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS);
-            assert!(angle_deg(&s.normal, &(c - s.position)) < 1e-6, "surface-model normal not radial");
+            assert!(
+                angle_deg(&s.normal, &(c - s.position)) < 1e-6,
+                "surface-model normal not radial"
+            );
         }
     }
     // No link penetrates: an independent box-vs-sphere distance for every link.
@@ -66,7 +86,11 @@ fn sphere_grasped_at_its_centre() {
         if let LinkShape::Box { half_extents } = spec.shape {
             let gap = point_box_distance(&c, link, &half_extents) - SPHERE_RADIUS;
             assert!(gap >= -1e-9, "{} penetrates by {}", spec.name, -gap);
-            assert!(gap <= CONTACT_TOLERANCE || !out.grasp.link_touching.iter().any(|t| *t) || gap > 0.0);
+            assert!(
+                gap <= CONTACT_TOLERANCE
+                    || !out.grasp.link_touching.iter().any(|t| *t)
+                    || gap > 0.0
+            );
         }
     }
     for (i, d) in out.grasp.link_distances.iter().enumerate() {
@@ -88,15 +112,28 @@ fn barrett_coupling_and_breakaway() {
     let far = trial(&sphere, &hand, &space.palm_pose(&[-0.1]).unwrap());
     for f in 0..3 {
         let (m, d) = (far.grasp.joints[1 + 2 * f], far.grasp.joints[2 + 2 * f]);
-        assert!(m > 0.0 && (d - m / 3.0).abs() < 1e-12, "finger {f}: {m} {d}");
-        assert!(far.grasp.link_touching[2 + 2 * f], "distal of finger {f} touches");
+        assert!(
+            m > 0.0 && (d - m / 3.0).abs() < 1e-12,
+            "finger {f}: {m} {d}"
+        );
+        assert!(
+            far.grasp.link_touching[2 + 2 * f],
+            "distal of finger {f} touches"
+        );
     }
     // Near: the medial link is blocked and the distal continues past the coupling ratio.
     let near = trial(&sphere, &hand, &space.palm_pose(&[0.0]).unwrap());
     for f in 0..3 {
         let (m, d) = (near.grasp.joints[1 + 2 * f], near.grasp.joints[2 + 2 * f]);
-        assert!(near.grasp.link_touching[1 + 2 * f], "medial of finger {f} touches");
-        assert!(d > m / 3.0 + 1e-3, "finger {f}: distal {d} continued beyond medial/3 = {}", m / 3.0);
+        assert!(
+            near.grasp.link_touching[1 + 2 * f],
+            "medial of finger {f} touches"
+        );
+        assert!(
+            d > m / 3.0 + 1e-3,
+            "finger {f}: distal {d} continued beyond medial/3 = {}",
+            m / 3.0
+        );
     }
 }
 
@@ -107,7 +144,10 @@ fn surface_model_on_a_flat_face_and_on_a_sphere() {
     let cuboid = Object::by_name("cuboid").unwrap();
     let cloud: Vec<ContactPoint> = [(-0.004, 0.05), (0.003, 0.052), (0.0, 0.047), (0.002, 0.049)]
         .iter()
-        .map(|&(x, z)| ContactPoint { position: Point3::new(x, 0.025, z), normal: -Vector3::y() })
+        .map(|&(x, z)| ContactPoint {
+            position: Point3::new(x, 0.025, z),
+            normal: -Vector3::y(),
+        })
         .collect();
     let surf = surface_model(&cloud, &cuboid, &settings);
     assert_eq!(surf.len(), 21);
@@ -123,7 +163,10 @@ fn surface_model_on_a_flat_face_and_on_a_sphere() {
         .iter()
         .map(|&e| {
             let d = (dir + Vector3::new(0.0, e, -e)).normalize();
-            ContactPoint { position: c + d * SPHERE_RADIUS, normal: -d }
+            ContactPoint {
+                position: c + d * SPHERE_RADIUS,
+                normal: -d,
+            }
         })
         .collect();
     let surf = surface_model(&cloud, &sphere, &settings);
@@ -151,7 +194,11 @@ fn parallel_jaw_on_the_cuboid_faces() {
     assert_eq!(out.fingers_in_contact(), 2);
     for (f, expect) in out.fingers.iter().zip([Vector3::y(), -Vector3::y()]) {
         for p in f.cloud.points.iter().chain(&f.surface) {
-            assert!((p.normal - expect).norm() < 1e-9, "{:?} vs {expect:?}", p.normal);
+            assert!(
+                (p.normal - expect).norm() < 1e-9,
+                "{:?} vs {expect:?}",
+                p.normal
+            );
             assert!((p.position.y.abs() - 0.025).abs() < 1e-9);
         }
         assert_eq!(f.surface.len(), 21);
@@ -164,7 +211,11 @@ fn every_object_is_touched_at_its_reference_pose() {
     for name in Object::names() {
         let o = Object::by_name(name).unwrap();
         let out = trial(&o, &hand, &reference_pose(&o));
-        assert!(out.fingers_in_contact() >= 2, "{name}: {} fingers", out.fingers_in_contact());
+        assert!(
+            out.fingers_in_contact() >= 2,
+            "{name}: {} fingers",
+            out.fingers_in_contact()
+        );
         assert!(out.touched());
         // Every raw contact lies on the object's surface; on the smooth objects its normal is the
         // opposite of the outward surface normal there.
@@ -172,14 +223,24 @@ fn every_object_is_touched_at_its_reference_pose() {
         for f in &out.fingers {
             for p in &f.cloud.points {
                 let sp = o.closest_point(&p.position).unwrap();
-                assert!(sp.signed_distance.abs() < 1e-9, "{name}: contact off the surface by {}", sp.signed_distance);
+                assert!(
+                    sp.signed_distance.abs() < 1e-9,
+                    "{name}: contact off the surface by {}",
+                    sp.signed_distance
+                );
                 assert!((p.normal.norm() - 1.0).abs() < 1e-12);
                 if smooth {
-                    assert!(p.normal.dot(&sp.outward_normal) < -0.9, "{name}: normal must point into the object");
+                    assert!(
+                        p.normal.dot(&sp.outward_normal) < -0.9,
+                        "{name}: normal must point into the object"
+                    );
                 }
             }
         }
-        assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0), "{name}: a link intersects");
+        assert!(
+            out.grasp.link_distances.iter().all(|d| *d > 0.0),
+            "{name}: a link intersects"
+        );
     }
 }
 
@@ -188,7 +249,11 @@ fn gripper_touches_the_objects_it_can_reach() {
     let hand = hand_by_name("parallel_jaw").unwrap();
     for name in Object::names() {
         let o = Object::by_name(name).unwrap();
-        let out = trial(&o, hand.as_ref(), &(reference_pose(&o) * Translation3::new(0.0, 0.0, 0.02)));
+        let out = trial(
+            &o,
+            hand.as_ref(),
+            &(reference_pose(&o) * Translation3::new(0.0, 0.0, 0.02)),
+        );
         assert!(out.fingers_in_contact() >= 1, "{name}");
     }
 }
@@ -197,18 +262,31 @@ fn gripper_touches_the_objects_it_can_reach() {
 fn a_far_pose_touches_nothing() {
     let cyl = Object::by_name("cylinder").unwrap();
     let far = reference_pose(&cyl) * Translation3::new(0.0, 0.0, -0.5);
-    for hand in [hand_by_name("barrett").unwrap(), hand_by_name("parallel_jaw").unwrap()] {
+    for hand in [
+        hand_by_name("barrett").unwrap(),
+        hand_by_name("parallel_jaw").unwrap(),
+    ] {
         let out = trial(&cyl, hand.as_ref(), &far);
         assert!(!out.touched());
         assert_eq!(out.fingers_in_contact(), 0);
         for f in out.fingers.iter().chain([&out.palm]) {
-            assert!(f.cloud.is_empty() && f.mean_point.is_none() && f.circular_patch.is_empty() && f.surface.is_empty());
+            assert!(
+                f.cloud.is_empty()
+                    && f.mean_point.is_none()
+                    && f.circular_patch.is_empty()
+                    && f.surface.is_empty()
+            );
         }
         assert!(out.contacts(ContactModel::Surface, true).is_empty());
         assert_eq!(out.grasp.retreat, 0.0);
         // Every finger joint closed to its limit (the spread is not a closing joint).
         let limits = hand.joint_limits();
-        for ((name, j), (_, hi)) in hand.joint_names().iter().zip(&out.grasp.joints).zip(&limits) {
+        for ((name, j), (_, hi)) in hand
+            .joint_names()
+            .iter()
+            .zip(&out.grasp.joints)
+            .zip(&limits)
+        {
             if name != "spread" {
                 assert!((j - hi).abs() < 1e-12, "joint {name} = {j}, limit {hi}");
             }
@@ -238,7 +316,10 @@ fn bad_input_gives_clear_errors() {
     assert!(e.to_string().contains("pose"));
 
     let e = Object::by_name("banana").unwrap_err();
-    assert!(e.to_string().contains("banana") && e.to_string().contains("cylinder"), "{e}");
+    assert!(
+        e.to_string().contains("banana") && e.to_string().contains("cylinder"),
+        "{e}"
+    );
     assert!(hand_by_name("shadow").is_err());
 
     let e = Object::from_mesh("empty", TriangleMesh::default()).unwrap_err();
@@ -249,7 +330,10 @@ fn bad_input_gives_clear_errors() {
     assert!(matches!(e, SimError::NotWatertight { .. }), "{e}");
     assert!(e.to_string().contains("open box"));
 
-    let bad = ContactModelSettings { radius: -1.0, ..Default::default() };
+    let bad = ContactModelSettings {
+        radius: -1.0,
+        ..Default::default()
+    };
     assert!(run_trial(&sphere, &hand, &reference_pose(&sphere), &bad).is_err());
     assert!(BarrettHand::new(4.0).is_err());
     assert!(hand.link_poses(&[0.0; 3]).is_err());
@@ -272,7 +356,8 @@ fn obj_and_stl_meshes_load_and_can_be_grasped() {
     let obj_path = dir.join("cube.obj");
     std::fs::write(&obj_path, obj).unwrap();
     // The same cube as binary and ASCII STL (triangles from the generator, each corner repeated).
-    let cube = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02)).transformed(&Isometry3::translation(0.0, 0.0, 0.02));
+    let cube = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02))
+        .transformed(&Isometry3::translation(0.0, 0.0, 0.02));
     let mut bin = vec![0u8; 80];
     bin.extend_from_slice(&(cube.triangles.len() as u32).to_le_bytes());
     let mut ascii = String::from("solid cube\n");
@@ -299,8 +384,14 @@ fn obj_and_stl_meshes_load_and_can_be_grasped() {
     for path in [&obj_path, &bin_path, &ascii_path] {
         let o = Object::from_file(path).unwrap();
         let (lo, hi) = o.aabb();
-        assert!((lo - Point3::new(-0.02, -0.02, 0.0)).norm() < 1e-6, "{path:?}: {lo:?}");
-        assert!((hi - Point3::new(0.02, 0.02, 0.04)).norm() < 1e-6, "{path:?}: {hi:?}");
+        assert!(
+            (lo - Point3::new(-0.02, -0.02, 0.0)).norm() < 1e-6,
+            "{path:?}: {lo:?}"
+        );
+        assert!(
+            (hi - Point3::new(0.02, 0.02, 0.04)).norm() < 1e-6,
+            "{path:?}: {hi:?}"
+        );
         assert!((o.centre_of_mass() - Point3::new(0.0, 0.0, 0.02)).norm() < 1e-6);
         let out = trial(&o, &hand, &reference_pose(&o));
         assert!(out.fingers_in_contact() >= 2, "{path:?}");
@@ -308,24 +399,46 @@ fn obj_and_stl_meshes_load_and_can_be_grasped() {
     // Errors: unknown extension, missing file, garbage, an open mesh.
     let txt = dir.join("cube.txt");
     std::fs::write(&txt, obj).unwrap();
-    assert!(matches!(Object::from_file(&txt).unwrap_err(), SimError::UnsupportedFormat { .. }));
-    assert!(matches!(Object::from_file(&dir.join("missing.obj")).unwrap_err(), SimError::Io { .. }));
+    assert!(matches!(
+        Object::from_file(&txt).unwrap_err(),
+        SimError::UnsupportedFormat { .. }
+    ));
+    assert!(matches!(
+        Object::from_file(&dir.join("missing.obj")).unwrap_err(),
+        SimError::Io { .. }
+    ));
     let junk = dir.join("junk.stl");
     std::fs::write(&junk, b"not a mesh").unwrap();
-    assert!(matches!(Object::from_file(&junk).unwrap_err(), SimError::MeshParse { .. }));
+    assert!(matches!(
+        Object::from_file(&junk).unwrap_err(),
+        SimError::MeshParse { .. }
+    ));
     let holey = dir.join("holey.obj");
     std::fs::write(&holey, obj.replace("f 5 6 7 8\n", "")).unwrap();
-    assert!(matches!(Object::from_file(&holey).unwrap_err(), SimError::NotWatertight { .. }));
+    assert!(matches!(
+        Object::from_file(&holey).unwrap_err(),
+        SimError::NotWatertight { .. }
+    ));
     let empty = dir.join("empty.obj");
     std::fs::write(&empty, "# nothing\n").unwrap();
-    assert!(matches!(Object::from_file(&empty).unwrap_err(), SimError::EmptyMesh { .. }));
+    assert!(matches!(
+        Object::from_file(&empty).unwrap_err(),
+        SimError::EmptyMesh { .. }
+    ));
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_non_convex_user_mesh_works_through_the_mesh_path() {
     // An L-shaped prism (not convex: collision uses the triangle mesh itself).
-    let l = [(0.03, -0.03), (0.03, 0.0), (0.0, 0.0), (0.0, 0.03), (-0.03, 0.03), (-0.03, -0.03)];
+    let l = [
+        (0.03, -0.03),
+        (0.03, 0.0),
+        (0.0, 0.0),
+        (0.0, 0.03),
+        (-0.03, 0.03),
+        (-0.03, -0.03),
+    ];
     // Star-shaped about the origin? No (the notch); build it as an explicit closed mesh.
     let n = l.len() as u32;
     let mut m = TriangleMesh::default();
@@ -358,7 +471,11 @@ fn noise_is_seeded_and_keeps_normals_unit() {
     let hand = BarrettHand::default();
     let pose = reference_pose(&mug);
     let noisy = |seed| ContactModelSettings {
-        noise: Some(NoiseSettings { position_std: 5e-4, normal_std: 0.05, seed }),
+        noise: Some(NoiseSettings {
+            position_std: 5e-4,
+            normal_std: 0.05,
+            seed,
+        }),
         ..Default::default()
     };
     let a = run_trial(&mug, &hand, &pose, &noisy(1)).unwrap();
@@ -366,9 +483,18 @@ fn noise_is_seeded_and_keeps_normals_unit() {
     let c = run_trial(&mug, &hand, &pose, &noisy(2)).unwrap();
     let clean = trial(&mug, &hand, &pose);
     assert_eq!(a, b);
-    assert_ne!(a.contacts(ContactModel::Surface, false), c.contacts(ContactModel::Surface, false));
-    assert_ne!(a.contacts(ContactModel::MeanPoint, false), clean.contacts(ContactModel::MeanPoint, false));
-    assert_eq!(a.fingers[0].cloud, clean.fingers[0].cloud, "raw clouds stay noise-free");
+    assert_ne!(
+        a.contacts(ContactModel::Surface, false),
+        c.contacts(ContactModel::Surface, false)
+    );
+    assert_ne!(
+        a.contacts(ContactModel::MeanPoint, false),
+        clean.contacts(ContactModel::MeanPoint, false)
+    );
+    assert_eq!(
+        a.fingers[0].cloud, clean.fingers[0].cloud,
+        "raw clouds stay noise-free"
+    );
     for p in a.contacts(ContactModel::Surface, true) {
         assert!((p.normal.norm() - 1.0).abs() < 1e-12);
     }
@@ -410,5 +536,160 @@ fn two_dimensional_space_covers_touching_and_empty_trials() {
             }
         }
     }
-    assert!(touched >= 3 && empty >= 1, "touched {touched}, empty {empty}");
+    assert!(
+        touched >= 3 && empty >= 1,
+        "touched {touched}, empty {empty}"
+    );
+}
+
+/// A one-finger pusher: a new hand is a new implementation of the trait, built from the helpers.
+#[derive(Debug)]
+struct Pusher {
+    links: Vec<LinkSpec>,
+    geometry: LinkGeometry,
+}
+
+impl Pusher {
+    fn new() -> Self {
+        let boxed = |name: &str, finger, h: [f64; 3]| LinkSpec {
+            name: name.to_string(),
+            finger,
+            shape: LinkShape::Box {
+                half_extents: Vector3::from(h),
+            },
+        };
+        let links = vec![
+            boxed("palm", None, [0.03, 0.03, 0.005]),
+            boxed("pad", Some(0), [0.01, 0.005, 0.03]),
+        ];
+        let geometry = LinkGeometry::new(&links);
+        Self { links, geometry }
+    }
+}
+
+impl Hand for Pusher {
+    fn name(&self) -> &str {
+        "pusher"
+    }
+    fn links(&self) -> &[LinkSpec] {
+        &self.links
+    }
+    fn finger_count(&self) -> usize {
+        1
+    }
+    fn joint_names(&self) -> Vec<String> {
+        vec!["push".to_string()]
+    }
+    fn joint_limits(&self) -> Vec<(f64, f64)> {
+        vec![(0.0, 0.1)]
+    }
+    fn open_configuration(&self) -> Vec<f64> {
+        vec![0.0]
+    }
+    fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>, SimError> {
+        let &[t] = joints else {
+            return Err(SimError::InvalidInput("pusher has one joint".to_string()));
+        };
+        Ok(vec![
+            Isometry3::translation(0.0, 0.0, -0.005),
+            Isometry3::translation(0.0, -0.06 + t, 0.03),
+        ])
+    }
+    fn close(
+        &self,
+        object: &Object,
+        palm_pose: &Isometry3<f64>,
+    ) -> Result<graspopt_sim::Grasp, SimError> {
+        let (palm, retreat) = clear_hand(self, &self.geometry, object, palm_pose)?;
+        let adv = advance_until_contact(
+            |t| {
+                Ok(vec![self.geometry.distance(
+                    object,
+                    1,
+                    &(palm * self.link_poses(&[t])?[1]),
+                )?])
+            },
+            0.0,
+            0.1,
+            &[1.0],
+        )?;
+        finish_grasp(
+            self,
+            &self.geometry,
+            object,
+            palm_pose,
+            palm,
+            retreat,
+            vec![adv.t],
+        )
+    }
+}
+
+#[test]
+fn a_new_hand_is_a_new_impl() {
+    let cuboid = Object::by_name("cuboid").unwrap();
+    let out = trial(&cuboid, &Pusher::new(), &reference_pose(&cuboid));
+    assert_eq!(out.fingers_in_contact(), 1);
+    // The pad travels from y = -0.055 to the face at y = -0.025, stopping within the tolerance.
+    let gap = out.grasp.link_distances[1];
+    assert!(gap > 0.0 && gap <= CONTACT_TOLERANCE);
+    assert!((out.grasp.joints[0] - (0.06 - 0.005 - 0.025 - gap)).abs() < 1e-9);
+    for p in &out.fingers[0].cloud.points {
+        assert!((p.normal - Vector3::y()).norm() < 1e-12);
+    }
+}
+
+#[test]
+fn barrett_with_spread_closes_without_penetrating() {
+    for spread in [std::f64::consts::FRAC_PI_2, std::f64::consts::PI] {
+        let hand = BarrettHand::new(spread).unwrap();
+        for name in ["cylinder", "sphere", "mug"] {
+            let o = Object::by_name(name).unwrap();
+            let out = trial(&o, &hand, &reference_pose(&o));
+            assert!(out.touched(), "{name} spread {spread}");
+            assert!(
+                out.grasp.link_distances.iter().all(|d| *d > 0.0),
+                "{name} spread {spread}"
+            );
+            assert!((out.grasp.joints[0] - spread).abs() < 1e-15);
+        }
+    }
+}
+
+#[test]
+fn sphere_approach_scan_spans_empty_fingertip_and_wrapping_grasps() {
+    // The thesis's 1D scans: along the approach axis the hand goes from touching nothing to
+    // fingertip contacts to wrapping the object with the palm against it.
+    let sphere = Object::by_name("sphere").unwrap();
+    let hand = BarrettHand::default();
+    let space = TrialSpace::approach_1d(&sphere);
+    let (lo, hi) = (space.params[0].lower, space.params[0].upper);
+    let n = 37;
+    let mut three = Vec::new();
+    for i in 0..n {
+        let a = lo + (hi - lo) * i as f64 / (n - 1) as f64;
+        let out = trial(&sphere, &hand, &space.palm_pose(&[a]).unwrap());
+        if i == 0 {
+            assert!(
+                !out.touched(),
+                "the far end of the default range touches nothing"
+            );
+        }
+        if i == n - 1 {
+            assert!(
+                out.palm.touches(),
+                "the near end presses the palm on the sphere"
+            );
+        }
+        if out.fingers_in_contact() == 3 {
+            three.push(a);
+        }
+    }
+    let span = three.last().unwrap() - three.first().unwrap();
+    assert!(span >= 0.1, "three-finger contacts over {span} m only");
+    assert_eq!(
+        three.len() as f64,
+        1.0 + (span / ((hi - lo) / (n - 1) as f64)).round(),
+        "contiguous"
+    );
 }

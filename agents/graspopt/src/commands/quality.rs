@@ -195,10 +195,13 @@ fn parse_case(case: &Value) -> Result<GraspMap> {
         bail!("expected an object");
     };
     if let Some(contacts) = obj.get("contacts") {
-        let params = obj.get("params").context("`contacts` given without `params`")?;
+        let params = obj
+            .get("params")
+            .context("`contacts` given without `params`")?;
         let model = parse_params(params)?;
         let contacts = parse_contacts(contacts)?;
-        return GraspMap::from_contacts(&contacts, &model).map_err(|e| anyhow::anyhow!("contacts: {e}"));
+        return GraspMap::from_contacts(&contacts, &model)
+            .map_err(|e| anyhow::anyhow!("contacts: {e}"));
     }
     if let Some(wrenches) = obj.get("wrenches") {
         let list = wrenches.as_array().context("wrenches: expected an array")?;
@@ -223,10 +226,9 @@ fn parse_params(params: &Value) -> Result<GraspModel> {
             .as_f64()
             .with_context(|| format!("params.{name}: expected a number"))
     };
-    let model = obj
-        .get("model")
-        .and_then(Value::as_str)
-        .context("params.model: expected \"frictionless\", \"point_friction\" or \"soft_finger\"")?;
+    let model = obj.get("model").and_then(Value::as_str).context(
+        "params.model: expected \"frictionless\", \"point_friction\" or \"soft_finger\"",
+    )?;
     let edges = || -> Result<usize> {
         let e = obj.get("edges").context("params.edges: missing")?;
         let n = e
@@ -262,7 +264,9 @@ fn parse_params(params: &Value) -> Result<GraspModel> {
         reference_point,
         torque_scale,
     };
-    model.validate().map_err(|e| anyhow::anyhow!("params: {e}"))?;
+    model
+        .validate()
+        .map_err(|e| anyhow::anyhow!("params: {e}"))?;
     Ok(model)
 }
 
@@ -297,6 +301,9 @@ fn numbers(v: &Value, len: usize) -> Result<Vec<f64>> {
         bail!("expected {len} numbers, got {}", list.len());
     }
     list.iter()
-        .map(|x| x.as_f64().with_context(|| format!("expected a number, got {x}")))
+        .map(|x| {
+            x.as_f64()
+                .with_context(|| format!("expected a number, got {x}"))
+        })
         .collect()
 }

@@ -99,8 +99,16 @@ mod tests {
         let p = |x, y, z| Vector3::new(x, y, z);
         assert_eq!(affine_rank::<3>(&[]), 0);
         assert_eq!(affine_rank(&[p(1.0, 2.0, 3.0), p(1.0, 2.0, 3.0)]), 0);
-        assert_eq!(affine_rank(&[p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0), p(2.0, 2.0, 2.0)]), 1);
-        let square = [p(0.0, 0.0, 1.0), p(1.0, 0.0, 1.0), p(0.0, 1.0, 1.0), p(1.0, 1.0, 1.0)];
+        assert_eq!(
+            affine_rank(&[p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0), p(2.0, 2.0, 2.0)]),
+            1
+        );
+        let square = [
+            p(0.0, 0.0, 1.0),
+            p(1.0, 0.0, 1.0),
+            p(0.0, 1.0, 1.0),
+            p(1.0, 1.0, 1.0),
+        ];
         let b = affine_basis(&square);
         assert_eq!(b.rank, 2);
         assert_eq!(b.indices.len(), 3);
@@ -112,9 +120,19 @@ mod tests {
     #[test]
     fn a_tiny_offset_below_tolerance_does_not_count() {
         let p = |x, y, z| Vector3::new(x, y, z);
-        let nearly_flat = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0), p(1.0, 1.0, 1e-13)];
+        let nearly_flat = [
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(0.0, 1.0, 0.0),
+            p(1.0, 1.0, 1e-13),
+        ];
         assert_eq!(affine_rank(&nearly_flat), 2);
-        let flat_enough = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0), p(1.0, 1.0, 1e-6)];
+        let flat_enough = [
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(0.0, 1.0, 0.0),
+            p(1.0, 1.0, 1e-6),
+        ];
         assert_eq!(affine_rank(&flat_enough), 3);
     }
 }

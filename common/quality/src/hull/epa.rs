@@ -145,7 +145,11 @@ mod tests {
             Vector2::new(1.0, 1.0),
         ];
         assert!(inner_distance(&tri).unwrap().offset < 0.0);
-        let flat = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 1.0, 0.0), Vector3::new(0.0, 0.0, 0.0)];
+        let flat = [
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(0.0, 0.0, 0.0),
+        ];
         assert_eq!(inner_distance(&flat), None);
     }
 }

@@ -39,7 +39,11 @@ pub fn min_norm_point<const D: usize>(points: &[SVector<f64, D>]) -> MinNormPoin
     let gap_tol = GAP_TOLERANCE * max_sq.max(f64::MIN_POSITIVE);
 
     let start = (0..points.len())
-        .min_by(|&a, &b| points[a].norm_squared().total_cmp(&points[b].norm_squared()))
+        .min_by(|&a, &b| {
+            points[a]
+                .norm_squared()
+                .total_cmp(&points[b].norm_squared())
+        })
         .unwrap_or(0);
     let mut corral: Vec<usize> = vec![start];
     let mut weights: Vec<f64> = vec![1.0];

@@ -87,13 +87,10 @@ impl<'a, const D: usize> Polytope<'a, D> {
         for f in 0..=D {
             let mut verts = [0u32; D];
             let mut neighbors = [0u32; D];
-            let mut k = 0;
-            for g in 0..=D {
-                if g != f {
-                    verts[k] = simplex[g] as u32;
-                    neighbors[k] = g as FacetId;
-                    k += 1;
-                }
+            let others = simplex.iter().enumerate().filter(|&(g, _)| g != f);
+            for (k, (g, &v)) in others.enumerate() {
+                verts[k] = v as u32;
+                neighbors[k] = g as FacetId;
             }
             let (normal, offset) = poly.hyperplane(&verts).ok_or(Degenerate)?;
             poly.facets.push(Facet {
@@ -264,7 +261,11 @@ impl<'a, const D: usize> Polytope<'a, D> {
                         break (other, slot_a);
                     }
                     let nf = &self.facets[next as usize];
-                    let back = nf.neighbors.iter().position(|&n| n == cur).ok_or(Degenerate)?;
+                    let back = nf
+                        .neighbors
+                        .iter()
+                        .position(|&n| n == cur)
+                        .ok_or(Degenerate)?;
                     b = a;
                     a = nf.verts[back];
                     cur = next;
@@ -358,8 +359,9 @@ fn determinant<const D: usize>(mut m: [[f64; D]; D]) -> f64 {
         for row in col + 1..D {
             let factor = m[row][col] / p;
             if factor != 0.0 {
-                for k in col..D {
-                    m[row][k] -= factor * m[col][k];
+                let pivot_row = m[col];
+                for (x, y) in m[row][col..].iter_mut().zip(&pivot_row[col..]) {
+                    *x -= factor * y;
                 }
             }
         }

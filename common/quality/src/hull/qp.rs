@@ -84,7 +84,9 @@ pub fn distance_to_hull(w: &[Wrench]) -> Result<f64, QualityError> {
     let weights: Vec<f64> = (0..m).map(|j| x[lambda(j)].max(0.0)).collect();
     let total: f64 = weights.iter().sum();
     if total.is_nan() || total <= 0.0 {
-        return Err(QualityError::Solver("no convex weights in the solution".into()));
+        return Err(QualityError::Solver(
+            "no convex weights in the solution".into(),
+        ));
     }
     let y: Wrench = w.iter().zip(&weights).map(|(wj, l)| wj * (l / total)).sum();
     Ok(y.norm())

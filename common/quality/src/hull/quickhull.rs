@@ -89,7 +89,10 @@ impl<const D: usize> Hull<D> {
     /// The smallest facet offset: the inscribed radius about the origin when the origin
     /// is inside, negative when it is outside.
     pub fn min_offset(&self) -> f64 {
-        self.facets.iter().map(|f| f.1).fold(f64::INFINITY, f64::min)
+        self.facets
+            .iter()
+            .map(|f| f.1)
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Points added after the initial simplex.
@@ -166,7 +169,12 @@ fn construct<const D: usize>(
     }
     let facets: Vec<(SVector<f64, D>, f64)> = poly
         .live_facets()
-        .map(|f| (poly.facets[f as usize].normal, poly.facets[f as usize].offset))
+        .map(|f| {
+            (
+                poly.facets[f as usize].normal,
+                poly.facets[f as usize].offset,
+            )
+        })
         .collect();
     // Convexity check: no input point may lie beyond a facet.
     let limit = CONVEXITY_TOLERANCE * scale;

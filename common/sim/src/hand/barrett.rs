@@ -16,8 +16,8 @@ use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaterni
 use parry3d_f64::math::Pose;
 
 use super::{
-    CONTACT_TOLERANCE, Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact, clear_hand, final_contacts,
-    world_link_poses,
+    CONTACT_TOLERANCE, Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact,
+    clear_hand, finish_grasp,
 };
 use crate::convert::iso2pose;
 use crate::error::{Result, SimError, ensure_finite};
@@ -72,7 +72,9 @@ impl BarrettHand {
     pub fn new(spread: f64) -> Result<Self> {
         ensure_finite(&[spread], "Barrett spread angle")?;
         if !(0.0..=SPREAD_MAX).contains(&spread) {
-            return Err(SimError::InvalidInput(format!("Barrett spread {spread} outside [0, pi]")));
+            return Err(SimError::InvalidInput(format!(
+                "Barrett spread {spread} outside [0, pi]"
+            )));
         }
         Ok(Self::build(spread))
     }
@@ -81,7 +83,10 @@ impl BarrettHand {
         let palm = LinkSpec {
             name: "palm".to_string(),
             finger: None,
-            shape: LinkShape::Cylinder { radius: PALM_RADIUS, half_height: PALM_THICKNESS / 2.0 },
+            shape: LinkShape::Cylinder {
+                radius: PALM_RADIUS,
+                half_height: PALM_THICKNESS / 2.0,
+            },
         };
         let mut links = vec![palm];
         for f in 0..3 {
@@ -90,13 +95,21 @@ impl BarrettHand {
                     name: format!("f{}_{part}", f + 1),
                     finger: Some(f),
                     shape: LinkShape::Box {
-                        half_extents: Vector3::new(FINGER_WIDTH / 2.0, FINGER_THICKNESS / 2.0, len / 2.0),
+                        half_extents: Vector3::new(
+                            FINGER_WIDTH / 2.0,
+                            FINGER_THICKNESS / 2.0,
+                            len / 2.0,
+                        ),
                     },
                 });
             }
         }
         let geometry = LinkGeometry::new(&links);
-        Self { spread, links, geometry }
+        Self {
+            spread,
+            links,
+            geometry,
+        }
     }
 
     /// The spread angle used.
@@ -115,14 +128,22 @@ impl BarrettHand {
             0 | 1 => {
                 let sign = if f == 0 { -1.0 } else { 1.0 };
                 let base = Vector3::new(sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]);
-                let out = Rotation3::from_axis_angle(&Vector3::z_axis(), sign * spread) * -Vector3::y();
+                let out =
+                    Rotation3::from_axis_angle(&Vector3::z_axis(), sign * spread) * -Vector3::y();
                 (base + KNUCKLE_OUT * out + KNUCKLE_UP * Vector3::z(), out)
             }
-            _ => (Vector3::new(F3_BASE[0], F3_BASE[1], F3_BASE[2]), Vector3::y()),
+            _ => (
+                Vector3::new(F3_BASE[0], F3_BASE[1], F3_BASE[2]),
+                Vector3::y(),
+            ),
         };
         let axis = out.cross(&Vector3::z());
-        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[axis, out, Vector3::z()]));
-        Isometry3::from_parts(Translation3::from(joint), UnitQuaternion::from_rotation_matrix(&rot))
+        let rot =
+            Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[axis, out, Vector3::z()]));
+        Isometry3::from_parts(
+            Translation3::from(joint),
+            UnitQuaternion::from_rotation_matrix(&rot),
+        )
     }
 
     /// Medial and distal link frames relative to the finger frame.
@@ -181,7 +202,10 @@ impl Hand for BarrettHand {
 
     fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>> {
         if joints.len() != 7 {
-            return Err(SimError::InvalidInput(format!("Barrett hand needs 7 joint values, got {}", joints.len())));
+            return Err(SimError::InvalidInput(format!(
+                "Barrett hand needs 7 joint values, got {}",
+                joints.len()
+            )));
         }
         ensure_finite(joints, "Barrett joint values")?;
         let palm = Isometry3::translation(0.0, 0.0, PALM_TOP - PALM_THICKNESS / 2.0);
@@ -214,8 +238,8 @@ impl Hand for BarrettHand {
                 |t| {
                     let (pm, pd) = poses(t, t / 3.0);
                     Ok(vec![
-                        self.geometry.distance(object, im, &pm, 0.05)?,
-                        self.geometry.distance(object, id, &pd, 0.05)?,
+                        self.geometry.distance_g(object, im, &pm, 0.05)?,
+                        self.geometry.distance_g(object, id, &pd, 0.05)?,
                     ])
                 },
                 0.0,
@@ -227,12 +251,12 @@ impl Hand for BarrettHand {
             if adv.touched == Some(0) {
                 // Phase 2: medial blocked, distal continues alone (unless already touching).
                 let (_, pm) = poses(medial, distal);
-                let d_now = self.geometry.distance(object, id, &pm, 0.05)?;
+                let d_now = self.geometry.distance_g(object, id, &pm, 0.05)?;
                 if d_now > CONTACT_TOLERANCE {
                     let adv2 = advance_until_contact(
                         |t| {
                             let (_, pd) = poses(medial, t);
-                            Ok(vec![self.geometry.distance(object, id, &pd, 0.05)?])
+                            Ok(vec![self.geometry.distance_g(object, id, &pd, 0.05)?])
                         },
                         distal,
                         DISTAL_MAX.max(distal),
@@ -244,17 +268,14 @@ impl Hand for BarrettHand {
             joints[im] = medial;
             joints[id] = distal;
         }
-        let world = world_link_poses(self, &palm, &joints)?;
-        let (link_distances, link_touching) = final_contacts(&self.geometry, object, &world)?;
-        Ok(Grasp {
-            hand: self.name().to_string(),
-            requested_palm_pose: *palm_pose,
-            palm_pose: palm,
+        finish_grasp(
+            self,
+            &self.geometry,
+            object,
+            palm_pose,
+            palm,
             retreat,
             joints,
-            link_poses: world.iter().map(crate::convert::pose2iso).collect(),
-            link_touching,
-            link_distances,
-        })
+        )
     }
 }

@@ -7,7 +7,9 @@
 
 use nalgebra::{Isometry3, Vector3};
 
-use super::{Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact, clear_hand, final_contacts, world_link_poses};
+use super::{
+    Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact, clear_hand, finish_grasp,
+};
 use crate::convert::iso2pose;
 use crate::error::{Result, SimError, ensure_finite};
 use crate::object::Object;
@@ -34,17 +36,23 @@ impl Default for ParallelJawGripper {
             LinkSpec {
                 name: "palm".to_string(),
                 finger: None,
-                shape: LinkShape::Box { half_extents: Vector3::from(PALM_HALF) },
+                shape: LinkShape::Box {
+                    half_extents: Vector3::from(PALM_HALF),
+                },
             },
             LinkSpec {
                 name: "jaw0".to_string(),
                 finger: Some(0),
-                shape: LinkShape::Box { half_extents: Vector3::from(JAW_HALF) },
+                shape: LinkShape::Box {
+                    half_extents: Vector3::from(JAW_HALF),
+                },
             },
             LinkSpec {
                 name: "jaw1".to_string(),
                 finger: Some(1),
-                shape: LinkShape::Box { half_extents: Vector3::from(JAW_HALF) },
+                shape: LinkShape::Box {
+                    half_extents: Vector3::from(JAW_HALF),
+                },
             },
         ];
         let geometry = LinkGeometry::new(&links);
@@ -55,7 +63,11 @@ impl Default for ParallelJawGripper {
 impl ParallelJawGripper {
     fn jaw(side: usize, travel: f64) -> Isometry3<f64> {
         let sign = if side == 0 { -1.0 } else { 1.0 };
-        Isometry3::translation(0.0, sign * (OPEN_HALF_WIDTH + JAW_HALF[1] - travel), JAW_HALF[2])
+        Isometry3::translation(
+            0.0,
+            sign * (OPEN_HALF_WIDTH + JAW_HALF[1] - travel),
+            JAW_HALF[2],
+        )
     }
 }
 
@@ -86,7 +98,10 @@ impl Hand for ParallelJawGripper {
 
     fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>> {
         if joints.len() != 2 {
-            return Err(SimError::InvalidInput(format!("parallel-jaw gripper needs 2 joint values, got {}", joints.len())));
+            return Err(SimError::InvalidInput(format!(
+                "parallel-jaw gripper needs 2 joint values, got {}",
+                joints.len()
+            )));
         }
         ensure_finite(joints, "gripper joint values")?;
         Ok(vec![
@@ -99,26 +114,30 @@ impl Hand for ParallelJawGripper {
     fn close(&self, object: &Object, palm_pose: &Isometry3<f64>) -> Result<Grasp> {
         let (palm, retreat) = clear_hand(self, &self.geometry, object, palm_pose)?;
         let mut joints = self.open_configuration();
-        for side in 0..2 {
+        for (side, joint) in joints.iter_mut().enumerate() {
             let adv = advance_until_contact(
-                |t| Ok(vec![self.geometry.distance(object, 1 + side, &iso2pose(&(palm * Self::jaw(side, t))), 0.05)?]),
+                |t| {
+                    Ok(vec![self.geometry.distance_g(
+                        object,
+                        1 + side,
+                        &iso2pose(&(palm * Self::jaw(side, t))),
+                        0.05,
+                    )?])
+                },
                 0.0,
                 MAX_TRAVEL,
                 &[1.0],
             )?;
-            joints[side] = adv.t;
+            *joint = adv.t;
         }
-        let world = world_link_poses(self, &palm, &joints)?;
-        let (link_distances, link_touching) = final_contacts(&self.geometry, object, &world)?;
-        Ok(Grasp {
-            hand: self.name().to_string(),
-            requested_palm_pose: *palm_pose,
-            palm_pose: palm,
+        finish_grasp(
+            self,
+            &self.geometry,
+            object,
+            palm_pose,
+            palm,
             retreat,
             joints,
-            link_poses: world.iter().map(crate::convert::pose2iso).collect(),
-            link_touching,
-            link_distances,
-        })
+        )
     }
 }

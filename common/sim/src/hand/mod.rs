@@ -2,17 +2,22 @@
 //! values, an open configuration and an auto-grasp `close`), the shared closing machinery, and two
 //! implementations: [`BarrettHand`] (BH8-style, three fingers) and [`ParallelJawGripper`].
 //!
-//! A new hand is a new implementation of [`Hand`]; the helpers here ([`LinkGeometry`],
-//! [`advance_until_contact`], [`clear_hand`]) do the collision work.
+//! A new hand is a new implementation of [`Hand`]; the public helpers here ([`LinkGeometry`],
+//! [`clear_hand`], [`advance_until_contact`], [`finish_grasp`]) do the collision work (see the
+//! `Pusher` hand in this crate's tests for a complete example in 50 lines).
+//!
+//! Placing: if the open hand intersects the object at the requested palm pose, it is retreated
+//! along its approach axis (palm `-z`) until clear and advanced back until a link is within
+//! [`CONTACT_TOLERANCE`] (as a real approach would stop); [`Grasp::retreat`] reports the distance.
 //!
 //! Closing (as GraspIt!/OpenRAVE auto-grasp): from the open configuration each finger's joints
 //! advance; a link that touches the object stops, the links after it keep closing until they touch
-//! or reach their limit. Advancement is *conservative*: each step moves no point of the moving
-//! links farther than their current distance to the object (minus half the tolerance), using a
-//! bound on how fast any link point moves per unit joint motion. Links therefore never penetrate
-//! the object: a link is declared in contact, and stops, when its distance falls to
-//! [`CONTACT_TOLERANCE`] or less, i.e. it rests between `CONTACT_TOLERANCE / 2` and
-//! `CONTACT_TOLERANCE` from the surface (a penetration of zero, up to floating-point round-off).
+//! or reach their limit. Each step is at least the *conservative-advancement* step (no point of a
+//! moving link moves farther than the link's distance to the object minus half the tolerance,
+//! using a bound on point speed per unit joint motion) and at most a secant extrapolation of the
+//! measured approach; a step that ends intersecting the object is undone by bisection. A link is
+//! in contact, and stops, when its distance is at most [`CONTACT_TOLERANCE`] (0.2 mm) and greater
+//! than zero: links never penetrate the object (penetration tolerance zero, up to round-off).
 
 mod barrett;
 mod gripper;
@@ -29,13 +34,17 @@ use crate::error::{Result, SimError, ensure_finite};
 use crate::mesh::{self, TriangleMesh};
 use crate::object::Object;
 
-/// A link stops when its distance to the object is at most this (metres). Links never
-/// penetrate: their final gap lies in `[CONTACT_TOLERANCE / 2, CONTACT_TOLERANCE]`.
+/// A link stops when its distance to the object is at most this (metres, 0.2 mm). Links never
+/// penetrate: their final gap lies in `(0, CONTACT_TOLERANCE]`.
 pub const CONTACT_TOLERANCE: f64 = 2e-4;
 
 /// Upper bound on conservative-advancement iterations for one motion (a safety net for grazing
 /// approaches; the motion then stops where it is and the link is reported as touching).
 pub const MAX_ADVANCE_ITERATIONS: usize = 400;
+
+/// The accelerated (secant) closing step moves no link point farther than its current distance
+/// plus this (metres): object features thinner than 1 mm could be stepped over, thicker ones not.
+pub const MAX_OVERSHOOT: f64 = 1e-3;
 
 /// How far back (metres) a hand placed in collision is retreated along its approach axis at most.
 pub const MAX_RETREAT: f64 = 0.5;
@@ -62,8 +71,16 @@ impl LinkShape {
     pub fn mesh(&self) -> TriangleMesh {
         match self {
             LinkShape::Box { half_extents } => mesh::box_mesh(half_extents),
-            LinkShape::Cylinder { radius, half_height } => mesh::revolve(
-                &[(0.0, -half_height), (*radius, -half_height), (*radius, *half_height), (0.0, *half_height)],
+            LinkShape::Cylinder {
+                radius,
+                half_height,
+            } => mesh::revolve(
+                &[
+                    (0.0, -half_height),
+                    (*radius, -half_height),
+                    (*radius, *half_height),
+                    (0.0, *half_height),
+                ],
                 48,
             ),
         }
@@ -73,7 +90,10 @@ impl LinkShape {
     pub fn bounding_radius(&self) -> f64 {
         match self {
             LinkShape::Box { half_extents } => half_extents.norm(),
-            LinkShape::Cylinder { radius, half_height } => radius.hypot(*half_height),
+            LinkShape::Cylinder {
+                radius,
+                half_height,
+            } => radius.hypot(*half_height),
         }
     }
 }
@@ -150,7 +170,10 @@ pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
     match name.trim().to_ascii_lowercase().replace('-', "_").as_str() {
         "barrett" | "bh8" => Ok(Box::new(BarrettHand::default())),
         "parallel_jaw" | "gripper" => Ok(Box::new(ParallelJawGripper::default())),
-        _ => Err(SimError::UnknownHand { name: name.to_string(), valid: hand_names().join(", ") }),
+        _ => Err(SimError::UnknownHand {
+            name: name.to_string(),
+            valid: hand_names().join(", "),
+        }),
     }
 }
 
@@ -173,15 +196,23 @@ impl LinkGeometry {
             .map(|l| {
                 let r = l.shape.bounding_radius();
                 match l.shape {
-                    LinkShape::Box { half_extents } => {
-                        (Box::new(Cuboid::new(v2g(&half_extents))) as Box<dyn Shape>, Pose::IDENTITY, r)
-                    }
-                    LinkShape::Cylinder { radius, half_height } => (
+                    LinkShape::Box { half_extents } => (
+                        Box::new(Cuboid::new(v2g(&half_extents))) as Box<dyn Shape>,
+                        Pose::IDENTITY,
+                        r,
+                    ),
+                    LinkShape::Cylinder {
+                        radius,
+                        half_height,
+                    } => (
                         Box::new(Cylinder::new(half_height, radius)) as Box<dyn Shape>,
                         // parry cylinders are along y; the link's axis is z.
                         iso2pose(&Isometry3::from_parts(
                             Translation3::identity(),
-                            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+                            UnitQuaternion::from_axis_angle(
+                                &Vector3::x_axis(),
+                                std::f64::consts::FRAC_PI_2,
+                            ),
                         )),
                         r,
                     ),
@@ -193,12 +224,25 @@ impl LinkGeometry {
 
     /// The parry shape and its pose for link `i` whose frame is at `link_world`.
     pub(crate) fn shape_at(&self, i: usize, link_world: &Pose) -> Option<(&dyn Shape, Pose)> {
-        self.shapes.get(i).map(|(s, off, _)| (s.as_ref(), *link_world * *off))
+        self.shapes
+            .get(i)
+            .map(|(s, off, _)| (s.as_ref(), *link_world * *off))
     }
 
-    /// Distance (0 if intersecting) from link `i` at `link_world` to the object. Uses the cheap
-    /// bounding-sphere bound when it already exceeds `far` (the bound is conservative).
-    pub fn distance(&self, object: &Object, i: usize, link_world: &Pose, far: f64) -> Result<f64> {
+    /// Distance (0 if intersecting) from link `i` whose frame is at `link_world` to the object.
+    pub fn distance(&self, object: &Object, i: usize, link_world: &Isometry3<f64>) -> Result<f64> {
+        self.distance_g(object, i, &iso2pose(link_world), 0.0)
+    }
+
+    /// [`LinkGeometry::distance`] in parry types; returns the cheap bounding-sphere lower bound
+    /// instead when it already exceeds `far` (conservative for advancement).
+    pub(crate) fn distance_g(
+        &self,
+        object: &Object,
+        i: usize,
+        link_world: &Pose,
+        far: f64,
+    ) -> Result<f64> {
         let Some((shape, pose)) = self.shape_at(i, link_world) else {
             return Err(SimError::InvalidInput(format!("no link {i}")));
         };
@@ -243,12 +287,18 @@ pub fn advance_until_contact(
     let mut d = distances(t)?;
     if let Some(k) = touching(&d).or_else(|| d.iter().position(|&di| di <= 0.0)) {
         // Already touching (or, if the caller allowed it, intersecting) at the start.
-        return Ok(Advance { t, touched: Some(k) });
+        return Ok(Advance {
+            t,
+            touched: Some(k),
+        });
     }
     let mut prev: Option<(f64, Vec<f64>)> = None;
     for _ in 0..MAX_ADVANCE_ITERATIONS {
         if t >= t1 {
-            return Ok(Advance { t: t1, touched: None });
+            return Ok(Advance {
+                t: t1,
+                touched: None,
+            });
         }
         let safe = d
             .iter()
@@ -266,8 +316,15 @@ pub fn advance_until_contact(
                     (slope > 0.0).then(|| 0.9 * (di - 0.6 * tol) / slope)
                 })
                 .fold(f64::INFINITY, f64::min);
+            // Never let a link move more than MAX_OVERSHOOT beyond its current distance, so an
+            // optimistic extrapolation cannot jump through a feature thicker than that.
+            let cap = d
+                .iter()
+                .zip(rates)
+                .map(|(&di, &r)| (di + MAX_OVERSHOOT) / r.max(1e-12))
+                .fold(f64::INFINITY, f64::min);
             if secant.is_finite() {
-                step = step.max(secant);
+                step = step.max(secant.min(cap));
             }
         }
         let t_new = (t + step).min(t1);
@@ -276,7 +333,10 @@ pub fn advance_until_contact(
             prev = Some((t, std::mem::replace(&mut d, d_new)));
             t = t_new;
             if let Some(k) = touching(&d) {
-                return Ok(Advance { t, touched: Some(k) });
+                return Ok(Advance {
+                    t,
+                    touched: Some(k),
+                });
             }
             continue;
         }
@@ -289,7 +349,10 @@ pub fn advance_until_contact(
             if intersecting(&dm) {
                 hi = mid;
             } else if let Some(k) = touching(&dm) {
-                return Ok(Advance { t: mid, touched: Some(k) });
+                return Ok(Advance {
+                    t: mid,
+                    touched: Some(k),
+                });
             } else {
                 lo = mid;
                 d = dm;
@@ -299,28 +362,56 @@ pub fn advance_until_contact(
             }
         }
         // Round-off limits: stop at the last clear parameter, reporting the nearest link.
-        let k = d.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| k);
+        let k = d
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(k, _)| k);
         return Ok(Advance { t: lo, touched: k });
     }
     // Grazing approach: stop here and report the nearest link.
-    let k = d.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| k);
+    let k = d
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(k, _)| k);
     Ok(Advance { t, touched: k })
 }
 
-/// World poses of all links for `joints` with the palm at `palm`.
-pub(crate) fn world_link_poses(hand: &dyn Hand, palm: &Isometry3<f64>, joints: &[f64]) -> Result<Vec<Pose>> {
-    Ok(hand.link_poses(joints)?.iter().map(|l| iso2pose(&(palm * l))).collect())
-}
-
-/// Final distances and touching flags of all links at `world` poses.
-pub(crate) fn final_contacts(geometry: &LinkGeometry, object: &Object, world: &[Pose]) -> Result<(Vec<f64>, Vec<bool>)> {
-    let d = world
+/// Builds the [`Grasp`] of a closed hand: world link poses, final distances and touching flags.
+pub fn finish_grasp(
+    hand: &dyn Hand,
+    geometry: &LinkGeometry,
+    object: &Object,
+    requested_palm_pose: &Isometry3<f64>,
+    palm_pose: Isometry3<f64>,
+    retreat: f64,
+    joints: Vec<f64>,
+) -> Result<Grasp> {
+    let link_poses: Vec<Isometry3<f64>> = hand
+        .link_poses(&joints)?
+        .iter()
+        .map(|l| palm_pose * l)
+        .collect();
+    let link_distances = link_poses
         .iter()
         .enumerate()
-        .map(|(i, p)| geometry.distance(object, i, p, 0.01))
+        .map(|(i, p)| geometry.distance_g(object, i, &iso2pose(p), 0.01))
         .collect::<Result<Vec<f64>>>()?;
-    let touching = d.iter().map(|&x| x <= CONTACT_TOLERANCE).collect();
-    Ok((d, touching))
+    let link_touching = link_distances
+        .iter()
+        .map(|&x| x <= CONTACT_TOLERANCE)
+        .collect();
+    Ok(Grasp {
+        hand: hand.name().to_string(),
+        requested_palm_pose: *requested_palm_pose,
+        palm_pose,
+        retreat,
+        joints,
+        link_poses,
+        link_touching,
+        link_distances,
+    })
 }
 
 /// Checks the palm pose, then retreats the open hand along `-z` until it is clear of the object
@@ -340,7 +431,7 @@ pub fn clear_hand(
     let dists = |s: f64| -> Result<Vec<f64>> {
         let palm = at(s);
         (0..n)
-            .map(|i| geometry.distance(object, i, &iso2pose(&(palm * rel[i])), 0.05))
+            .map(|i| geometry.distance_g(object, i, &iso2pose(&(palm * rel[i])), 0.05))
             .collect()
     };
     let d0 = dists(0.0)?;

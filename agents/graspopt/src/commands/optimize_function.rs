@@ -1,0 +1,187 @@
+//! `graspopt optimize-function`: run the Bayesian optimisation engine (or random search) on a
+//! standard test function over several seeds and report the best value after each evaluation
+//! and the evaluations (and rounds, for batches) needed to reach normalised regret 5%, 1% and
+//! 0.1%, then medians over the seeds.
+
+use anyhow::Context;
+use graspopt_bayesopt::TestFunction;
+use graspopt_bayesopt::benchmark::{
+    Method, REGRET_LEVELS, SeedSummary, aggregate, run_seed, summarize,
+};
+use serde_json::json;
+
+/// Method to run.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodArg {
+    /// The engine with its recommended settings.
+    Bo,
+    /// The engine with the thesis settings as written (EI xi = sigma_f^2 / 100).
+    BoThesis,
+    /// Uniform random search.
+    Random,
+}
+
+/// Output format.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormatArg {
+    /// Human-readable lines.
+    Text,
+    /// One JSON object per line (per seed, then a summary).
+    Json,
+}
+
+/// Arguments of `graspopt optimize-function`.
+#[derive(clap::Args, Debug)]
+pub struct OptimizeFunctionArgs {
+    /// Test function: branin, hartmann3, hartmann6 or rosenbrock.
+    pub function: String,
+    /// Number of seeds (0..N).
+    #[arg(long, default_value_t = 10)]
+    pub seeds: u64,
+    /// Evaluations per seed (default: 50 in 2D, 100 otherwise).
+    #[arg(long)]
+    pub budget: Option<usize>,
+    /// Random initial points (default: 5 in 2D, 10 in 6D, otherwise 2 d).
+    #[arg(long)]
+    pub init: Option<usize>,
+    /// Points proposed per round (parallel workers).
+    #[arg(long, default_value_t = 1)]
+    pub batch: usize,
+    /// Method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Bo)]
+    pub method: MethodArg,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = FormatArg::Text)]
+    pub format: FormatArg,
+}
+
+fn fmt_opt(v: Option<usize>) -> String {
+    v.map_or_else(|| "-".to_string(), |e| e.to_string())
+}
+
+fn fmt_med(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".to_string(), |e| format!("{e}"))
+}
+
+/// Run the command.
+pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
+    let function = TestFunction::from_name(&args.function)?;
+    let d = function.dim();
+    let budget = args.budget.unwrap_or(if d <= 2 { 50 } else { 100 });
+    let n_init = args.init.unwrap_or(match d {
+        2 => 5,
+        6 => 10,
+        _ => 2 * d,
+    });
+    anyhow::ensure!(args.batch >= 1, "--batch must be at least 1");
+    anyhow::ensure!(budget >= 1, "--budget must be at least 1");
+    let method = match args.method {
+        MethodArg::Bo => Method::Bo,
+        MethodArg::BoThesis => Method::BoThesis,
+        MethodArg::Random => Method::Random,
+    };
+    let q = args.batch;
+    let mut summaries: Vec<SeedSummary> = Vec::new();
+    for seed in 0..args.seeds {
+        let trace = run_seed(function, seed, budget, n_init, q, method)
+            .with_context(|| format!("seed {seed}"))?;
+        let s = summarize(function, seed, &trace, q);
+        match args.format {
+            FormatArg::Json => {
+                let line = json!({
+                    "function": function.name(),
+                    "method": format!("{:?}", args.method).to_lowercase(),
+                    "seed": seed,
+                    "budget": budget,
+                    "init": n_init,
+                    "batch": q,
+                    "best": trace,
+                    "regret_levels": REGRET_LEVELS,
+                    "evals_to": s.evals_to,
+                    "rounds_to": s.rounds_to,
+                    "final_regret": s.final_regret,
+                });
+                println!("{line}");
+            }
+            FormatArg::Text => {
+                let best: Vec<String> = trace.iter().map(|v| format!("{v:.6}")).collect();
+                println!(
+                    "seed {seed}: best after each evaluation: {}",
+                    best.join(" ")
+                );
+                let levels: Vec<String> = REGRET_LEVELS
+                    .iter()
+                    .enumerate()
+                    .map(|(k, l)| {
+                        format!(
+                            "{}%: {} evals / {} rounds",
+                            l * 100.0,
+                            fmt_opt(s.evals_to[k]),
+                            fmt_opt(s.rounds_to[k])
+                        )
+                    })
+                    .collect();
+                println!(
+                    "seed {seed}: regret {} (final regret {:.3e})",
+                    levels.join(", "),
+                    s.final_regret
+                );
+            }
+        }
+        summaries.push(s);
+    }
+    let agg = aggregate(&summaries, budget, q);
+    match args.format {
+        FormatArg::Json => {
+            let levels: Vec<serde_json::Value> = agg
+                .iter()
+                .map(|l| {
+                    json!({
+                        "level": l.level,
+                        "reached": l.reached,
+                        "seeds": l.seeds,
+                        "median_evals": l.median_evals,
+                        "median_rounds": l.median_rounds,
+                        "max_evals": l.max_evals,
+                    })
+                })
+                .collect();
+            println!(
+                "{}",
+                json!({
+                    "summary": {
+                        "function": function.name(),
+                        "method": format!("{:?}", args.method).to_lowercase(),
+                        "seeds": args.seeds,
+                        "budget": budget,
+                        "init": n_init,
+                        "batch": q,
+                        "levels": levels,
+                    }
+                })
+            );
+        }
+        FormatArg::Text => {
+            let parts: Vec<String> = agg
+                .iter()
+                .map(|l| {
+                    format!(
+                        "{}%: {}/{} seeds, median {} evals / {} rounds",
+                        l.level * 100.0,
+                        l.reached,
+                        l.seeds,
+                        fmt_med(l.median_evals),
+                        fmt_med(l.median_rounds)
+                    )
+                })
+                .collect();
+            println!(
+                "summary {} ({:?}, budget {budget}, init {n_init}, batch {q}): {}",
+                function.name(),
+                args.method,
+                parts.join("; ")
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,13 @@
+//! Errors of a scored trial: from the simulator, the quality core, or the settings.
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum TrialError {
+    #[error(transparent)]
+    Sim(#[from] graspopt_sim::SimError),
+    #[error(transparent)]
+    Quality(#[from] graspopt_quality::QualityError),
+    #[error("{0}")]
+    Settings(String),
+}

@@ -1,0 +1,22 @@
+//! A scored grasp trial: place a simulated hand, close it on the object, turn the
+//! contacts into wrenches and score them with a grasp-quality metric (thesis chapter 4).
+//!
+//! This crate joins the simulator (`graspopt-sim`, geometry only) and the quality core
+//! (`graspopt-quality`, mathematics only). It owns the choices between them: which
+//! contact model, which reference frame and torque scale, which metric, and the score of
+//! a trial that touches nothing. It knows nothing of files or the bus.
+//!
+//! - [`score`]: settings and scoring of one trial outcome.
+//! - [`evaluator`]: an object, a hand and a trial space: parameters in, score out.
+//! - [`scan`]: 1D/2D (any-D) grid scans over the trial space, in parallel.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod error;
+pub mod evaluator;
+pub mod scan;
+pub mod score;
+
+pub use error::TrialError;
+pub use evaluator::{Evaluation, Evaluator};
+pub use scan::{ScanPoint, scan_grid};
+pub use score::{Metric, ReferenceFrame, ScoreSettings, TrialScore, score_outcome};

@@ -1,0 +1,115 @@
+//! Grid scans: the score at every point of a grid over the trial space, computed in
+//! parallel on all cores (scoped threads pulling indices from a shared counter), with a
+//! progress callback. Points come back in grid order (the last axis fastest).
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::TrialError;
+use crate::evaluator::Evaluator;
+use crate::score::TrialScore;
+
+/// One grid point of a scan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScanPoint {
+    pub params: Vec<f64>,
+    pub score: TrialScore,
+}
+
+/// Evenly spaced values from `lower` to `upper` inclusive (`n >= 2`; one value, the
+/// midpoint, for `n == 1`).
+pub fn linspace(lower: f64, upper: f64, n: usize) -> Vec<f64> {
+    match n {
+        0 => Vec::new(),
+        1 => vec![0.5 * (lower + upper)],
+        _ => (0..n)
+            .map(|i| lower + (upper - lower) * i as f64 / (n - 1) as f64)
+            .collect(),
+    }
+}
+
+/// Scores the grid `axes[0] x axes[1] x ...` with `threads` workers (0: all cores),
+/// calling `progress(done)` after each point. The first failing point stops the scan and
+/// its error is returned with its parameters.
+pub fn scan_grid(
+    evaluator: &Evaluator,
+    axes: &[Vec<f64>],
+    threads: usize,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<ScanPoint>, TrialError> {
+    if axes.is_empty() || axes.iter().any(Vec::is_empty) {
+        return Err(TrialError::Settings(
+            "a scan needs at least one value per axis".into(),
+        ));
+    }
+    if axes.len() != evaluator.space.dim() {
+        return Err(TrialError::Settings(format!(
+            "the scan has {} axes but the trial space has {} parameters",
+            axes.len(),
+            evaluator.space.dim()
+        )));
+    }
+    let total: usize = axes.iter().map(Vec::len).product();
+    let point = |mut index: usize| -> Vec<f64> {
+        let mut params = vec![0.0; axes.len()];
+        for (k, axis) in axes.iter().enumerate().rev() {
+            params[k] = axis[index % axis.len()];
+            index /= axis.len();
+        }
+        params
+    };
+    let threads = if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        threads
+    }
+    .min(total);
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let failed: Mutex<Option<TrialError>> = Mutex::new(None);
+    let results: Mutex<Vec<Option<ScanPoint>>> = Mutex::new(vec![None; total]);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= total || failed.lock().map_or(true, |f| f.is_some()) {
+                        break;
+                    }
+                    let params = point(i);
+                    match evaluator.evaluate(&params) {
+                        Ok(e) => {
+                            if let Ok(mut r) = results.lock() {
+                                r[i] = Some(ScanPoint {
+                                    params,
+                                    score: e.score,
+                                });
+                            }
+                            progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+                        }
+                        Err(err) => {
+                            if let Ok(mut f) = failed.lock() {
+                                f.get_or_insert(TrialError::Settings(format!(
+                                    "trial at {params:?} failed: {err}"
+                                )));
+                            }
+                            break;
+                        }
+                    }
+                }
+            });
+        }
+    });
+    if let Some(err) = failed.into_inner().ok().flatten() {
+        return Err(err);
+    }
+    let results = results
+        .into_inner()
+        .map_err(|_| TrialError::Settings("a scan worker panicked".into()))?;
+    results
+        .into_iter()
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| TrialError::Settings("a scan point was not computed".into()))
+}

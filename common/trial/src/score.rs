@@ -1,0 +1,215 @@
+//! Scoring a trial outcome.
+//!
+//! The contacts of the chosen contact model (per finger, optionally the palm) become
+//! wrenches about a reference point, torques divided by a torque scale (by default the
+//! object's centre of mass and its bounding radius), and one metric of their hull is the
+//! score.
+//!
+//! **A trial that touches nothing** (no modelled contact) has no wrench space. It scores
+//! `-(B + 1) - min(d / rho, 1)`, where `B` bounds the norm of any contact wrench on this
+//! object (so `-B` is below the BW of every touching grasp), `d` is the closed hand's
+//! smallest distance to the object and `rho` the torque scale: finite, always below any
+//! touching grasp, and better the nearer the hand came, so an optimiser still learns from
+//! it. For epsilon and volume, which are 0 without force closure, it scores 0.
+
+use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts};
+use graspopt_quality::{Contact, ContactModel as QualityModel, GraspModel};
+use graspopt_sim::{ContactModel, Object, TrialOutcome};
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::TrialError;
+
+/// The metric that becomes the score.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// The Bimodal Wrench metric (thesis 2.6): the default.
+    #[default]
+    Bw,
+    /// Largest Sphere (epsilon), 0 without force closure.
+    Epsilon,
+    /// Grasp Wrench Volume.
+    Volume,
+}
+
+impl Metric {
+    /// Parses `bw`, `epsilon` (or `ls`), `volume` (or `gwv`).
+    pub fn parse(name: &str) -> Result<Self, TrialError> {
+        match name {
+            "bw" => Ok(Metric::Bw),
+            "epsilon" | "ls" => Ok(Metric::Epsilon),
+            "volume" | "gwv" => Ok(Metric::Volume),
+            other => Err(TrialError::Settings(format!(
+                "unknown metric {other:?}: expected bw, epsilon (ls) or volume (gwv)"
+            ))),
+        }
+    }
+}
+
+/// The point about which torques are taken.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ReferenceFrame {
+    /// The object's centre of mass (the thesis's usual choice): the default.
+    #[default]
+    Object,
+    /// The world origin.
+    World,
+    /// The palm origin at its final pose.
+    Palm,
+    /// A given point (world).
+    Point([f64; 3]),
+}
+
+/// How a trial outcome is scored.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ScoreSettings {
+    /// Which of the simulator's contact models supplies the contacts.
+    pub contacts: ContactModel,
+    /// The contact model of each contact point (soft finger by default, as in the thesis).
+    pub model: QualityModel,
+    pub frame: ReferenceFrame,
+    /// Torque scale in metres; `None`: the object's bounding radius.
+    pub torque_scale: Option<f64>,
+    pub metric: Metric,
+    /// Count the palm's contacts too.
+    pub include_palm: bool,
+}
+
+impl Default for ScoreSettings {
+    fn default() -> Self {
+        Self {
+            contacts: ContactModel::Surface,
+            model: QualityModel::SoftFinger {
+                mu: 0.5,
+                edges: 8,
+                gamma: 0.005,
+            },
+            frame: ReferenceFrame::Object,
+            torque_scale: None,
+            metric: Metric::Bw,
+            include_palm: true,
+        }
+    }
+}
+
+/// The score of one trial and what it was computed from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrialScore {
+    pub score: f64,
+    /// Modelled contact points scored.
+    pub contacts: usize,
+    pub fingers_in_contact: usize,
+    /// The metrics, when there were contacts.
+    pub metrics: Option<Metrics>,
+}
+
+/// Scores an outcome on `object`.
+pub fn score_outcome(
+    outcome: &TrialOutcome,
+    object: &Object,
+    settings: &ScoreSettings,
+) -> Result<TrialScore, TrialError> {
+    let contacts: Vec<Contact> = outcome
+        .contacts(settings.contacts, settings.include_palm)
+        .iter()
+        .map(|c| Contact::normalized(c.position.coords, c.normal))
+        .collect::<Result<_, _>>()?;
+    let grasp_model = grasp_model(outcome, object, settings)?;
+    let fingers_in_contact = outcome.fingers_in_contact();
+    if contacts.is_empty() {
+        return Ok(TrialScore {
+            score: no_contact_score(outcome, object, &grasp_model, settings.metric),
+            contacts: 0,
+            fingers_in_contact,
+            metrics: None,
+        });
+    }
+    let options = MetricsOptions {
+        volume: settings.metric == Metric::Volume,
+        ..MetricsOptions::default()
+    };
+    let metrics = evaluate_contacts(&contacts, &grasp_model, &options)?;
+    let score = match settings.metric {
+        Metric::Bw => metrics.bw,
+        Metric::Epsilon => metrics.epsilon,
+        Metric::Volume => metrics.volume.unwrap_or(0.0),
+    };
+    Ok(TrialScore {
+        score,
+        contacts: contacts.len(),
+        fingers_in_contact,
+        metrics: Some(metrics),
+    })
+}
+
+/// The grasp model of the settings for this outcome (reference point and torque scale
+/// resolved).
+pub fn grasp_model(
+    outcome: &TrialOutcome,
+    object: &Object,
+    settings: &ScoreSettings,
+) -> Result<GraspModel, TrialError> {
+    let reference = reference_point(outcome, object, settings.frame);
+    let rho = settings
+        .torque_scale
+        .unwrap_or_else(|| object.bounding_sphere().1);
+    let model = GraspModel::new(settings.model)
+        .with_reference_point(reference.coords)
+        .with_torque_scale(rho);
+    model.validate()?;
+    Ok(model)
+}
+
+fn reference_point(outcome: &TrialOutcome, object: &Object, frame: ReferenceFrame) -> Point3<f64> {
+    match frame {
+        ReferenceFrame::Object => object.centre_of_mass(),
+        ReferenceFrame::World => Point3::origin(),
+        ReferenceFrame::Palm => Point3::from(outcome.grasp.palm_pose.translation.vector),
+        ReferenceFrame::Point(p) => Point3::new(p[0], p[1], p[2]),
+    }
+}
+
+/// The score of a trial without contacts (see the module documentation).
+pub fn no_contact_score(
+    outcome: &TrialOutcome,
+    object: &Object,
+    model: &GraspModel,
+    metric: Metric,
+) -> f64 {
+    if metric != Metric::Bw {
+        return 0.0;
+    }
+    let rho = model.torque_scale;
+    let bound = wrench_norm_bound(object, model);
+    let gap = outcome
+        .grasp
+        .link_distances
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let gap = if gap.is_finite() {
+        (gap / rho).min(1.0)
+    } else {
+        1.0
+    };
+    -(bound + 1.0) - gap
+}
+
+/// An upper bound on the norm of any contact wrench on `object` under `model`: force at
+/// most `sqrt(1 + mu^2)`, lever arm at most the distance `R` from the reference point to
+/// the farthest point of the object, torsion at most `gamma`.
+pub fn wrench_norm_bound(object: &Object, model: &GraspModel) -> f64 {
+    let (centre, radius) = object.bounding_sphere();
+    let reach = (centre.coords - model.reference_point).norm() + radius;
+    let rho = model.torque_scale;
+    let (mu, gamma) = match model.contact {
+        QualityModel::Frictionless => (0.0, 0.0),
+        QualityModel::PointFriction { mu, .. } => (mu, 0.0),
+        QualityModel::SoftFinger { mu, gamma, .. } => (mu, gamma),
+    };
+    let force = (1.0 + mu * mu).sqrt();
+    force * (1.0 + (reach / rho).powi(2)).sqrt() + gamma / rho
+}
