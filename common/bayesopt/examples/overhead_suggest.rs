@@ -1,12 +1,25 @@
-//! Time `suggest(1)` at 100 observations in 6D under setting variations (median of 15).
+//! Planner overhead per proposal at about 100 observations in 6D (Hartmann6, recommended
+//! settings): 100 random observations, then 20 consecutive rounds of `suggest(1)` + `observe`
+//! (all kinds of rounds: plain, diversification, full refit). Prints each round's time and the
+//! median. Run on one core: `taskset -c 0 cargo run --release --example overhead_suggest`.
+
 use std::time::Instant;
 
 use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::rng::Rng;
-use graspopt_bayesopt::{Optimizer, Settings, TestFunction};
+use graspopt_bayesopt::{Optimizer, TestFunction};
 
-fn time(label: &str, s: Settings) {
+fn main() {
     let f = TestFunction::Hartmann6;
+    let mut s = recommended_settings();
+    s.minimize = true;
+    if let Some(v) = std::env::var("OV_FIT").ok().and_then(|v| v.parse().ok()) {
+        s.fit.max_iter = v;
+        s.fit.warm_max_iter = v;
+    }
+    if let Some(v) = std::env::var("OV_POLISH").ok().and_then(|v| v.parse().ok()) {
+        s.polish_iters = v;
+    }
     let Ok(mut opt) = Optimizer::new(&[(0.0, 1.0); 6], s, 1) else {
         return;
     };
@@ -15,34 +28,23 @@ fn time(label: &str, s: Settings) {
         let x = rng.unit_point(6);
         let _ = opt.observe(&x, f.eval(&x));
     }
-    let _ = opt.suggest(1);
-    opt.clear_pending();
     let mut ts = Vec::new();
-    for _ in 0..15 {
-        let mut o = opt.clone();
+    for round in 0..20 {
         let t = Instant::now();
-        let _ = o.suggest(1);
-        ts.push(t.elapsed().as_secs_f64() * 1e3);
+        let Ok(p) = opt.suggest(1) else { return };
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        ts.push(ms);
+        println!("round {round:2} ({} obs): {ms:.2} ms", opt.len());
+        for x in p {
+            let _ = opt.observe(&x, f.eval(&x));
+        }
     }
     ts.sort_by(|a, b| a.total_cmp(b));
-    println!("{label}: median {:.2} ms (min {:.2})", ts[7], ts[0]);
-}
-
-fn main() {
-    let mut base = recommended_settings();
-    base.minimize = true;
-    time("recommended", base.clone());
-    let mut s = base.clone();
-    s.direct_evals_per_dim = 150;
-    time("direct 150/dim", s);
-    let mut s = base.clone();
-    s.direct_evals_per_dim = 150;
-    s.fit.max_iter = 10;
-    time("direct 150/dim, fit 10 iters", s);
-    let mut s = base.clone();
-    s.direct_evals_per_dim = 10;
-    time("direct 60", s);
-    let mut s = base.clone();
-    s.fit.max_iter = 0;
-    time("no fit iters", s);
+    println!(
+        "median {:.2} ms, min {:.2} ms, max {:.2} ms over {} rounds",
+        0.5 * (ts[9] + ts[10]),
+        ts[0],
+        ts[19],
+        ts.len()
+    );
 }

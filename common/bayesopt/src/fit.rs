@@ -39,6 +39,8 @@ pub struct FitSettings {
     pub restarts: usize,
     /// L-BFGS iterations per start.
     pub max_iter: usize,
+    /// L-BFGS iterations when only the warm start is run (rounds without restarts).
+    pub warm_max_iter: usize,
 }
 
 impl Default for FitSettings {
@@ -55,6 +57,7 @@ impl Default for FitSettings {
             noise_bounds: (1e-6, 1.0),
             restarts: 2,
             max_iter: 50,
+            warm_max_iter: 6,
         }
     }
 }
@@ -294,16 +297,14 @@ pub fn fit_map(
         t[d] += 0.5 * settings.signal_log_sd * rng.normal();
         starts.push(t);
     }
+    let iters = if restarts == 0 && warm.is_some() {
+        settings.warm_max_iter.min(settings.max_iter)
+    } else {
+        settings.max_iter
+    };
     let mut best: Option<(Vec<f64>, f64)> = None;
     for s in starts {
-        let m = lbfgs::minimize_box(
-            |t, g| obj.value_grad(t, g),
-            &s,
-            &lo,
-            &hi,
-            settings.max_iter,
-            1e-5,
-        );
+        let m = lbfgs::minimize_box(|t, g| obj.value_grad(t, g), &s, &lo, &hi, iters, 1e-5);
         if m.f.is_finite() && best.as_ref().is_none_or(|b| m.f < b.1) {
             best = Some((m.x, m.f));
         }

@@ -128,7 +128,7 @@ impl Default for Settings {
             acquisition: AcquisitionKind::ExpectedImprovement,
             xi: XiRule::ThesisSignalVariance,
             fit: FitSettings::default(),
-            full_refit_every: 5,
+            full_refit_every: 10,
             direct_evals_per_dim: 150,
             polish_starts: 3,
             polish_iters: 30,
@@ -684,15 +684,21 @@ impl Optimizer {
                 taken.push(u);
             }
             while out.len() < q {
-                let (mut u, mut ei) = self.maximize_acquisition(&gp, incumbent, xi)?;
                 let k = self.settings.diversify_every;
-                if k > 0 && out.is_empty() && self.rounds % k == k - 1 {
+                let diversify = k > 0 && out.is_empty() && self.rounds % k == k - 1;
+                let share = if diversify {
+                    1.0 / (1 + self.settings.diversify_depth.max(1)) as f64
+                } else {
+                    1.0
+                };
+                let (mut u, mut ei) = self.maximize_acquisition(&gp, incumbent, xi, share)?;
+                if diversify {
                     // Diversification round: assume the EI maximiser is as bad as the worst
                     // observation (constant liar, min) and propose the next EI maximiser.
                     let mut g2 = gp.clone();
                     for _ in 0..self.settings.diversify_depth.max(1) {
                         g2.push(u.clone(), y_min_std)?;
-                        let (u2, ei2) = self.maximize_acquisition(&g2, incumbent, xi)?;
+                        let (u2, ei2) = self.maximize_acquisition(&g2, incumbent, xi, share)?;
                         u = u2;
                         ei = ei.max(ei2);
                     }
@@ -775,7 +781,13 @@ impl Optimizer {
 
     /// Maximise the acquisition on the unit cube: DIRECT then L-BFGS polish from the best
     /// centres. Returns the point and its EI (standardised units; the UCB value for UCB).
-    fn maximize_acquisition(&self, gp: &Gp, incumbent: f64, xi: f64) -> Result<(Vec<f64>, f64)> {
+    fn maximize_acquisition(
+        &self,
+        gp: &Gp,
+        incumbent: f64,
+        xi: f64,
+        budget_share: f64,
+    ) -> Result<(Vec<f64>, f64)> {
         let d = self.dim();
         let lo = vec![0.0; d];
         let hi = vec![1.0; d];
@@ -790,7 +802,8 @@ impl Optimizer {
             }
         };
         let ds = DirectSettings {
-            max_evals: self.settings.direct_evals_per_dim * d,
+            max_evals: ((self.settings.direct_evals_per_dim * d) as f64 * budget_share)
+                .max(2.0 * d as f64 + 1.0) as usize,
             ..DirectSettings::default()
         };
         let res = direct::maximize(value, &lo, &hi, &ds, self.settings.polish_starts.max(1))?;

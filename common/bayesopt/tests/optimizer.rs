@@ -43,7 +43,15 @@ fn same_seed_same_proposals() {
 
 #[test]
 fn serde_round_trip_continues_identically() {
-    let mut a = Optimizer::new(&branin_bounds(), fast_settings(), 7).unwrap();
+    // recommended-style settings so every piece of state is exercised
+    let s = Settings {
+        diversify_every: 2,
+        full_refit_every: 3,
+        output_transform: graspopt_bayesopt::OutputTransform::TailLog,
+        prior_mean_quantile: Some(0.0),
+        ..fast_settings()
+    };
+    let mut a = Optimizer::new(&branin_bounds(), s, 7).unwrap();
     for _ in 0..8 {
         step(&mut a, 1);
     }

@@ -1,0 +1,181 @@
+//! `graspopt scan --object sphere --axes x,y --steps 41,41`: a grid scan of a metric over
+//! one or two trial parameters (any number for the CSV), in parallel over cores, with a
+//! progress bar. Writes `<out>/<object>-<metric>-<axes>.csv` and `.svg` (a line plot for
+//! one axis, a heatmap for two).
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use graspopt_trial::scan::{ScanPoint, linspace, scan_grid};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::setup::{SimArgs, param_kind, param_name};
+use super::svg;
+
+#[derive(Args, Debug)]
+pub struct ScanArgs {
+    #[command(flatten)]
+    pub sim: SimArgs,
+    /// Parameters to scan, comma separated: x (approach), y (vertical), lateral, rx, ry, rz.
+    #[arg(long, default_value = "x")]
+    pub axes: String,
+    /// Grid points per axis, comma separated (one value applies to every axis).
+    #[arg(long, default_value = "41")]
+    pub steps: String,
+    /// Output folder.
+    #[arg(long, default_value = "results/scan")]
+    pub out: PathBuf,
+    /// Worker threads (0: all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
+    let kinds = args
+        .axes
+        .split(',')
+        .map(param_kind)
+        .collect::<Result<Vec<_>>>()?;
+    let steps: Vec<usize> = args
+        .steps
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n >= 1)
+                .with_context(|| format!("--steps: expected whole numbers >= 1, got {s:?}"))
+        })
+        .collect::<Result<_>>()?;
+    let steps = match steps.len() {
+        1 => vec![steps[0]; kinds.len()],
+        n if n == kinds.len() => steps,
+        n => bail!("--steps has {n} values for {} axes", kinds.len()),
+    };
+    let ev = args.sim.evaluator(&kinds)?;
+    let axes: Vec<Vec<f64>> = ev
+        .space
+        .bounds()
+        .iter()
+        .zip(&steps)
+        .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
+        .collect();
+    let total: usize = steps.iter().product();
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} trials  {per_sec}  eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let started = Instant::now();
+    let points = scan_grid(&ev, &axes, args.threads, &|_| bar.inc(1))?;
+    bar.finish_and_clear();
+    let elapsed = started.elapsed();
+
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let names: Vec<&str> = kinds.iter().map(|k| param_name(*k)).collect();
+    let stem = format!(
+        "{}-{}-{}",
+        ev.object.name(),
+        args.sim.metric,
+        names.join("-")
+    );
+    let csv_path = args.out.join(format!("{stem}.csv"));
+    std::fs::write(&csv_path, csv(&names, &points))
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    let title = format!(
+        "{} on the {} ({:?} contacts)",
+        args.sim.metric.to_uppercase(),
+        ev.object.name(),
+        ev.score.contacts
+    );
+    let chart = match axes.len() {
+        1 => Some(svg::line_plot(
+            &title,
+            &format!("{} offset (m)", names[0]),
+            &args.sim.metric,
+            &axes[0],
+            &points.iter().map(|p| p.score.score).collect::<Vec<_>>(),
+        )),
+        2 => {
+            let z: Vec<Vec<f64>> = (0..axes[0].len())
+                .map(|i| {
+                    (0..axes[1].len())
+                        .map(|j| points[i * axes[1].len() + j].score.score)
+                        .collect()
+                })
+                .collect();
+            Some(svg::heatmap(
+                &title,
+                &format!("{} offset (m)", names[0]),
+                &format!("{} offset (m)", names[1]),
+                &axes[0],
+                &axes[1],
+                &z,
+            ))
+        }
+        _ => None,
+    };
+    let mut written = vec![csv_path.display().to_string()];
+    if let Some(chart) = chart {
+        let svg_path = args.out.join(format!("{stem}.svg"));
+        std::fs::write(&svg_path, chart)
+            .with_context(|| format!("cannot write {}", svg_path.display()))?;
+        written.push(svg_path.display().to_string());
+    }
+    let best = points
+        .iter()
+        .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
+        .context("empty scan")?;
+    let closed = points
+        .iter()
+        .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure))
+        .count();
+    eprintln!(
+        "{total} trials in {:.2} s ({:.2} ms per trial per thread); force closure in {closed}; best {} {:.6} at {:?}",
+        elapsed.as_secs_f64(),
+        elapsed.as_secs_f64() * 1e3 * threads_used(args.threads, total) as f64 / total as f64,
+        args.sim.metric,
+        best.score.score,
+        best.params
+    );
+    for w in written {
+        println!("{w}");
+    }
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+fn threads_used(requested: usize, total: usize) -> usize {
+    let n = if requested == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        requested
+    };
+    n.min(total).max(1)
+}
+
+fn csv(names: &[&str], points: &[ScanPoint]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{},score,force_closure,epsilon,distance,contacts,fingers_in_contact",
+        names.join(",")
+    );
+    for p in points {
+        for v in &p.params {
+            let _ = write!(out, "{v},");
+        }
+        let (fc, eps, dist) = p.score.metrics.map_or((false, 0.0, f64::NAN), |m| {
+            (m.force_closure, m.epsilon, m.distance)
+        });
+        let _ = writeln!(
+            out,
+            "{},{fc},{eps},{dist},{},{}",
+            p.score.score, p.score.contacts, p.score.fingers_in_contact
+        );
+    }
+    out
+}

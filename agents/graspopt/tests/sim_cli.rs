@@ -1,0 +1,111 @@
+//! `graspopt trial` and `graspopt scan` as users run them.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn graspopt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_graspopt"))
+        .args(args)
+        .output()
+        .expect("run graspopt")
+}
+
+fn tempdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("graspopt-sim-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn trial_prints_contacts_and_metrics() {
+    let out = graspopt(&[
+        "trial", "--object", "sphere", "--at", "x=-0.1", "--format", "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let e: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(e["params"], serde_json::json!([-0.1]));
+    let m = &e["score"]["metrics"];
+    assert_eq!(m["force_closure"], true);
+    assert_eq!(e["score"]["score"], m["bw"]);
+    assert_eq!(e["outcome"]["fingers"].as_array().unwrap().len(), 3);
+    let text = graspopt(&["trial", "--object", "sphere", "--at", "x=-0.1"]);
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(
+        text.contains("finger 3:") && text.contains("force closure true"),
+        "{text}"
+    );
+}
+
+#[test]
+fn trial_bad_input_is_named() {
+    for (args, expected) in [
+        (
+            vec!["trial", "--object", "teapot"],
+            "unknown object `teapot`",
+        ),
+        (
+            vec!["trial", "--at", "q=1"],
+            "unknown trial parameter \"q\"",
+        ),
+        (vec!["trial", "--at", "x=abc"], "x is not a number"),
+        (
+            vec!["trial", "--at", "x=NaN"],
+            "non-finite value in trial parameter vector",
+        ),
+        (vec!["trial", "--at", "x=5"], "outside"),
+        (vec!["trial", "--metric", "area"], "unknown metric \"area\""),
+        (
+            vec!["trial", "--mesh", "/nonexistent.stl"],
+            "cannot load the mesh /nonexistent.stl",
+        ),
+    ] {
+        let out = graspopt(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn scan_writes_csv_and_svg() {
+    let dir = tempdir("scan");
+    let out = graspopt(&[
+        "scan",
+        "--object",
+        "cylinder",
+        "--axes",
+        "x,y",
+        "--steps",
+        "3,4",
+        "--out",
+        dir.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("cylinder-bw-approach-vertical.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 1 + 12);
+    assert!(lines[0].starts_with("approach,vertical,score,force_closure"));
+    let svg = std::fs::read_to_string(dir.join("cylinder-bw-approach-vertical.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    // The best score reported is the maximum of the CSV's score column.
+    let best = lines[1..]
+        .iter()
+        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(&format!("best bw {best:.6}")), "{stderr}");
+    let bad = graspopt(&["scan", "--axes", "x,y", "--steps", "3,4,5"]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--steps has 3 values for 2 axes"));
+}
