@@ -72,5 +72,51 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// 100 seeded random grasps of three soft-finger contacts on the unit sphere (k = 8,
+/// 48 wrenches each), split by force closure; each timed separately, so the report
+/// gives the typical cost rather than one hand-picked grasp.
+fn random_grasps(c: &mut Criterion) {
+    let model = GraspModel::new(SOFT);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut closed = Vec::new();
+    let mut open = Vec::new();
+    for _ in 0..100 {
+        let contacts: Vec<Contact> = (0..3)
+            .map(|_| {
+                let z: f64 = 2.0 * uniform() - 1.0;
+                let lon = std::f64::consts::TAU * uniform();
+                on_sphere(lon, z.asin())
+            })
+            .collect();
+        let g = GraspMap::from_contacts(&contacts, &model).expect("grasp");
+        let fc = evaluate(&g, &MetricsOptions::without_volume())
+            .expect("metrics")
+            .force_closure;
+        if fc { closed.push(g) } else { open.push(g) }
+    }
+    for (name, set) in [("force closure", &closed), ("no force closure", &open)] {
+        c.bench_function(
+            &format!("random 3 soft contacts, {name} ({} grasps), all but volume, per grasp", set.len()),
+            |b| {
+                b.iter_custom(|iters| {
+                    let start = std::time::Instant::now();
+                    for _ in 0..iters {
+                        for g in set.iter() {
+                            let _ = black_box(evaluate(black_box(g), &MetricsOptions::without_volume()));
+                        }
+                    }
+                    start.elapsed() / set.len().max(1) as u32
+                })
+            },
+        );
+    }
+}
+
+criterion_group!(benches, bench, random_grasps);
 criterion_main!(benches);

@@ -1,0 +1,26 @@
+//! One full scored trial on the mug at its reference pose: close the Barrett hand,
+//! extract contact clouds, build the surface model, compute BW.
+//!
+//! Run: `cargo bench -p graspopt-trial --bench trial`.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use graspopt_sim::hand::hand_by_name;
+use graspopt_sim::{Object, TrialSpace};
+use graspopt_trial::Evaluator;
+
+fn bench(c: &mut Criterion) {
+    let object = Object::by_name("mug").expect("mug");
+    let space = TrialSpace::approach_vertical_2d(&object);
+    let ev = Evaluator::new(object, hand_by_name("barrett").expect("hand"), space);
+    let x = [-0.09, 0.0];
+    let e = ev.evaluate(&x).expect("trial");
+    assert!(e.score.contacts > 0, "the benchmark grasp must touch the mug");
+    c.bench_function("scored trial, mug, barrett, surface model, BW", |b| {
+        b.iter(|| ev.evaluate(black_box(&x)))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
