@@ -102,13 +102,19 @@ fn random_grasps(c: &mut Criterion) {
     }
     for (name, set) in [("force closure", &closed), ("no force closure", &open)] {
         c.bench_function(
-            &format!("random 3 soft contacts, {name} ({} grasps), all but volume, per grasp", set.len()),
+            &format!(
+                "random 3 soft contacts, {name} ({} grasps), all but volume, per grasp",
+                set.len()
+            ),
             |b| {
                 b.iter_custom(|iters| {
                     let start = std::time::Instant::now();
                     for _ in 0..iters {
                         for g in set.iter() {
-                            let _ = black_box(evaluate(black_box(g), &MetricsOptions::without_volume()));
+                            let _ = black_box(evaluate(
+                                black_box(g),
+                                &MetricsOptions::without_volume(),
+                            ));
                         }
                     }
                     start.elapsed() / set.len().max(1) as u32

@@ -16,7 +16,10 @@ fn bench(c: &mut Criterion) {
     let ev = Evaluator::new(object, hand_by_name("barrett").expect("hand"), space);
     let x = [-0.09, 0.0];
     let e = ev.evaluate(&x).expect("trial");
-    assert!(e.score.contacts > 0, "the benchmark grasp must touch the mug");
+    assert!(
+        e.score.contacts > 0,
+        "the benchmark grasp must touch the mug"
+    );
     c.bench_function("scored trial, mug, barrett, surface model, BW", |b| {
         b.iter(|| ev.evaluate(black_box(&x)))
     });
