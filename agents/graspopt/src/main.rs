@@ -6,6 +6,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod commands;
+mod export;
+mod render;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -27,6 +29,8 @@ enum Command {
     Trial(commands::trial::TrialArgs),
     /// Grid-scan a metric over one or two trial parameters (CSV and SVG).
     Scan(commands::scan::ScanArgs),
+    /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15).
+    Experiment(commands::experiment::ExperimentArgs),
     /// Run the BO engine (or random search) on a standard test function.
     OptimizeFunction(commands::optimize_function::OptimizeFunctionArgs),
 }
@@ -37,6 +41,7 @@ fn main() -> ExitCode {
         Command::Quality(args) => commands::quality::run(args),
         Command::Trial(args) => commands::trial::run(args),
         Command::Scan(args) => commands::scan::run(args),
+        Command::Experiment(args) => commands::experiment::run(args),
         Command::OptimizeFunction(args) => {
             commands::optimize_function::run(args).map(|()| ExitCode::SUCCESS)
         }

@@ -109,3 +109,83 @@ fn scan_writes_csv_and_svg() {
     let bad = graspopt(&["scan", "--axes", "x,y", "--steps", "3,4,5"]);
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--steps has 3 values for 2 axes"));
 }
+
+#[test]
+fn scan_2d_writes_a_png_heatmap_too() {
+    let dir = tempdir("png");
+    let out = graspopt(&[
+        "scan",
+        "--object",
+        "sphere",
+        "--axes",
+        "x,y",
+        "--steps",
+        "4,3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let file = std::fs::File::open(dir.join("sphere-bw-approach-vertical.png")).unwrap();
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap();
+    let info = reader.info();
+    // 4 x 3 cells of 8 px, plus the colour bar.
+    assert_eq!(info.height, 3 * 8);
+    assert!(info.width > 4 * 8);
+}
+
+#[test]
+fn experiment_metrics_writes_every_figure_and_a_report() {
+    let dir = tempdir("experiment");
+    let out = graspopt(&[
+        "experiment",
+        "metrics",
+        "--steps",
+        "4",
+        "--steps-2d",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for heading in [
+        "4.3-4.5",
+        "Figure 4.6",
+        "Figure 4.7",
+        "Figure 4.8",
+        "4.9-4.15",
+    ] {
+        assert!(report.contains(heading), "report lacks {heading}");
+    }
+    // Every file the report names exists.
+    let mut named = 0;
+    for word in report.split(|c: char| c.is_whitespace() || c == ',' || c == '|') {
+        if word.ends_with(".svg") || word.ends_with(".csv") {
+            assert!(dir.join(word).exists(), "{word} missing");
+            named += 1;
+        }
+    }
+    // 4.3-4.5: 3 objects x (CSV + 3 SVG); 4.6: 2; 4.7: 2; 4.8: 1; 4.9-4.15: 7.
+    assert_eq!(named, 12 + 2 + 2 + 1 + 7);
+    for object in [
+        "sphere",
+        "wine_glass",
+        "cylinder",
+        "mug",
+        "cuboid",
+        "rotated_cuboid",
+        "star_prism",
+    ] {
+        assert!(dir.join(format!("fig4.9-4.15-{object}.png")).exists());
+    }
+}

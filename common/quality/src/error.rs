@@ -37,6 +37,12 @@ pub enum QualityError {
     /// The normals of a contact cloud cancel out, so it has no mean normal.
     #[error("the normals of the contact cloud cancel out: no mean normal")]
     NoMeanNormal,
+    /// The full wrench hull could not be built (floating-point degeneracy that neither
+    /// the exact nor the joggled points overcame), so its volume is unavailable.
+    #[error(
+        "the wrench hull of {points} wrenches could not be built (degenerate geometry); its volume is unavailable"
+    )]
+    HullFailed { points: usize },
     /// The conic solver failed.
     #[error("the distance QP solver failed: {0}")]
     Solver(String),

@@ -100,7 +100,11 @@ pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metri
     };
     let force_closure = epsilon > FORCE_CLOSURE_MARGIN;
     let epsilon = if force_closure { epsilon } else { 0.0 };
-    let volume = options.volume.then(|| grasp_wrench_volume(w));
+    let volume = if options.volume {
+        Some(grasp_wrench_volume(w)?)
+    } else {
+        None
+    };
     Ok(Metrics {
         rank,
         force_closure,
@@ -119,11 +123,13 @@ pub fn distance_to_hull(w: &[Wrench], solver: DistanceSolver) -> Result<f64, Qua
     }
 }
 
-/// The Grasp Wrench Volume: the 6-volume of the hull of `w` (0 below rank 6).
-pub fn grasp_wrench_volume(w: &[Wrench]) -> f64 {
+/// The Grasp Wrench Volume: the 6-volume of the hull of `w` (0 below rank 6); an error
+/// when the hull cannot be built.
+pub fn grasp_wrench_volume(w: &[Wrench]) -> Result<f64, QualityError> {
     match quickhull::Hull::new(w) {
-        Ok(h) => h.volume(),
-        Err(_) => 0.0,
+        Ok(h) => Ok(h.volume()),
+        Err(quickhull::HullError::LowerDimensional { .. }) => Ok(0.0),
+        Err(quickhull::HullError::Degenerate) => Err(QualityError::HullFailed { points: w.len() }),
     }
 }
 

@@ -160,3 +160,69 @@ fn expanding_polytope_agrees_with_the_full_hull() {
     }
     assert!(checked >= 40, "only {checked} force-closure cases");
 }
+
+/// A surface-model wrench set on which the expanding polytope once asked for a point it
+/// had already added (the polytope went non-convex in rounding) and grew without bound.
+/// It must now finish, with a radius whose ball fits inside the exact hull: along every
+/// direction the support function reaches at least that radius (up to the joggle the
+/// recovery may use, at most 1e-6 of the coordinate scale).
+#[test]
+fn expanding_polytope_terminates_on_a_near_degenerate_surface_model() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/data/epa-regression.json"
+    );
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let w: Vec<Wrench> = doc["wrenches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| Wrench::from_iterator(w.as_array().unwrap().iter().map(|x| x.as_f64().unwrap())))
+        .collect();
+    assert_eq!(w.len(), 960);
+    let m = evaluate(
+        &GraspMap::from_wrenches(w.clone()).unwrap(),
+        &MetricsOptions::without_volume(),
+    )
+    .unwrap();
+    assert!(m.force_closure && m.epsilon > 0.01, "{m:?}");
+    let scale = w
+        .iter()
+        .flat_map(|x| x.iter())
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let mut state = 0x1234_5678_9abc_def1u64;
+    let mut normal = move || {
+        // Box-Muller on xorshift uniforms.
+        let mut u = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        (-2.0 * u().ln()).sqrt() * (std::f64::consts::TAU * u()).cos()
+    };
+    let mut tightest = f64::INFINITY;
+    for _ in 0..20_000 {
+        let u = Wrench::from_fn(|_, _| normal()).normalize();
+        let support = w
+            .iter()
+            .map(|x| x.dot(&u))
+            .fold(f64::NEG_INFINITY, f64::max);
+        tightest = tightest.min(support);
+        assert!(
+            support >= m.epsilon - 1e-6 * scale * 6.0,
+            "ball pokes out along {u}"
+        );
+    }
+    // Sampled directions only bound epsilon from above: it must not exceed them.
+    assert!(m.epsilon <= tightest + 1e-6 * scale * 6.0);
+    // The volume is requested: the hull of these points cannot be built, and that is
+    // an error naming the problem, not a silent 0.
+    match evaluate(
+        &GraspMap::from_wrenches(w).unwrap(),
+        &MetricsOptions::default(),
+    ) {
+        Ok(m) => assert!(m.volume.unwrap() > 0.0),
+        Err(e) => assert!(e.to_string().contains("could not be built"), "{e}"),
+    }
+}

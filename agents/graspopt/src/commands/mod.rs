@@ -1,5 +1,6 @@
 //! The subcommands of `graspopt`.
 
+pub mod experiment;
 pub mod optimize_function;
 pub mod quality;
 pub mod scan;

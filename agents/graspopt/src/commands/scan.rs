@@ -92,6 +92,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         ev.object.name(),
         ev.score.contacts
     );
+    let mut extra = Vec::new();
     let chart = match axes.len() {
         1 => Some(svg::line_plot(
             &title,
@@ -104,10 +105,13 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
             let z: Vec<Vec<f64>> = (0..axes[0].len())
                 .map(|i| {
                     (0..axes[1].len())
-                        .map(|j| points[i * axes[1].len() + j].score.score)
+                        .map(|j| touched_score(&points[i * axes[1].len() + j]))
                         .collect()
                 })
                 .collect();
+            let png_path = args.out.join(format!("{stem}.png"));
+            crate::render::heatmap_png(&z, 8).save_png(&png_path)?;
+            extra.push(png_path.display().to_string());
             Some(svg::heatmap(
                 &title,
                 &format!("{} offset (m)", names[0]),
@@ -126,6 +130,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
             .with_context(|| format!("cannot write {}", svg_path.display()))?;
         written.push(svg_path.display().to_string());
     }
+    written.extend(extra);
     let best = points
         .iter()
         .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
@@ -146,6 +151,16 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         println!("{w}");
     }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// The score for a map: NaN where the hand touched nothing, so the colour scale spans
+/// the touching grasps (the CSV keeps the defined no-contact score).
+pub fn touched_score(p: &ScanPoint) -> f64 {
+    if p.score.contacts == 0 {
+        f64::NAN
+    } else {
+        p.score.score
+    }
 }
 
 fn threads_used(requested: usize, total: usize) -> usize {

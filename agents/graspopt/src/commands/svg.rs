@@ -84,11 +84,30 @@ fn axes(out: &mut String, x: (f64, f64), y: (f64, f64), xlabel: &str, ylabel: &s
 
 /// A line plot of `ys` against `xs`, with a dashed zero line when 0 is in range.
 pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, xs: &[f64], ys: &[f64]) -> String {
+    lines_plot(title, xlabel, ylabel, xs, &[("", ys.to_vec())])
+}
+
+/// Several named series against the same `xs`, with a legend when names are given.
+pub fn lines_plot(
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    xs: &[f64],
+    series: &[(&str, Vec<f64>)],
+) -> String {
+    const COLOURS: [&str; 6] = [
+        "rgb(31,119,180)",
+        "rgb(214,39,40)",
+        "rgb(44,160,44)",
+        "rgb(148,103,189)",
+        "rgb(255,127,14)",
+        "rgb(23,190,207)",
+    ];
     let mut out = String::new();
     header(&mut out, title);
     let width = W - LEFT - 30.0;
     let xr = range(xs.iter().copied());
-    let yr = range(ys.iter().copied());
+    let yr = range(series.iter().flat_map(|(_, ys)| ys.iter().copied()));
     axes(&mut out, xr, yr, xlabel, ylabel, width);
     let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
     let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
@@ -100,17 +119,32 @@ pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, xs: &[f64], ys: &[f64]
             LEFT + width
         );
     }
-    let points: Vec<String> = xs
-        .iter()
-        .zip(ys)
-        .filter(|(x, y)| x.is_finite() && y.is_finite())
-        .map(|(&x, &y)| format!("{:.2},{:.2}", px(x), py(y)))
-        .collect();
-    let _ = writeln!(
-        out,
-        r#"<polyline points="{}" fill="none" stroke="rgb(31,119,180)" stroke-width="2"/>"#,
-        points.join(" ")
-    );
+    for (k, (name, ys)) in series.iter().enumerate() {
+        let colour = COLOURS[k % COLOURS.len()];
+        let points: Vec<String> = xs
+            .iter()
+            .zip(ys)
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|(&x, &y)| format!("{:.2},{:.2}", px(x), py(y)))
+            .collect();
+        let _ = writeln!(
+            out,
+            r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="2"/>"#,
+            points.join(" ")
+        );
+        if !name.is_empty() {
+            let y = TOP + 16.0 + 16.0 * k as f64;
+            let _ = writeln!(
+                out,
+                r#"<line x1="{0}" y1="{y}" x2="{1}" y2="{y}" stroke="{colour}" stroke-width="2"/><text x="{2}" y="{3}">{4}</text>"#,
+                LEFT + 10.0,
+                LEFT + 30.0,
+                LEFT + 36.0,
+                y + 4.0,
+                escape(name)
+            );
+        }
+    }
     out.push_str("</svg>\n");
     out
 }

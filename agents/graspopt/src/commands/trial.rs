@@ -1,10 +1,21 @@
 //! `graspopt trial --object mug --hand barrett --at x=-0.08,y=0.01`: run one simulated
 //! trial and print its contacts and metrics (`--format json` for everything).
 
+use std::path::{Path, PathBuf};
+
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use graspopt_trial::{Evaluation, Evaluator};
 
 use super::setup::{SimArgs, param_kind, param_name};
+use crate::{export, render};
+
+/// Size of `--preview` pictures (two views side by side).
+pub const PREVIEW_WIDTH: u32 = 1200;
+pub const PREVIEW_HEIGHT: u32 = 560;
+/// Colours of the object and of the hand's links (alternating) in previews.
+const OBJECT_COLOUR: [u8; 3] = [90, 140, 220];
+const LINK_COLOURS: [[u8; 3]; 2] = [[230, 150, 60], [200, 120, 40]];
 
 #[derive(Args, Debug)]
 pub struct TrialArgs {
@@ -16,6 +27,14 @@ pub struct TrialArgs {
     pub at: String,
     #[arg(long, value_enum, default_value_t = TrialFormat::Text)]
     pub format: TrialFormat,
+    /// Write the scene (object, hand links, contact points and normals) for any 3D viewer:
+    /// glTF 2.0 if FILE ends in `.gltf`, else a Wavefront OBJ with its colours in an MTL next
+    /// to it.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Draw the grasp from two viewpoints (along the approach axis, from the side) into a PNG.
+    #[arg(long, value_name = "FILE.png")]
+    pub preview: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -44,6 +63,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
     }
     let ev = args.sim.evaluator(&kinds)?;
     let e = ev.evaluate(&values)?;
+    let written = write_pictures(args, &ev, &e)?;
     match args.format {
         TrialFormat::Json => println!("{}", serde_json::to_string_pretty(&e)?),
         TrialFormat::Text => {
@@ -103,5 +123,62 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
             println!("score {:.6}", e.score.score);
         }
     }
+    for path in written {
+        // JSON goes to stdout alone, so it stays parseable.
+        match args.format {
+            TrialFormat::Text => println!("wrote {}", path.display()),
+            TrialFormat::Json => eprintln!("wrote {}", path.display()),
+        }
+    }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// Writes `--scene` and `--preview` (if asked for); returns the paths written.
+fn write_pictures(args: &TrialArgs, ev: &Evaluator, e: &Evaluation) -> Result<Vec<PathBuf>> {
+    if args.scene.is_none() && args.preview.is_none() {
+        return Ok(Vec::new());
+    }
+    let meshes = graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
+    let contacts = e.outcome.contacts(ev.score.contacts, true);
+    let mut written = Vec::new();
+    if let Some(path) = &args.scene {
+        let (lo, hi) = ev.object.aabb();
+        let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
+        if has_extension(path, "glb") {
+            bail!(
+                "--scene {}: binary glTF (.glb) is not supported; write .gltf or .obj",
+                path.display()
+            );
+        }
+        if has_extension(path, "gltf") {
+            export::write_gltf(path, &meshes, &contacts, normal_length)?;
+            written.push(path.clone());
+        } else {
+            export::write_obj(path, &meshes, &contacts, normal_length)?;
+            written.push(path.clone());
+            written.push(export::mtl_path(path));
+        }
+    }
+    if let Some(path) = &args.preview {
+        let coloured: Vec<_> = meshes
+            .iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let c = if k == 0 {
+                    OBJECT_COLOUR
+                } else {
+                    LINK_COLOURS[k % 2]
+                };
+                (&m.mesh, c)
+            })
+            .collect();
+        render::render_grasp(&coloured, &contacts, PREVIEW_WIDTH, PREVIEW_HEIGHT).save_png(path)?;
+        written.push(path.clone());
+    }
+    Ok(written)
+}
+
+fn has_extension(path: &Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case(ext))
 }

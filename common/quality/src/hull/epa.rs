@@ -48,15 +48,20 @@ pub fn inner_distance<const D: usize>(points: &[SVector<f64, D>]) -> Option<Inne
         return None;
     }
     let scale = coordinate_scale(points);
-    match expand(points, &basis.indices, scale) {
-        Ok(r) => Some(r),
-        // Floating-point degeneracy in the incremental polytope: fall back to the
-        // full hull, which is slower but has its own recovery.
-        Err(Degenerate) => quickhull::Hull::new(points).ok().map(|h| InnerDistance {
-            offset: h.min_offset(),
-            iterations: h.added(),
-        }),
+    if let Ok(r) = expand(points, &basis.indices, scale) {
+        return Some(r);
     }
+    // Floating-point degeneracy (near-coplanar contact grids): retry on slightly
+    // joggled copies, then fall back to the full hull, which has its own recovery.
+    for joggle in quickhull::JOGGLES {
+        if let Ok(r) = expand(&quickhull::joggled(points, joggle), &basis.indices, scale) {
+            return Some(r);
+        }
+    }
+    quickhull::Hull::new(points).ok().map(|h| InnerDistance {
+        offset: h.min_offset(),
+        iterations: h.added(),
+    })
 }
 
 /// As [`inner_distance`], starting from a given simplex (D+1 affinely independent
@@ -90,6 +95,10 @@ fn expand<const D: usize>(
         .map(|f| Reverse((Key(poly.facets[f as usize].offset), f)))
         .collect();
     let mut iterations = 0;
+    let mut used = vec![false; points.len()];
+    for &i in simplex {
+        used[i] = true;
+    }
     while let Some(Reverse((Key(offset), f))) = heap.pop() {
         let facet = &poly.facets[f as usize];
         if !facet.alive {
@@ -104,6 +113,11 @@ fn expand<const D: usize>(
             .ok_or(Degenerate)?;
         if height - offset <= tolerance {
             return Ok(InnerDistance { offset, iterations });
+        }
+        // A point is added at most once; asked for again, the polytope has gone
+        // non-convex in rounding: give up on it (the caller falls back to the full hull).
+        if std::mem::replace(&mut used[best], true) {
+            return Err(Degenerate);
         }
         let new = poly.add_point(best, f)?;
         iterations += 1;

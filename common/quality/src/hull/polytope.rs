@@ -206,6 +206,11 @@ impl<'a, const D: usize> Polytope<'a, D> {
                 }
                 let id = self.facets.len() as FacetId;
                 let mut verts = self.facets[f as usize].verts;
+                // The apex already on the horizon: rounding made the polytope non-convex
+                // there; a facet with a repeated vertex would break the topology.
+                if verts.contains(&(p as u32)) {
+                    return Err(Degenerate);
+                }
                 verts[slot] = p as u32;
                 let (normal, offset) = self.cone_hyperplane(f, outer, &point, &verts)?;
                 let mut neighbors = [FacetId::MAX; D];

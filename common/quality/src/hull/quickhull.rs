@@ -20,8 +20,10 @@ use super::polytope::{Degenerate, FacetId, Polytope};
 const VISIBILITY_TOLERANCE: f64 = 1e-10;
 /// How far (relative) an input point may lie beyond a facet of the finished hull.
 const CONVEXITY_TOLERANCE: f64 = 1e-8;
-/// Relative joggles tried, in order, when the hull of the exact points fails.
-const JOGGLES: [f64; 3] = [1e-10, 1e-9, 1e-8];
+/// Relative joggles tried, in order, when the hull of the exact points fails. The
+/// largest moves points by a millionth of the coordinate scale: a last resort, reported
+/// by [`Hull::joggle`], preferable to no answer.
+pub const JOGGLES: [f64; 5] = [1e-10, 1e-9, 1e-8, 1e-7, 1e-6];
 
 /// Why a hull could not be built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,13 +59,8 @@ impl<const D: usize> Hull<D> {
         if let Ok(hull) = construct(points, &basis.indices, 0.0) {
             return Ok(hull);
         }
-        let scale = coordinate_scale(points);
-        let mut rng = SplitMix(0x9e37_79b9_7f4a_7c15);
         for joggle in JOGGLES {
-            let moved: Vec<SVector<f64, D>> = points
-                .iter()
-                .map(|p| p.map(|x| x + joggle * scale * rng.symmetric()))
-                .collect();
+            let moved = joggled(points, joggle);
             if let Ok(hull) = construct(&moved, &basis.indices, joggle) {
                 return Ok(hull);
             }
@@ -104,6 +101,17 @@ impl<const D: usize> Hull<D> {
     pub fn joggle(&self) -> f64 {
         self.joggle
     }
+}
+
+/// A copy of `points` with each coordinate moved by at most `joggle` times the
+/// coordinate scale, by a fixed-seed generator (the same result on every run).
+pub fn joggled<const D: usize>(points: &[SVector<f64, D>], joggle: f64) -> Vec<SVector<f64, D>> {
+    let scale = coordinate_scale(points);
+    let mut rng = SplitMix(0x9e37_79b9_7f4a_7c15);
+    points
+        .iter()
+        .map(|p| p.map(|x| x + joggle * scale * rng.symmetric()))
+        .collect()
 }
 
 fn construct<const D: usize>(
