@@ -91,10 +91,11 @@ pub fn evaluate_contacts(
 /// All metrics of a wrench set; errors on an empty set or a non-finite wrench.
 pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metrics, QualityError> {
     check_wrenches(w)?;
-    let rank = affine::affine_rank(w);
+    let basis = affine::affine_basis(w);
+    let rank = basis.rank;
     let distance = distance_to_hull(w, options.distance_solver)?;
     let epsilon = if rank == 6 && distance <= INSIDE_TOLERANCE * coordinate_scale(w) {
-        epa::inner_distance(w).map_or(0.0, |r| r.offset.max(0.0))
+        epa::inner_distance_with_basis(w, &basis).map_or(0.0, |r| r.offset.max(0.0))
     } else {
         0.0
     };

@@ -4,15 +4,10 @@ use graspopt_quality::metrics::{MetricsOptions, evaluate_contacts, evaluate_wren
 use graspopt_quality::{Contact, ContactModel, GraspModel, QualityError, Wrench};
 use nalgebra::Vector3;
 
+mod support;
+
 fn sphere_grasp() -> Vec<Contact> {
-    [0.0f64, 120.0, 240.0]
-        .iter()
-        .map(|a| {
-            let (s, c) = a.to_radians().sin_cos();
-            let p = Vector3::new(c, s, 0.0);
-            Contact::new(p, -p)
-        })
-        .collect()
+    support::equator(&[0.0, 120.0, 240.0])
 }
 
 fn model() -> GraspModel {

@@ -2,19 +2,9 @@
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts, evaluate_wrenches};
 use graspopt_quality::{Contact, ContactModel, GraspModel, Wrench};
-use nalgebra::Vector3;
+mod support;
 
-/// Contacts on the unit sphere at the given equator angles (degrees), normals inward.
-fn equator(angles: &[f64]) -> Vec<Contact> {
-    angles
-        .iter()
-        .map(|a| {
-            let (s, c) = a.to_radians().sin_cos();
-            let p = Vector3::new(c, s, 0.0);
-            Contact::new(p, -p)
-        })
-        .collect()
-}
+use support::equator;
 
 fn friction(mu: f64) -> GraspModel {
     GraspModel::new(ContactModel::PointFriction { mu, edges: 8 })

@@ -15,7 +15,7 @@ use std::collections::BinaryHeap;
 
 use nalgebra::SVector;
 
-use super::affine::affine_basis;
+use super::affine::{AffineBasis, affine_basis};
 use super::coordinate_scale;
 use super::polytope::{Degenerate, FacetId, Polytope};
 use super::quickhull;
@@ -43,7 +43,14 @@ pub struct InnerDistance {
 /// The value is exact for an origin inside the hull (the Largest Sphere radius). For an
 /// origin outside it is only a certificate (negative), not the distance to the hull.
 pub fn inner_distance<const D: usize>(points: &[SVector<f64, D>]) -> Option<InnerDistance> {
-    let basis = affine_basis(points);
+    inner_distance_with_basis(points, &affine_basis(points))
+}
+
+/// As [`inner_distance`], with the affine basis of `points` already computed.
+pub fn inner_distance_with_basis<const D: usize>(
+    points: &[SVector<f64, D>],
+    basis: &AffineBasis,
+) -> Option<InnerDistance> {
     if basis.rank < D {
         return None;
     }
@@ -62,15 +69,6 @@ pub fn inner_distance<const D: usize>(points: &[SVector<f64, D>]) -> Option<Inne
         offset: h.min_offset(),
         iterations: h.added(),
     })
-}
-
-/// As [`inner_distance`], starting from a given simplex (D+1 affinely independent
-/// point indices), e.g. the corral of the minimum-norm point, which holds the origin.
-pub fn inner_distance_from<const D: usize>(
-    points: &[SVector<f64, D>],
-    simplex: &[usize],
-) -> Option<InnerDistance> {
-    expand(points, simplex, coordinate_scale(points)).ok()
 }
 
 #[derive(PartialEq, PartialOrd)]
