@@ -1,19 +1,15 @@
 //! `graspopt quality` as users run it: the reference file, both formats, bad input.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
+mod support;
+use support::{graspopt, tempdir};
+
 fn reference_file() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/metric-cases.json")
-}
-
-fn graspopt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_graspopt"))
-        .args(args)
-        .output()
-        .expect("run graspopt")
 }
 
 fn close(a: f64, b: f64) -> bool {
@@ -202,13 +198,4 @@ fn unreadable_input_is_a_clear_error() {
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("expected an object with a `cases` array")
     );
-}
-
-fn tempdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "graspopt-quality-cli-{}-{name}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }

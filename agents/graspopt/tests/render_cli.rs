@@ -1,38 +1,7 @@
 //! `graspopt trial --preview FILE.png`: a two-view picture of the grasp.
 
-use std::fs::File;
-use std::io::BufReader;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn graspopt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_graspopt"))
-        .args(args)
-        .output()
-        .expect("run graspopt")
-}
-
-fn tempdir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("graspopt-render-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Width, height and RGB pixels of a PNG.
-fn decode(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
-    let file = BufReader::new(File::open(path).unwrap());
-    let mut reader = png::Decoder::new(file).read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    assert_eq!(info.bit_depth, png::BitDepth::Eight);
-    let px = buf[..info.buffer_size()]
-        .chunks(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
-    (info.width, info.height, px)
-}
+mod support;
+use support::{decode_png as decode, graspopt, tempdir};
 
 /// The contact dots' colour (`render::CONTACT_COLOUR`).
 const DOT: [u8; 3] = [230, 20, 20];

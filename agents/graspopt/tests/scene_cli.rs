@@ -1,27 +1,13 @@
 //! `graspopt trial --scene FILE`: the exported OBJ and glTF hold the object, every hand link,
 //! a marker per modelled contact and a normal segment per contact.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::scene::scene_meshes;
 use graspopt_sim::{ContactModel, Object, TrialOutcome};
 use serde_json::Value;
 
-fn graspopt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_graspopt"))
-        .args(args)
-        .output()
-        .expect("run graspopt")
-}
-
-fn tempdir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("graspopt-scene-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod support;
+use support::{graspopt, tempdir};
 
 /// Runs a sphere trial with JSON output and `extra` flags; returns the outcome.
 fn sphere_trial(extra: &[&str]) -> TrialOutcome {

@@ -1,22 +1,9 @@
 //! `graspopt trial` and `graspopt scan` as users run them.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use serde_json::Value;
 
-fn graspopt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_graspopt"))
-        .args(args)
-        .output()
-        .expect("run graspopt")
-}
-
-fn tempdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("graspopt-sim-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod support;
+use support::{decode_png, graspopt, tempdir};
 
 #[test]
 fn trial_prints_contacts_and_metrics() {
@@ -129,14 +116,10 @@ fn scan_2d_writes_a_png_heatmap_too() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let file = std::fs::File::open(dir.join("sphere-bw-approach-vertical.png")).unwrap();
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .unwrap();
-    let info = reader.info();
+    let (width, height, _) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
     // 4 x 3 cells of 8 px, plus the colour bar.
-    assert_eq!(info.height, 3 * 8);
-    assert!(info.width > 4 * 8);
+    assert_eq!(height, 3 * 8);
+    assert!(width > 4 * 8);
 }
 
 #[test]

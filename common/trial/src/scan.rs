@@ -30,6 +30,17 @@ pub fn linspace(lower: f64, upper: f64, n: usize) -> Vec<f64> {
     }
 }
 
+/// The workers a scan of `points` points uses when `requested` are asked for (0: one per
+/// core), never more than there are points, at least one.
+pub fn worker_count(requested: usize, points: usize) -> usize {
+    let n = if requested == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        requested
+    };
+    n.min(points).max(1)
+}
+
 /// Scores the grid `axes[0] x axes[1] x ...` with `threads` workers (0: all cores),
 /// calling `progress(done)` after each point. The first failing point stops the scan and
 /// its error is returned with its parameters.
@@ -60,12 +71,7 @@ pub fn scan_grid(
         }
         params
     };
-    let threads = if threads == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        threads
-    }
-    .min(total);
+    let threads = worker_count(threads, total);
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
     let failed: Mutex<Option<TrialError>> = Mutex::new(None);

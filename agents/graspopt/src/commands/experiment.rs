@@ -218,24 +218,22 @@ fn metrics(args: &MetricsArgs) -> Result<()> {
     }
 
     // 4.7: 2D sphere maps, mean point vs surface model.
-    report.push_str("\n## Figure 4.7: 2D BW maps of the sphere, mean point and surface model\n\n| object | best BW | at (approach, vertical) | force closure | file |\n|---|---|---|---|---|\n");
+    report.push_str("\n## Figure 4.7: 2D BW maps of the sphere, mean point and surface model\n\n");
+    report.push_str(MAP_TABLE);
     for (name, model) in [
         ("mean-point", ContactModel::MeanPoint),
         ("surface", ContactModel::Surface),
     ] {
         let mut ev = evaluator("sphere", &[ParamKind::Approach, ParamKind::Vertical])?;
         ev.score.contacts = model;
-        let mut line = String::new();
-        let file = heatmap_files(
+        report.push_str(&map_row(
             dir,
             &format!("fig4.7-sphere-{name}"),
             &format!("Fig. 4.7: BW on the sphere ({name})"),
             &ev,
             steps2,
             args.threads,
-            &mut line,
-        )?;
-        let _ = writeln!(report, "{} {file} |", line.trim_end());
+        )?);
     }
 
     // 4.8: reference frames with the torque scale fixed.
@@ -285,20 +283,18 @@ fn metrics(args: &MetricsArgs) -> Result<()> {
     let _ = writeln!(report, "\nFile: {file}");
 
     // 4.9-4.15: 2D maps of the seven objects.
-    report.push_str("\n## Figures 4.9-4.15: 2D BW maps (approach x vertical, surface model)\n\n| object | best BW | at (approach, vertical) | force closure | file |\n|---|---|---|---|---|\n");
+    report.push_str("\n## Figures 4.9-4.15: 2D BW maps (approach x vertical, surface model)\n\n");
+    report.push_str(MAP_TABLE);
     for object in OBJECTS {
         let ev = evaluator(object, &[ParamKind::Approach, ParamKind::Vertical])?;
-        let mut line = String::new();
-        let file = heatmap_files(
+        report.push_str(&map_row(
             dir,
             &format!("fig4.9-4.15-{object}"),
             &format!("BW on the {object}"),
             &ev,
             steps2,
             args.threads,
-            &mut line,
-        )?;
-        let _ = writeln!(report, "{} {file} |", line.trim_end());
+        )?);
     }
     let path = dir.join("report.md");
     std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
@@ -306,16 +302,17 @@ fn metrics(args: &MetricsArgs) -> Result<()> {
     Ok(())
 }
 
-/// A 2D scan written as CSV and SVG heatmap; appends "| object | best | at | fc |" cells
-/// to `line`. Returns the SVG file name.
-fn heatmap_files(
+/// The header of the 2D-map tables of the report.
+const MAP_TABLE: &str = "| object | best BW | at (approach, vertical) | force closure | file |\n|---|---|---|---|---|\n";
+
+/// A 2D scan written as CSV, SVG and PNG heatmaps; returns its row of [`MAP_TABLE`].
+fn map_row(
     dir: &Path,
     stem: &str,
     title: &str,
     ev: &Evaluator,
     steps: usize,
     threads: usize,
-    line: &mut String,
 ) -> Result<String> {
     let (axes, points) = scan(ev, &[steps, steps], threads)?;
     let mut csv = String::from("approach,vertical,bw,force_closure,contacts\n");
@@ -353,14 +350,12 @@ fn heatmap_files(
         .iter()
         .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure))
         .count();
-    let _ = write!(
-        line,
-        "| {} | {:.4} | ({:.3}, {:.3}) | {closed}/{} |",
+    Ok(format!(
+        "| {} | {:.4} | ({:.3}, {:.3}) | {closed}/{} | {file} |\n",
         ev.object.name(),
         best.score.score,
         best.params[0],
         best.params[1],
         points.len()
-    );
-    Ok(file)
+    ))
 }

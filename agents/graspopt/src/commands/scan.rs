@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use graspopt_trial::scan::{ScanPoint, linspace, scan_grid};
+use graspopt_trial::scan::{ScanPoint, linspace, scan_grid, worker_count};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::setup::{SimArgs, param_kind, param_name};
@@ -142,7 +142,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
     eprintln!(
         "{total} trials in {:.2} s ({:.2} ms per trial per thread); force closure in {closed}; best {} {:.6} at {:?}",
         elapsed.as_secs_f64(),
-        elapsed.as_secs_f64() * 1e3 * threads_used(args.threads, total) as f64 / total as f64,
+        elapsed.as_secs_f64() * 1e3 * worker_count(args.threads, total) as f64 / total as f64,
         args.sim.metric,
         best.score.score,
         best.params
@@ -161,15 +161,6 @@ pub fn touched_score(p: &ScanPoint) -> f64 {
     } else {
         p.score.score
     }
-}
-
-fn threads_used(requested: usize, total: usize) -> usize {
-    let n = if requested == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        requested
-    };
-    n.min(total).max(1)
 }
 
 fn csv(names: &[&str], points: &[ScanPoint]) -> String {
