@@ -33,10 +33,28 @@ enum Command {
     Experiment(commands::experiment::ExperimentArgs),
     /// Run the BO engine (or random search) on a standard test function.
     OptimizeFunction(commands::optimize_function::OptimizeFunctionArgs),
+    /// Optimize grasps: every agent in this process (no router needed), results in a folder.
+    Run(commands::run::RunArgs),
+    /// Run one agent (perception, hand, metric, planner, coordinator) as its own process.
+    Agent(commands::agent::AgentArgs),
+    /// A Zenoh router, for agents on several machines.
+    Router(commands::router::RouterArgs),
+    /// A run's trials from its journal, as CSV or JSON.
+    Export(commands::export::ExportArgs),
+    /// Figures of the distributed pipeline (throughput, overhead, cloud latency).
+    Bench(commands::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Logs go to stderr; RUST_LOG overrides the default level (warnings).
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
     let result = match &cli.command {
         Command::Quality(args) => commands::quality::run(args),
         Command::Trial(args) => commands::trial::run(args),
@@ -45,6 +63,11 @@ fn main() -> ExitCode {
         Command::OptimizeFunction(args) => {
             commands::optimize_function::run(args).map(|()| ExitCode::SUCCESS)
         }
+        Command::Run(args) => commands::run::run(args),
+        Command::Agent(args) => commands::agent::run(args),
+        Command::Router(args) => commands::router::run(args),
+        Command::Export(args) => commands::export::run(args),
+        Command::Bench(args) => commands::bench::run(args),
     };
     match result {
         Ok(code) => code,

@@ -444,6 +444,16 @@ impl Optimizer {
         self.pending.clear();
     }
 
+    /// Replace the pending points by `pending` (the trials a coordinator has issued and not
+    /// yet observed, e.g. after a restart). Nothing changes on an invalid point.
+    pub fn set_pending(&mut self, pending: Vec<Vec<f64>>) -> Result<()> {
+        for p in &pending {
+            self.check_point(p)?;
+        }
+        self.pending = pending;
+        Ok(())
+    }
+
     /// Hyperparameters of the last fit (unit-cube inputs, standardised outputs).
     pub fn hyperparameters(&self) -> Option<&Hyperparameters> {
         self.hyper.as_ref()

@@ -8,11 +8,13 @@
 //!
 //! - [`score`]: settings and scoring of one trial outcome.
 //! - [`evaluator`]: an object, a hand and a trial space: parameters in, score out.
+//! - [`measured`]: scoring clouds a hand measured (the metric agent's side).
 //! - [`scan`]: 1D/2D (any-D) grid scans over the trial space, in parallel.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod error;
 pub mod evaluator;
+pub mod measured;
 pub mod scan;
 pub mod score;
 

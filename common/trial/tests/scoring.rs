@@ -111,3 +111,24 @@ fn scans_are_in_grid_order_and_match_single_evaluations() {
         "{err}"
     );
 }
+
+/// A trial scored from its raw clouds alone (what a metric agent receives) equals the same
+/// trial scored whole, for touching and non-touching trials.
+#[test]
+fn measured_clouds_score_like_the_whole_trial() {
+    use graspopt_trial::measured::{MeasuredTrial, score_measured};
+    let object = graspopt_sim::Object::by_name("mug").unwrap();
+    let hand = graspopt_sim::hand_by_name("barrett").unwrap();
+    let space = graspopt_sim::TrialSpace::approach_vertical_2d(&object);
+    let evaluator = graspopt_trial::Evaluator::new(object.clone(), hand, space);
+    let mut touched = 0;
+    for params in [[0.0, 0.0], [-0.03, 0.02], [-0.16, 0.0], [0.015, -0.04]] {
+        let e = evaluator.evaluate(&params).unwrap();
+        let measured = MeasuredTrial::from_outcome(&e.outcome);
+        let (score, _) =
+            score_measured(&measured, &object, &evaluator.contacts, &evaluator.score).unwrap();
+        assert_eq!(score, e.score, "params {params:?}");
+        touched += usize::from(e.outcome.touched);
+    }
+    assert!((2..4).contains(&touched), "{touched} of 4 trials touched");
+}

@@ -1,8 +1,13 @@
 //! The subcommands of `graspopt`.
 
+pub mod agent;
+pub mod bench;
 pub mod experiment;
+pub mod export;
 pub mod optimize_function;
 pub mod quality;
+pub mod router;
+pub mod run;
 pub mod scan;
 pub mod setup;
 pub mod svg;

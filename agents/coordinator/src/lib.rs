@@ -1,0 +1,498 @@
+//! The coordinator agent owns a run. It watches hand workers by their liveliness tokens,
+//! leases each trial to one idle worker, re-issues a trial whose worker vanished or whose
+//! lease expired, asks the planner for as many proposals as there are idle workers, accepts
+//! each trial's result exactly once, writes everything to the trial journal (SQLite) as it
+//! happens, and publishes the run's status. Restarted on the same journal, it continues the
+//! run: completed trials are kept, unfinished ones are issued again.
+//!
+//! [`state`] is the bookkeeping (no network, no disk); [`run`] wires it to the bus and the
+//! journal.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod state;
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use graspopt_bus::{Bus, now_ms};
+use graspopt_journal::{
+    Journal, MetricValues as JournalMetrics, ResultOutcome, RunRecord, RunStatus as JournalStatus,
+    TrialIssue, TrialResultRecord, TrialState,
+};
+use graspopt_protocol::{
+    AgentKind, Encoding, ObjectEstimate, PlannerMethod, RunId, RunPhase, RunStatus, SuggestReply,
+    SuggestRequest, TrialCommand, TrialResult,
+};
+use graspopt_sim::{ParamKind, ParamSpec, TrialSpace, reference_pose};
+use serde::{Deserialize, Serialize};
+use tokio::sync::watch;
+
+use crate::state::{Disposition, RunState, TrialPhase};
+
+/// What a run is: recorded in the journal when the run is created, and taken from there when
+/// it resumes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// The object the run is about (perception must agree).
+    pub object: String,
+    pub hand: String,
+    pub params: Vec<ParamKind>,
+    /// `[lower, upper]` per parameter; `None`: the simulator's defaults for the object.
+    pub bounds: Option<Vec<[f64; 2]>>,
+    /// Number of trials.
+    pub trials: u64,
+    pub seed: u64,
+    pub method: PlannerMethod,
+    /// Size of the random initial design (`None`: the engine's default).
+    pub initial: Option<u32>,
+}
+
+/// Coordinator settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CoordinatorConfig {
+    pub id: String,
+    /// The journal file.
+    pub journal: PathBuf,
+    /// A trial without a result after this long is issued again.
+    pub lease_ms: u64,
+    /// How long to wait for the planner before asking again.
+    pub planner_timeout_ms: u64,
+    /// Status publication period.
+    pub status_period_ms: u64,
+}
+
+impl Default for CoordinatorConfig {
+    fn default() -> Self {
+        CoordinatorConfig {
+            id: "coordinator".into(),
+            journal: PathBuf::from("journal.sqlite"),
+            lease_ms: 30_000,
+            planner_timeout_ms: 30_000,
+            status_period_ms: 500,
+        }
+    }
+}
+
+/// The trial space of a run on an object estimate.
+pub fn trial_space(
+    spec: &RunSpec,
+    estimate: &ObjectEstimate,
+) -> anyhow::Result<(TrialSpace, Vec<[f64; 2]>)> {
+    let object = graspopt_convert::object_from_estimate(estimate)
+        .context("coordinator: the object estimate")?;
+    let defaults = graspopt_sim::pose::default_bounds(&object);
+    let mut params = Vec::with_capacity(spec.params.len());
+    for (i, kind) in spec.params.iter().enumerate() {
+        let default = defaults
+            .iter()
+            .find(|d| d.kind == *kind)
+            .copied()
+            .context("coordinator: no default bounds for a parameter")?;
+        let (lower, upper) = match &spec.bounds {
+            Some(b) => {
+                let b = b
+                    .get(i)
+                    .with_context(|| format!("run spec: no bounds for parameter {i}"))?;
+                (b[0], b[1])
+            }
+            None => (default.lower, default.upper),
+        };
+        params.push(ParamSpec {
+            kind: *kind,
+            lower,
+            upper,
+        });
+    }
+    let space = TrialSpace::new(reference_pose(&object), params).context("run spec")?;
+    let bounds = space.bounds().iter().map(|b| [b.0, b.1]).collect();
+    Ok((space, bounds))
+}
+
+/// Parameter names, as the journal and CSV show them.
+pub fn param_names(spec: &RunSpec) -> Vec<String> {
+    spec.params
+        .iter()
+        .map(|k| {
+            serde_json::to_value(k)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_else(|| format!("{k:?}"))
+        })
+        .collect()
+}
+
+/// Opens (or creates) the run in the journal and rebuilds the state from it.
+pub fn open_run(
+    journal: &mut Journal,
+    run: &RunId,
+    spec: &RunSpec,
+    resume: bool,
+) -> anyhow::Result<(RunSpec, RunState)> {
+    let existing = journal.run(run.as_str())?;
+    let spec = match existing {
+        Some(record) => {
+            if !resume {
+                bail!(
+                    "run {run} already exists in the journal: resume it (--resume) or choose another run id"
+                );
+            }
+            serde_json::from_str::<RunSpec>(&record.config_json)
+                .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?
+        }
+        None => {
+            journal.create_run(&RunRecord {
+                run_id: run.as_str().to_string(),
+                created_ms: now_ms(),
+                config_json: serde_json::to_string(spec)?,
+                param_names: param_names(spec),
+                status: JournalStatus::Running,
+            })?;
+            spec.clone()
+        }
+    };
+    let mut state = RunState::new(spec.trials);
+    let mut rows = journal.trials(run.as_str())?;
+    // Observations in completion order (as the planner first saw them).
+    rows.sort_by_key(|r| (r.completed_ms.unwrap_or(i64::MAX), r.trial_id));
+    for row in &rows {
+        let phase = match row.state {
+            TrialState::Completed => TrialPhase::Completed {
+                score: row.score.unwrap_or(f64::NAN),
+            },
+            TrialState::Failed => TrialPhase::Failed {
+                error: row.error.clone().unwrap_or_default(),
+            },
+            TrialState::Running => TrialPhase::Queued {
+                reason: Some("coordinator restarted".into()),
+            },
+        };
+        state.trials.insert(
+            row.trial_id,
+            state::Trial {
+                params: row.params.clone(),
+                attempts: row.attempts,
+                phase,
+            },
+        );
+        if let (TrialState::Completed, Some(score)) = (&row.state, row.score) {
+            state.observe(
+                row.trial_id,
+                row.params.clone(),
+                score,
+                row.metrics.as_ref().map(|m| m.force_closure),
+            );
+        }
+    }
+    Ok((spec, state))
+}
+
+fn status(run: &RunId, spec: &RunSpec, state: &RunState, phase: RunPhase) -> RunStatus {
+    RunStatus {
+        run_id: run.clone(),
+        phase,
+        object: spec.object.clone(),
+        param_names: param_names(spec),
+        budget: spec.trials,
+        completed: state.completed(),
+        running: state.running(),
+        failed: state.failed(),
+        best: state.best.clone(),
+        best_history: state.best_history.clone(),
+        workers: state.worker_statuses(),
+        errors: state.errors,
+        stamp_ms: now_ms(),
+    }
+}
+
+fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
+    TrialResultRecord {
+        run_id: r.run_id.as_str().to_string(),
+        trial_id: r.trial_id,
+        attempt: r.attempt,
+        worker: r.worker.clone(),
+        at_ms,
+        score: r.score,
+        metrics: r.metrics.map(|m| JournalMetrics {
+            rank: m.rank,
+            force_closure: m.force_closure,
+            epsilon: m.epsilon,
+            volume: m.volume,
+            distance: m.distance,
+            bw: m.bw,
+        }),
+        contacts: r.contacts,
+        fingers_in_contact: r.fingers_in_contact,
+        cloud_points: r.cloud_points,
+        details_json: serde_json::json!({
+            "scorer": r.scorer,
+            "cloud_transport": r.cloud_transport,
+        })
+        .to_string(),
+    }
+}
+
+struct Ctx<'a> {
+    bus: &'a Bus,
+    run: &'a RunId,
+    spec: &'a RunSpec,
+    config: &'a CoordinatorConfig,
+    journal: &'a mut Journal,
+    state: RunState,
+    space: Option<(TrialSpace, Vec<[f64; 2]>)>,
+    request_id: u64,
+}
+
+impl Ctx<'_> {
+    /// Sends queued trials to idle workers.
+    async fn issue_queued(&mut self) -> anyhow::Result<()> {
+        let Some((space, _)) = &self.space else {
+            return Ok(());
+        };
+        let mut idle = self.state.idle_workers().into_iter();
+        for (trial_id, reason) in self.state.queued() {
+            let Some(worker) = idle.next() else { break };
+            let now = now_ms();
+            let lease_until = now + self.config.lease_ms as i64;
+            let Some(attempt) = self.state.assign(trial_id, &worker, lease_until) else {
+                continue;
+            };
+            let params = self.state.trials[&trial_id].params.clone();
+            let palm = space
+                .palm_pose(&params)
+                .with_context(|| format!("trial {trial_id}: palm pose"))?;
+            self.journal.record_issue(&TrialIssue {
+                run_id: self.run.as_str().to_string(),
+                trial_id,
+                attempt,
+                params: params.clone(),
+                worker: worker.clone(),
+                at_ms: now,
+                lease_until_ms: lease_until,
+                reason,
+            })?;
+            let command = TrialCommand {
+                run_id: self.run.clone(),
+                trial_id,
+                attempt,
+                worker: worker.clone(),
+                hand: self.spec.hand.clone(),
+                params,
+                palm_pose: graspopt_convert::pose(&palm),
+                lease_ms: self.config.lease_ms,
+                issued_ms: now,
+            };
+            self.bus
+                .put(&self.run.command_key(&worker), &command, Encoding::Bincode)
+                .await?;
+        }
+        Ok(())
+    }
+
+    /// Asks the planner for proposals when workers are idle. Returns false when the planner
+    /// did not answer (the caller waits and tries again).
+    async fn plan(&mut self) -> anyhow::Result<bool> {
+        let n = self.state.proposals_needed();
+        let Some((_, bounds)) = &self.space else {
+            return Ok(true);
+        };
+        if n == 0 {
+            return Ok(true);
+        }
+        self.request_id += 1;
+        let request = SuggestRequest {
+            run_id: self.run.clone(),
+            request_id: self.request_id,
+            method: self.spec.method,
+            bounds: bounds.clone(),
+            seed: self.spec.seed,
+            initial: self.spec.initial,
+            observations: self.state.observations.clone(),
+            pending: self.state.pending_points(),
+            count: n as u32,
+        };
+        let timeout = Duration::from_millis(self.config.planner_timeout_ms);
+        let reply: SuggestReply = match self
+            .bus
+            .query(&self.run.suggest_key(), &request, timeout)
+            .await
+        {
+            Ok(r) => r,
+            Err(e) => {
+                tracing::warn!("coordinator: planner not available: {e}");
+                return Ok(false);
+            }
+        };
+        if let Some(e) = reply.error {
+            tracing::warn!("coordinator: planner could not propose: {e}");
+            return Ok(false);
+        }
+        for p in reply.points.into_iter().take(n) {
+            if p.len() != bounds.len() {
+                self.state.errors.bad_messages += 1;
+                continue;
+            }
+            self.state.add_trial(p);
+        }
+        Ok(true)
+    }
+
+    fn on_result(&mut self, result: &TrialResult) -> anyhow::Result<Disposition> {
+        let now = now_ms();
+        let known = self.state.trials.contains_key(&result.trial_id);
+        if !known {
+            return Ok(self.state.on_result(result));
+        }
+        let already = matches!(
+            self.state.trials[&result.trial_id].phase,
+            TrialPhase::Completed { .. } | TrialPhase::Failed { .. }
+        );
+        if !already {
+            if let Some(error) = &result.error {
+                self.journal.record_failure(
+                    self.run.as_str(),
+                    result.trial_id,
+                    result.attempt,
+                    error,
+                    now,
+                )?;
+            } else {
+                match self.journal.record_result(&journal_result(result, now))? {
+                    ResultOutcome::Accepted => {}
+                    other => tracing::warn!(
+                        "coordinator: journal says {other:?} for trial {}",
+                        result.trial_id
+                    ),
+                }
+            }
+        } else {
+            // Let the journal log the duplicate; it changes no trial.
+            let _ = self.journal.record_result(&journal_result(result, now));
+        }
+        Ok(self.state.on_result(result))
+    }
+}
+
+/// Runs the coordinator until the run finishes; returns the final status. `progress`
+/// receives every status published.
+pub async fn run(
+    bus: &Bus,
+    run: &RunId,
+    spec: &RunSpec,
+    config: &CoordinatorConfig,
+    resume: bool,
+    progress: Option<watch::Sender<RunStatus>>,
+) -> anyhow::Result<RunStatus> {
+    let mut journal = Journal::open(&config.journal)
+        .with_context(|| format!("cannot open the journal {}", config.journal.display()))?;
+    let (spec, state) = open_run(&mut journal, run, spec, resume)?;
+    let results = bus.subscribe::<TrialResult>(&run.result_key()).await?;
+    let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
+    let hands = bus
+        .watch_alive(&run.alive_kind_key(AgentKind::Hand))
+        .await?;
+    let state_server = bus
+        .serve::<graspopt_protocol::RunStatus>(&run.state_key())
+        .await?;
+    let _token = bus
+        .declare_alive(run, AgentKind::Coordinator, &config.id)
+        .await?;
+    let mut ctx = Ctx {
+        bus,
+        run,
+        spec: &spec,
+        config,
+        journal: &mut journal,
+        state,
+        space: None,
+        request_id: 0,
+    };
+    let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
+    let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
+    let mut planner_retry_at = tokio::time::Instant::now();
+    let status_key = run.status_key();
+    loop {
+        if ctx.state.finished() {
+            break;
+        }
+        if ctx.space.is_some() {
+            ctx.issue_queued().await?;
+            if tokio::time::Instant::now() >= planner_retry_at {
+                if ctx.plan().await? {
+                    ctx.issue_queued().await?;
+                } else {
+                    planner_retry_at = tokio::time::Instant::now() + Duration::from_millis(500);
+                }
+            }
+        }
+        tokio::select! {
+            Some(r) = results.recv() => match r.message {
+                Ok(result) if result.run_id == *run => {
+                    match ctx.on_result(&result)? {
+                        Disposition::Unknown => tracing::warn!("coordinator: result for unknown trial {}", result.trial_id),
+                        Disposition::Duplicate => tracing::info!("coordinator: duplicate result for trial {}", result.trial_id),
+                        _ => {}
+                    }
+                    let s = status(run, &spec, &ctx.state, RunPhase::Running);
+                    if let Some(p) = &progress { let _ = p.send(s); }
+                }
+                Ok(result) => {
+                    ctx.state.errors.bad_messages += 1;
+                    tracing::warn!("coordinator: result of run {} on this run's key", result.run_id);
+                }
+                Err(e) => {
+                    ctx.state.errors.bad_messages += 1;
+                    tracing::warn!("coordinator: bad result on {} ({} bad messages): {e}", r.key, ctx.state.errors.bad_messages);
+                }
+            },
+            Some(r) = objects.recv() => match r.message {
+                Ok(estimate) if estimate.run_id == *run => {
+                    if ctx.space.is_none() {
+                        if estimate.object != spec.object {
+                            bail!("perception sees {:?}, the run is about {:?}", estimate.object, spec.object);
+                        }
+                        ctx.space = Some(trial_space(&spec, &estimate)?);
+                    }
+                }
+                Ok(_) => ctx.state.errors.bad_messages += 1,
+                Err(e) => {
+                    ctx.state.errors.bad_messages += 1;
+                    tracing::warn!("coordinator: bad object estimate on {}: {e}", r.key);
+                }
+            },
+            Some(ev) = hands.recv() => {
+                if ev.agent.run == *run {
+                    if ev.alive {
+                        ctx.state.worker_up(&ev.agent.id, &ev.agent.host);
+                    } else if let Some(t) = ctx.state.worker_down(&ev.agent.id) {
+                        tracing::warn!("coordinator: worker {} lost with trial {t}: re-issuing", ev.agent.id);
+                    }
+                }
+            },
+            Some(q) = state_server.recv() => {
+                let s = status(run, &spec, &ctx.state, if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting });
+                let _ = q.reply(&s).await;
+            },
+            _ = lease_tick.tick() => {
+                for t in ctx.state.expire_leases(now_ms()) {
+                    tracing::warn!("coordinator: lease of trial {t} expired: re-issuing");
+                }
+            },
+            _ = tick.tick() => {
+                let phase = if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting };
+                let s = status(run, &spec, &ctx.state, phase);
+                let _ = bus.put_droppable(&status_key, &s, Encoding::Bincode).await;
+                if let Some(p) = &progress { let _ = p.send(s); }
+            },
+        }
+    }
+    ctx.journal
+        .set_run_status(run.as_str(), JournalStatus::Finished, now_ms())?;
+    let s = status(run, &spec, &ctx.state, RunPhase::Finished);
+    let _ = bus.put(&status_key, &s, Encoding::Bincode).await;
+    if let Some(p) = &progress {
+        let _ = p.send(s.clone());
+    }
+    Ok(s)
+}

@@ -1,0 +1,375 @@
+//! The coordinator's bookkeeping, without a network: trials and their leases, live workers,
+//! the observations for the planner, the best trial, the error counters. The async loop in
+//! [`crate::run`] feeds it events and carries out what it decides.
+
+use std::collections::BTreeMap;
+
+use graspopt_protocol::{BestTrial, ErrorCounts, Observation, TrialResult, WorkerStatus};
+
+/// Where a trial is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrialPhase {
+    /// Waiting for a worker (new, or re-queued after a lost worker or an expired lease).
+    Queued {
+        reason: Option<String>,
+    },
+    /// Leased to a worker.
+    Running {
+        worker: String,
+        lease_until_ms: i64,
+    },
+    Completed {
+        score: f64,
+    },
+    Failed {
+        error: String,
+    },
+}
+
+/// One trial.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trial {
+    pub params: Vec<f64>,
+    /// Attempts issued so far.
+    pub attempts: u32,
+    pub phase: TrialPhase,
+}
+
+/// A live hand worker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Worker {
+    pub host: String,
+    /// The trial it holds (it is busy until a result for it arrives).
+    pub trial: Option<u64>,
+}
+
+/// What a result did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Disposition {
+    /// First result of the trial: completed.
+    Completed,
+    /// The trial failed (the hand or the scorer said so).
+    Failed,
+    /// The trial already had its result: ignored.
+    Duplicate,
+    /// No such trial in this run: ignored.
+    Unknown,
+}
+
+/// The state of one run.
+#[derive(Debug, Clone, Default)]
+pub struct RunState {
+    pub budget: u64,
+    pub trials: BTreeMap<u64, Trial>,
+    pub workers: BTreeMap<String, Worker>,
+    /// Completed trials in completion order, for the planner.
+    pub observations: Vec<Observation>,
+    pub best: Option<BestTrial>,
+    pub best_history: Vec<f64>,
+    pub errors: ErrorCounts,
+}
+
+impl RunState {
+    pub fn new(budget: u64) -> RunState {
+        RunState {
+            budget,
+            ..RunState::default()
+        }
+    }
+
+    /// A worker appeared.
+    pub fn worker_up(&mut self, id: &str, host: &str) {
+        self.workers
+            .entry(id.to_string())
+            .or_insert_with(|| Worker {
+                host: host.to_string(),
+                trial: None,
+            });
+    }
+
+    /// A worker vanished: its trial (if not completed) goes back to the queue. Returns it.
+    pub fn worker_down(&mut self, id: &str) -> Option<u64> {
+        let worker = self.workers.remove(id)?;
+        let trial_id = worker.trial?;
+        let trial = self.trials.get_mut(&trial_id)?;
+        match &trial.phase {
+            TrialPhase::Running { worker, .. } if worker == id => {
+                trial.phase = TrialPhase::Queued {
+                    reason: Some(format!("worker {id} lost")),
+                };
+                self.errors.reissued += 1;
+                Some(trial_id)
+            }
+            _ => None,
+        }
+    }
+
+    /// Workers holding no trial, by id.
+    pub fn idle_workers(&self) -> Vec<String> {
+        self.workers
+            .iter()
+            .filter(|(_, w)| w.trial.is_none())
+            .map(|(id, _)| id.clone())
+            .collect()
+    }
+
+    /// Queued trials, oldest first, with the reason they were re-queued.
+    pub fn queued(&self) -> Vec<(u64, Option<String>)> {
+        self.trials
+            .iter()
+            .filter_map(|(id, t)| match &t.phase {
+                TrialPhase::Queued { reason } => Some((*id, reason.clone())),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// How many new trials to ask the planner for now.
+    pub fn proposals_needed(&self) -> usize {
+        let idle = self.idle_workers().len();
+        let queued = self.queued().len();
+        let left = self.budget.saturating_sub(self.trials.len() as u64) as usize;
+        idle.saturating_sub(queued).min(left)
+    }
+
+    /// Adds a new trial (queued); returns its id (ids start at 1).
+    pub fn add_trial(&mut self, params: Vec<f64>) -> u64 {
+        let id = self.trials.keys().next_back().map_or(1, |k| k + 1);
+        self.trials.insert(
+            id,
+            Trial {
+                params,
+                attempts: 0,
+                phase: TrialPhase::Queued { reason: None },
+            },
+        );
+        id
+    }
+
+    /// Leases a queued trial to an idle worker; returns the attempt number.
+    pub fn assign(&mut self, trial_id: u64, worker: &str, lease_until_ms: i64) -> Option<u32> {
+        let w = self.workers.get_mut(worker)?;
+        if w.trial.is_some() {
+            return None;
+        }
+        let t = self.trials.get_mut(&trial_id)?;
+        if !matches!(t.phase, TrialPhase::Queued { .. }) {
+            return None;
+        }
+        t.attempts += 1;
+        t.phase = TrialPhase::Running {
+            worker: worker.to_string(),
+            lease_until_ms,
+        };
+        w.trial = Some(trial_id);
+        Some(t.attempts)
+    }
+
+    /// Re-queues trials whose lease expired. The worker stays busy (it may be slow, not
+    /// dead) until it answers. Returns the re-queued trials.
+    pub fn expire_leases(&mut self, now_ms: i64) -> Vec<u64> {
+        let mut out = Vec::new();
+        for (id, t) in self.trials.iter_mut() {
+            if let TrialPhase::Running {
+                worker,
+                lease_until_ms,
+            } = &t.phase
+                && *lease_until_ms < now_ms
+            {
+                t.phase = TrialPhase::Queued {
+                    reason: Some(format!("lease of worker {worker} expired")),
+                };
+                out.push(*id);
+            }
+        }
+        self.errors.reissued += out.len() as u64;
+        out
+    }
+
+    /// Applies a result (already accepted by the journal when `Completed`/`Failed`).
+    pub fn on_result(&mut self, result: &TrialResult) -> Disposition {
+        if let Some(w) = self.workers.get_mut(&result.worker)
+            && w.trial == Some(result.trial_id)
+        {
+            w.trial = None;
+        }
+        let Some(t) = self.trials.get_mut(&result.trial_id) else {
+            self.errors.unknown_trial += 1;
+            return Disposition::Unknown;
+        };
+        if matches!(
+            t.phase,
+            TrialPhase::Completed { .. } | TrialPhase::Failed { .. }
+        ) {
+            self.errors.duplicates += 1;
+            return Disposition::Duplicate;
+        }
+        if let Some(e) = &result.error {
+            t.phase = TrialPhase::Failed { error: e.clone() };
+            self.errors.failed += 1;
+            return Disposition::Failed;
+        }
+        t.phase = TrialPhase::Completed {
+            score: result.score,
+        };
+        let params = t.params.clone();
+        self.observe(
+            result.trial_id,
+            params,
+            result.score,
+            result.metrics.map(|m| m.force_closure),
+        );
+        Disposition::Completed
+    }
+
+    /// Records a completed trial's observation and the best so far.
+    pub fn observe(
+        &mut self,
+        trial_id: u64,
+        params: Vec<f64>,
+        score: f64,
+        force_closure: Option<bool>,
+    ) {
+        self.observations.push(Observation {
+            x: params.clone(),
+            y: score,
+        });
+        if self.best.as_ref().is_none_or(|b| score > b.score) {
+            self.best = Some(BestTrial {
+                trial_id,
+                score,
+                params,
+                force_closure,
+            });
+        }
+        if let Some(b) = &self.best {
+            self.best_history.push(b.score);
+        }
+    }
+
+    /// Parameters of trials issued and not finished (for the planner).
+    pub fn pending_points(&self) -> Vec<Vec<f64>> {
+        self.trials
+            .values()
+            .filter(|t| {
+                matches!(
+                    t.phase,
+                    TrialPhase::Queued { .. } | TrialPhase::Running { .. }
+                )
+            })
+            .map(|t| t.params.clone())
+            .collect()
+    }
+
+    pub fn completed(&self) -> u64 {
+        self.count(|p| matches!(p, TrialPhase::Completed { .. }))
+    }
+
+    pub fn failed(&self) -> u64 {
+        self.count(|p| matches!(p, TrialPhase::Failed { .. }))
+    }
+
+    pub fn running(&self) -> u64 {
+        self.count(|p| matches!(p, TrialPhase::Running { .. } | TrialPhase::Queued { .. }))
+    }
+
+    fn count(&self, f: impl Fn(&TrialPhase) -> bool) -> u64 {
+        self.trials.values().filter(|t| f(&t.phase)).count() as u64
+    }
+
+    /// Every trial of the budget issued and finished.
+    pub fn finished(&self) -> bool {
+        self.trials.len() as u64 >= self.budget && self.completed() + self.failed() >= self.budget
+    }
+
+    pub fn worker_statuses(&self) -> Vec<WorkerStatus> {
+        self.workers
+            .iter()
+            .map(|(id, w)| WorkerStatus {
+                id: id.clone(),
+                host: w.host.clone(),
+                trial: w.trial,
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use graspopt_protocol::RunId;
+
+    fn result(trial_id: u64, worker: &str, score: f64) -> TrialResult {
+        TrialResult {
+            run_id: RunId::new("r").unwrap(),
+            trial_id,
+            attempt: 1,
+            worker: worker.into(),
+            scorer: "m".into(),
+            score,
+            metrics: None,
+            contacts: 1,
+            fingers_in_contact: 1,
+            cloud_points: 1,
+            cloud_transport: String::new(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_lost_worker_trial_is_requeued_and_completed_once() {
+        let mut s = RunState::new(2);
+        s.worker_up("a", "h");
+        s.worker_up("b", "h");
+        assert_eq!(s.proposals_needed(), 2);
+        let t1 = s.add_trial(vec![0.1]);
+        let t2 = s.add_trial(vec![0.2]);
+        assert_eq!((t1, t2), (1, 2));
+        assert_eq!(s.assign(t1, "a", 100), Some(1));
+        assert_eq!(s.assign(t2, "b", 100), Some(1));
+        assert_eq!(s.proposals_needed(), 0);
+        // Worker a dies holding trial 1.
+        assert_eq!(s.worker_down("a"), Some(1));
+        assert_eq!(s.queued().len(), 1);
+        assert_eq!(s.on_result(&result(2, "b", 0.5)), Disposition::Completed);
+        assert_eq!(s.idle_workers(), vec!["b".to_string()]);
+        assert_eq!(s.assign(1, "b", 200), Some(2));
+        assert_eq!(s.on_result(&result(1, "b", 0.7)), Disposition::Completed);
+        assert_eq!(s.on_result(&result(1, "b", 0.9)), Disposition::Duplicate);
+        assert!(s.finished());
+        assert_eq!(s.completed(), 2);
+        assert_eq!(s.errors.duplicates, 1);
+        assert_eq!(s.errors.reissued, 1);
+        assert_eq!(s.best.as_ref().unwrap().trial_id, 1);
+        assert_eq!(s.best_history, vec![0.5, 0.7]);
+    }
+
+    #[test]
+    fn expired_leases_requeue_and_keep_the_slow_worker_busy() {
+        let mut s = RunState::new(1);
+        s.worker_up("a", "h");
+        let t = s.add_trial(vec![0.0]);
+        s.assign(t, "a", 1000);
+        assert!(s.expire_leases(999).is_empty());
+        assert_eq!(s.expire_leases(1001), vec![t]);
+        assert!(s.idle_workers().is_empty());
+        // The slow worker's late result still completes the trial.
+        assert_eq!(s.on_result(&result(t, "a", 1.0)), Disposition::Completed);
+        assert!(s.finished());
+        assert_eq!(s.on_result(&result(42, "a", 1.0)), Disposition::Unknown);
+        assert_eq!(s.errors.unknown_trial, 1);
+    }
+
+    #[test]
+    fn failures_count_against_the_budget() {
+        let mut s = RunState::new(1);
+        s.worker_up("a", "h");
+        let t = s.add_trial(vec![0.0]);
+        s.assign(t, "a", 10);
+        let mut r = result(t, "a", 0.0);
+        r.error = Some("unreachable".into());
+        assert_eq!(s.on_result(&r), Disposition::Failed);
+        assert!(s.finished());
+        assert!(s.observations.is_empty());
+    }
+}

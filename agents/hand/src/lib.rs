@@ -1,0 +1,195 @@
+//! The hand agent: executes trial commands and sends what the fingers touched.
+//!
+//! This implementation drives the simulated hand: the world holds the object perception names
+//! (at its true pose; `object` in the settings overrides it), the hand is put at the commanded
+//! palm pose, closes until contact, and the raw contact clouds go to the metric agents
+//! (shared memory on the same host, Zenoh otherwise). One trial at a time; `trial_cost_ms`
+//! pads each trial to at least that long, to model a real robot's cycle time. A real hand is
+//! another implementation of the same conversation (see `docs/protocol.md`).
+//!
+//! [`SimulatedHand::execute`] is the logic (no network); [`run`] wires it to the bus.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use graspopt_bus::{Bus, CloudSender, now_ms};
+use graspopt_convert::{TrialTag, clouds_from_outcome, isometry, pose};
+use graspopt_protocol::{AgentKind, ContactClouds, ObjectEstimate, RunId, TrialCommand};
+use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
+use serde::{Deserialize, Serialize};
+
+/// Hand settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HandConfig {
+    pub id: String,
+    /// `barrett` or `parallel_jaw`.
+    pub hand: String,
+    /// The world's object; `None`: the one perception names.
+    pub object: Option<String>,
+    /// A user mesh as the world's object.
+    pub mesh: Option<PathBuf>,
+    /// Minimum duration of a trial (milliseconds), to model a robot's cycle time.
+    pub trial_cost_ms: u64,
+}
+
+impl Default for HandConfig {
+    fn default() -> Self {
+        HandConfig {
+            id: "hand-1".into(),
+            hand: "barrett".into(),
+            object: None,
+            mesh: None,
+            trial_cost_ms: 0,
+        }
+    }
+}
+
+/// A simulated hand in a simulated world.
+#[derive(Debug)]
+pub struct SimulatedHand {
+    hand: Box<dyn Hand>,
+    settings: ContactModelSettings,
+}
+
+impl SimulatedHand {
+    pub fn new(name: &str) -> anyhow::Result<SimulatedHand> {
+        Ok(SimulatedHand {
+            hand: hand_by_name(name).context("hand agent")?,
+            settings: ContactModelSettings::default(),
+        })
+    }
+
+    pub fn name(&self) -> &str {
+        self.hand.name()
+    }
+
+    /// Executes one command on `world` (the object at its true pose). A command the hand
+    /// cannot execute gives clouds with `error` set, not a failure of the agent.
+    pub fn execute(&self, world: &Object, command: &TrialCommand, worker: &str) -> ContactClouds {
+        let tag = TrialTag {
+            run_id: command.run_id.clone(),
+            trial_id: command.trial_id,
+            attempt: command.attempt,
+            worker: worker.to_string(),
+        };
+        let palm = isometry(&command.palm_pose);
+        match run_trial(world, self.hand.as_ref(), &palm, &self.settings) {
+            Ok(outcome) => clouds_from_outcome(&tag, &outcome, now_ms()),
+            Err(e) => ContactClouds {
+                run_id: tag.run_id,
+                trial_id: tag.trial_id,
+                attempt: tag.attempt,
+                worker: tag.worker,
+                hand: self.hand.name().to_string(),
+                palm_pose: pose(&palm),
+                fingers: Vec::new(),
+                min_gap: None,
+                error: Some(format!("hand could not execute the trial: {e}")),
+                executed_ms: now_ms(),
+            },
+        }
+    }
+}
+
+/// The world's object: the configured one, or the one the estimate names at its true pose.
+pub fn world_object(config: &HandConfig, estimate: Option<&ObjectEstimate>) -> Option<Object> {
+    let loaded = match (&config.mesh, &config.object, estimate) {
+        (Some(path), _, _) => Object::from_file(path),
+        (None, Some(name), _) => Object::by_name(name),
+        (None, None, Some(e)) => {
+            let mut truth = e.clone();
+            truth.pose = graspopt_protocol::Pose::IDENTITY;
+            graspopt_convert::object_from_estimate(&truth)
+        }
+        (None, None, None) => return None,
+    };
+    match loaded {
+        Ok(o) => Some(o),
+        Err(e) => {
+            tracing::error!("hand {}: cannot build the world's object: {e}", config.id);
+            None
+        }
+    }
+}
+
+/// Serves trial commands until the task is cancelled.
+pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
+    let hand = Arc::new(SimulatedHand::new(&config.hand)?);
+    let commands = bus
+        .subscribe::<TrialCommand>(&run.command_key(&config.id))
+        .await?;
+    let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
+    let sender = CloudSender::open(bus, run);
+    let mut world: Option<Arc<Object>> = world_object(config, None).map(Arc::new);
+    let mut world_name: Option<String> = None;
+    // Declared last: the coordinator sends commands once it sees the token.
+    let _token = bus.declare_alive(run, AgentKind::Hand, &config.id).await?;
+    let mut bad = 0u64;
+    loop {
+        tokio::select! {
+            Some(r) = objects.recv() => match r.message {
+                Ok(e) if config.object.is_none() && config.mesh.is_none() && world_name.as_deref() != Some(&e.object) => {
+                    world = world_object(config, Some(&e)).map(Arc::new);
+                    world_name = Some(e.object.clone());
+                }
+                Ok(_) => {}
+                Err(e) => {
+                    bad += 1;
+                    tracing::warn!("hand {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
+                }
+            },
+            Some(r) = commands.recv() => {
+                let command = match r.message {
+                    Ok(c) if c.run_id == *run && c.worker == config.id => c,
+                    Ok(c) => {
+                        bad += 1;
+                        tracing::warn!("hand {}: command for {}/{} ignored", config.id, c.run_id, c.worker);
+                        continue;
+                    }
+                    Err(e) => {
+                        bad += 1;
+                        tracing::warn!("hand {}: bad command on {} ({bad} bad messages): {e}", config.id, r.key);
+                        continue;
+                    }
+                };
+                // Wait for the world's object if perception has not spoken yet.
+                while world.is_none() {
+                    match objects.recv().await {
+                        Some(r) => if let Ok(e) = r.message {
+                            world = world_object(config, Some(&e)).map(Arc::new);
+                            world_name = Some(e.object.clone());
+                        },
+                        None => return Ok(()),
+                    }
+                }
+                let Some(object) = world.clone() else { continue };
+                let started = Instant::now();
+                let h = hand.clone();
+                let id = config.id.clone();
+                let mut clouds = if command.hand != hand.name() {
+                    let mut c = h.execute(&object, &command, &id);
+                    c.fingers.clear();
+                    c.error = Some(format!("worker {} has a {} hand, the trial asks for {}", id, hand.name(), command.hand));
+                    c
+                } else {
+                    tokio::task::spawn_blocking(move || h.execute(&object, &command, &id))
+                        .await
+                        .context("hand: trial thread panicked")?
+                };
+                let cost = Duration::from_millis(config.trial_cost_ms);
+                if let Some(rest) = cost.checked_sub(started.elapsed()) {
+                    tokio::time::sleep(rest).await;
+                }
+                clouds.executed_ms = now_ms();
+                if let Err(e) = sender.send(&clouds).await {
+                    tracing::warn!("hand {}: cannot send the clouds of trial {}: {e}", config.id, clouds.trial_id);
+                }
+            },
+            else => return Ok(()),
+        }
+    }
+}

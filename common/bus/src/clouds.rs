@@ -1,0 +1,146 @@
+//! The contact-cloud channel from hand to metric agents.
+//!
+//! A hand sends each trial's clouds through iceoryx2 shared memory when a metric agent of the
+//! same run listens on the same host (the shared-memory service has a subscriber), and over
+//! Zenoh otherwise; the choice is made per message, so a metric agent that starts or stops is
+//! followed. A metric agent listens on both paths at once. Both carry the same bincode
+//! payload.
+
+use graspopt_protocol::{ContactClouds, DecodeError, Encoding, RunId, decode, encode};
+use graspopt_shm::{ShmPublisher, ShmSubscriber};
+use tokio::sync::mpsc;
+
+use crate::{Bus, BusError};
+
+/// Which path a cloud took.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CloudPath {
+    SharedMemory,
+    Zenoh,
+}
+
+impl CloudPath {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CloudPath::SharedMemory => "shm",
+            CloudPath::Zenoh => "zenoh",
+        }
+    }
+}
+
+/// Sends contact clouds.
+pub struct CloudSender {
+    bus: Bus,
+    key: String,
+    shm: Option<ShmPublisher>,
+}
+
+impl CloudSender {
+    /// A sender for the run's clouds. Shared memory is used when available (and not disabled
+    /// on the bus); if it cannot be opened, a warning is logged and Zenoh alone is used.
+    pub fn open(bus: &Bus, run: &RunId) -> CloudSender {
+        let shm =
+            bus.shm().and_then(
+                |cfg| match ShmPublisher::open(cfg, &run.shm_clouds_service()) {
+                    Ok(p) => Some(p),
+                    Err(e) => {
+                        tracing::warn!("shared memory unavailable, clouds go over Zenoh: {e}");
+                        None
+                    }
+                },
+            );
+        CloudSender {
+            bus: bus.clone(),
+            key: run.clouds_key(),
+            shm,
+        }
+    }
+
+    /// Sends one trial's clouds and says which path they took.
+    pub async fn send(&self, clouds: &ContactClouds) -> Result<CloudPath, BusError> {
+        if let Some(shm) = &self.shm
+            && shm.subscriber_count().unwrap_or(0) > 0
+        {
+            let bytes = encode(clouds, Encoding::Bincode)?;
+            match shm.send(&bytes) {
+                Ok(()) => return Ok(CloudPath::SharedMemory),
+                Err(e) => tracing::warn!("shared-memory send failed, using Zenoh: {e}"),
+            }
+        }
+        self.bus.put(&self.key, clouds, Encoding::Bincode).await?;
+        Ok(CloudPath::Zenoh)
+    }
+}
+
+/// Clouds received on either path.
+#[derive(Debug)]
+pub struct ReceivedClouds {
+    pub path: CloudPath,
+    pub size: usize,
+    pub message: Result<ContactClouds, DecodeError>,
+}
+
+/// Receives contact clouds from both paths.
+pub struct CloudReceiver {
+    rx: mpsc::Receiver<ReceivedClouds>,
+    _shm: Option<ShmSubscriber>,
+    task: tokio::task::JoinHandle<()>,
+}
+
+impl Drop for CloudReceiver {
+    fn drop(&mut self) {
+        self.task.abort();
+    }
+}
+
+impl CloudReceiver {
+    /// Listens for the run's clouds on Zenoh and, when available, on shared memory.
+    pub async fn open(bus: &Bus, run: &RunId) -> Result<CloudReceiver, BusError> {
+        let (tx, rx) = mpsc::channel(1024);
+        let shm = match bus.shm() {
+            Some(cfg) => {
+                let tx = tx.clone();
+                let on_message = move |bytes: &[u8]| {
+                    let received = ReceivedClouds {
+                        path: CloudPath::SharedMemory,
+                        size: bytes.len(),
+                        message: decode::<ContactClouds>(bytes, Encoding::Bincode),
+                    };
+                    // The receiver gone means the agent is stopping: nothing to do.
+                    let _ = tx.blocking_send(received);
+                };
+                match ShmSubscriber::open(cfg, &run.shm_clouds_service(), on_message) {
+                    Ok(s) => Some(s),
+                    Err(e) => {
+                        tracing::warn!("shared memory unavailable, clouds come over Zenoh: {e}");
+                        None
+                    }
+                }
+            }
+            None => None,
+        };
+        let sub = bus.subscribe::<ContactClouds>(&run.clouds_key()).await?;
+        let task = tokio::spawn(async move {
+            while let Some(r) = sub.recv().await {
+                let received = ReceivedClouds {
+                    path: CloudPath::Zenoh,
+                    size: r.size,
+                    message: r.message,
+                };
+                if tx.send(received).await.is_err() {
+                    break;
+                }
+            }
+        });
+        Ok(CloudReceiver {
+            rx,
+            _shm: shm,
+            task,
+        })
+    }
+
+    /// The next clouds; `None` when both paths closed.
+    pub async fn recv(&mut self) -> Option<ReceivedClouds> {
+        self.rx.recv().await
+    }
+}

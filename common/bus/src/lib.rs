@@ -1,0 +1,40 @@
+//! graspopt on the network. This crate and `graspopt-protocol` are the only common crates that
+//! know there is a network:
+//!
+//! - [`args`]: one flag set for every tool and agent (`--connect`, `--listen`, `--mode`,
+//!   `--zenoh-config`, `--no-multicast-scouting`, `--shm-prefix`, `--no-shm`).
+//! - [`session`]: a [`Bus`]: a Zenoh session plus typed put / subscribe / query / serve over the
+//!   protocol's codecs. Trial commands and results are put with `CongestionControl::Block`:
+//!   they are never dropped under congestion. Payloads that do not decode are handed to the
+//!   caller as errors (to count and log), never acted on.
+//! - [`alive`]: liveliness tokens and watching who is alive.
+//! - [`clouds`]: the contact-cloud channel: iceoryx2 shared memory when a metric agent listens
+//!   on the same host, Zenoh otherwise, chosen per message.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod alive;
+pub mod args;
+pub mod clouds;
+pub mod error;
+pub mod session;
+
+pub use alive::{AliveEvent, AliveWatch};
+pub use args::{BusArgs, BusMode};
+pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
+pub use error::BusError;
+pub use session::{Bus, Incoming, Received, Server, Subscription};
+
+/// A free TCP port on the loopback interface (bound then released: for tests and for the
+/// embedded run's default listener).
+pub fn free_loopback_port() -> std::io::Result<u16> {
+    let listener = std::net::TcpListener::bind(("127.0.0.1", 0))?;
+    Ok(listener.local_addr()?.port())
+}
+
+/// Milliseconds since the Unix epoch.
+pub fn now_ms() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_millis() as i64)
+        .unwrap_or(0)
+}

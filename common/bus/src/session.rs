@@ -1,0 +1,332 @@
+//! A [`Bus`]: one Zenoh session and typed operations on it.
+
+use std::marker::PhantomData;
+use std::time::Duration;
+
+use graspopt_protocol::{Encoding, Message, decode, encode};
+use zenoh::Session;
+use zenoh::bytes::Encoding as ZEncoding;
+use zenoh::handlers::{FifoChannel, FifoChannelHandler, RingChannel, RingChannelHandler};
+use zenoh::pubsub::Subscriber;
+use zenoh::qos::CongestionControl;
+use zenoh::query::{Query, Queryable};
+use zenoh::sample::Sample;
+
+use crate::{BusArgs, BusError};
+
+/// The protocol encoding as a Zenoh encoding.
+pub fn zenoh_encoding(encoding: Encoding) -> ZEncoding {
+    match encoding {
+        Encoding::Json => ZEncoding::APPLICATION_JSON,
+        Encoding::Bincode => ZEncoding::from(encoding.mime()),
+    }
+}
+
+/// The protocol encoding a Zenoh encoding declares.
+pub fn protocol_encoding(encoding: &ZEncoding) -> Encoding {
+    Encoding::from_mime(&encoding.to_string())
+}
+
+/// A joined bus.
+#[derive(Clone)]
+pub struct Bus {
+    session: Session,
+    host: String,
+    shm: Option<graspopt_shm::ShmConfig>,
+}
+
+impl std::fmt::Debug for Bus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bus")
+            .field("host", &self.host)
+            .field("shm", &self.shm.is_some())
+            .finish()
+    }
+}
+
+/// This host's name as a key chunk (`GRASPOPT_HOST` overrides, for tests that pretend to be
+/// on several hosts).
+pub fn host_name() -> String {
+    let raw = std::env::var("GRASPOPT_HOST")
+        .ok()
+        .or_else(|| std::fs::read_to_string("/etc/hostname").ok())
+        .unwrap_or_else(|| "localhost".to_string());
+    graspopt_protocol::keys::sanitize_chunk(raw.trim())
+}
+
+impl Bus {
+    /// Opens a session from the flags.
+    pub async fn open(args: &BusArgs) -> Result<Bus, BusError> {
+        let config = args.zenoh_config()?;
+        let session = zenoh::open(config)
+            .await
+            .map_err(|e| BusError::zenoh("opening the session", e))?;
+        let shm = if args.no_shm {
+            None
+        } else {
+            let prefix = args
+                .shm_prefix
+                .clone()
+                .unwrap_or_else(|| graspopt_shm::PREFIX_BASE.to_string());
+            let config = graspopt_shm::ShmConfig {
+                prefix,
+                ..graspopt_shm::ShmConfig::default()
+            };
+            // Resources of processes that died under this prefix (a killed worker).
+            if let Err(e) = graspopt_shm::clean_stale(&config) {
+                tracing::warn!("shared memory: stale-resource cleanup failed: {e}");
+            }
+            Some(config)
+        };
+        Ok(Bus {
+            session,
+            host: host_name(),
+            shm,
+        })
+    }
+
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
+    /// This host's name (a key chunk).
+    pub fn host(&self) -> &str {
+        &self.host
+    }
+
+    /// Shared-memory settings, unless disabled.
+    pub fn shm(&self) -> Option<&graspopt_shm::ShmConfig> {
+        self.shm.as_ref()
+    }
+
+    /// Puts a message reliably: blocks under congestion rather than dropping (trial
+    /// commands, clouds, results).
+    pub async fn put<T: Message>(
+        &self,
+        key: &str,
+        msg: &T,
+        encoding: Encoding,
+    ) -> Result<(), BusError> {
+        let bytes = encode(msg, encoding)?;
+        self.put_bytes(key, bytes, encoding, CongestionControl::Block)
+            .await
+    }
+
+    /// Puts a message that a newer one soon replaces (status): dropped under congestion.
+    pub async fn put_droppable<T: Message>(
+        &self,
+        key: &str,
+        msg: &T,
+        encoding: Encoding,
+    ) -> Result<(), BusError> {
+        let bytes = encode(msg, encoding)?;
+        self.put_bytes(key, bytes, encoding, CongestionControl::Drop)
+            .await
+    }
+
+    /// Puts raw bytes declared as `encoding` (tests and tools).
+    pub async fn put_bytes(
+        &self,
+        key: &str,
+        bytes: Vec<u8>,
+        encoding: Encoding,
+        congestion: CongestionControl,
+    ) -> Result<(), BusError> {
+        self.session
+            .put(key, bytes)
+            .encoding(zenoh_encoding(encoding))
+            .congestion_control(congestion)
+            .await
+            .map_err(|e| BusError::zenoh(format!("put on {key}"), e))
+    }
+
+    /// Subscribes to `key` with a bounded queue (back-pressure on the sender's side when the
+    /// queue is full: for agents that keep up).
+    pub async fn subscribe<T: Message>(&self, key: &str) -> Result<Subscription<T>, BusError> {
+        let sub = self
+            .session
+            .declare_subscriber(key)
+            .with(FifoChannel::new(1024))
+            .await
+            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))?;
+        Ok(Subscription {
+            inner: Inner::Fifo(sub),
+            _t: PhantomData,
+        })
+    }
+
+    /// Subscribes to `key` through a ring buffer of `capacity` samples: a slow reader loses
+    /// the oldest samples and never slows the publishers (monitors, terminals).
+    pub async fn subscribe_ring<T: Message>(
+        &self,
+        key: &str,
+        capacity: usize,
+    ) -> Result<Subscription<T>, BusError> {
+        let sub = self
+            .session
+            .declare_subscriber(key)
+            .with(RingChannel::new(capacity.max(1)))
+            .await
+            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))?;
+        Ok(Subscription {
+            inner: Inner::Ring(sub),
+            _t: PhantomData,
+        })
+    }
+
+    /// Sends a query and decodes the first reply.
+    pub async fn query<Q: Message, R: Message>(
+        &self,
+        key: &str,
+        request: &Q,
+        timeout: Duration,
+    ) -> Result<R, BusError> {
+        let bytes = encode(request, Encoding::Bincode)?;
+        let replies = self
+            .session
+            .get(key)
+            .payload(bytes)
+            .encoding(zenoh_encoding(Encoding::Bincode))
+            .timeout(timeout)
+            .await
+            .map_err(|e| BusError::zenoh(format!("query on {key}"), e))?;
+        match replies.recv_async().await {
+            Ok(reply) => match reply.result() {
+                Ok(sample) => {
+                    let enc = protocol_encoding(sample.encoding());
+                    Ok(decode::<R>(&sample.payload().to_bytes(), enc)?)
+                }
+                Err(err) => Err(BusError::ReplyError {
+                    key: key.to_string(),
+                    detail: String::from_utf8_lossy(&err.payload().to_bytes()).into_owned(),
+                }),
+            },
+            Err(_) => Err(BusError::NoReply {
+                key: key.to_string(),
+                timeout_ms: timeout.as_millis() as u64,
+            }),
+        }
+    }
+
+    /// Answers queries on `key`.
+    pub async fn serve<Q: Message>(&self, key: &str) -> Result<Server<Q>, BusError> {
+        let queryable = self
+            .session
+            .declare_queryable(key)
+            .await
+            .map_err(|e| BusError::zenoh(format!("serving {key}"), e))?;
+        Ok(Server {
+            queryable,
+            _q: PhantomData,
+        })
+    }
+
+    /// Closes the session (liveliness tokens vanish at once for the others).
+    pub async fn close(&self) -> Result<(), BusError> {
+        self.session
+            .close()
+            .await
+            .map_err(|e| BusError::zenoh("closing the session", e))
+    }
+}
+
+enum Inner {
+    Fifo(Subscriber<FifoChannelHandler<Sample>>),
+    Ring(Subscriber<RingChannelHandler<Sample>>),
+}
+
+/// A sample received on a subscription: the key it came on and the decoded message, or why
+/// it did not decode.
+#[derive(Debug)]
+pub struct Received<T> {
+    pub key: String,
+    pub encoding: Encoding,
+    pub size: usize,
+    pub message: Result<T, graspopt_protocol::DecodeError>,
+}
+
+/// A typed subscription.
+pub struct Subscription<T> {
+    inner: Inner,
+    _t: PhantomData<fn() -> T>,
+}
+
+impl<T: Message> Subscription<T> {
+    /// The next sample; `None` when the session closed.
+    pub async fn recv(&self) -> Option<Received<T>> {
+        let sample = match &self.inner {
+            Inner::Fifo(s) => s.recv_async().await.ok()?,
+            Inner::Ring(s) => s.recv_async().await.ok()?,
+        };
+        Some(decode_sample(&sample))
+    }
+}
+
+/// Decodes a sample as a `T`, by its declared encoding.
+pub fn decode_sample<T: Message>(sample: &Sample) -> Received<T> {
+    let encoding = protocol_encoding(sample.encoding());
+    let bytes = sample.payload().to_bytes();
+    Received {
+        key: sample.key_expr().as_str().to_string(),
+        encoding,
+        size: bytes.len(),
+        message: decode::<T>(&bytes, encoding),
+    }
+}
+
+/// Answers queries.
+pub struct Server<Q> {
+    queryable: Queryable<FifoChannelHandler<Query>>,
+    _q: PhantomData<fn() -> Q>,
+}
+
+/// One query: the decoded request (or why it did not decode) and the means to answer.
+pub struct Incoming<Q> {
+    query: Query,
+    pub request: Result<Q, graspopt_protocol::DecodeError>,
+}
+
+impl<Q: Message> Server<Q> {
+    /// The next query; `None` when the session closed.
+    pub async fn recv(&self) -> Option<Incoming<Q>> {
+        let query = self.queryable.recv_async().await.ok()?;
+        let request = match query.payload() {
+            Some(p) => {
+                let enc = query
+                    .encoding()
+                    .map(protocol_encoding)
+                    .unwrap_or(Encoding::Bincode);
+                decode::<Q>(&p.to_bytes(), enc)
+            }
+            None => Err(graspopt_protocol::DecodeError::Empty {
+                message_type: Q::TYPE,
+            }),
+        };
+        Some(Incoming { query, request })
+    }
+}
+
+impl<Q> Incoming<Q> {
+    /// Answers with a message, in the encoding the request came in.
+    pub async fn reply<R: Message>(&self, reply: &R) -> Result<(), BusError> {
+        let enc = self
+            .query
+            .encoding()
+            .map(protocol_encoding)
+            .unwrap_or(Encoding::Bincode);
+        let bytes = encode(reply, enc)?;
+        self.query
+            .reply(self.query.key_expr().clone(), bytes)
+            .encoding(zenoh_encoding(enc))
+            .await
+            .map_err(|e| BusError::zenoh("replying", e))
+    }
+
+    /// Answers with an error text.
+    pub async fn reply_error(&self, text: &str) -> Result<(), BusError> {
+        self.query
+            .reply_err(text.as_bytes().to_vec())
+            .await
+            .map_err(|e| BusError::zenoh("replying with an error", e))
+    }
+}

@@ -1,0 +1,189 @@
+//! Conversions between the wire messages of `graspopt-protocol` (plain arrays, so that agents
+//! in other languages can write them) and the nalgebra / simulator / quality types the
+//! algorithm crates use. Agents convert here and nowhere else.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+use graspopt_protocol::{
+    CloudPoint, ContactClouds, FingerCloud, MeshData, MetricValues, ObjectEstimate, Pose, RunId,
+};
+use graspopt_quality::metrics::Metrics;
+use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
+use graspopt_trial::measured::{MeasuredFinger, MeasuredTrial};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+/// A wire pose as an isometry (the quaternion is renormalised).
+pub fn isometry(pose: &Pose) -> Isometry3<f64> {
+    let [w, x, y, z] = pose.rotation;
+    let q = UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z));
+    let [tx, ty, tz] = pose.translation;
+    Isometry3::from_parts(Translation3::new(tx, ty, tz), q)
+}
+
+/// An isometry as a wire pose.
+pub fn pose(iso: &Isometry3<f64>) -> Pose {
+    let q = iso.rotation.quaternion();
+    let t = iso.translation.vector;
+    Pose {
+        translation: [t.x, t.y, t.z],
+        rotation: [q.w, q.i, q.j, q.k],
+    }
+}
+
+/// The object an estimate describes, placed at the estimated pose.
+pub fn object_from_estimate(estimate: &ObjectEstimate) -> Result<Object, SimError> {
+    let object = match &estimate.mesh {
+        Some(mesh) => {
+            let vertices = mesh
+                .vertices
+                .iter()
+                .map(|v| Point3::new(v[0], v[1], v[2]))
+                .collect();
+            Object::from_mesh(
+                &estimate.object,
+                TriangleMesh::new(vertices, mesh.triangles.clone()),
+            )?
+        }
+        None => Object::by_name(&estimate.object)?,
+    };
+    object.with_pose(isometry(&estimate.pose))
+}
+
+/// The mesh to send with an object that is not built in (its surface in its own frame).
+pub fn mesh_data(object: &Object) -> MeshData {
+    let local = object.surface_mesh().transformed(&object.pose().inverse());
+    MeshData {
+        vertices: local.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        triangles: local.triangles.clone(),
+    }
+}
+
+fn cloud_point(c: &ContactPoint) -> CloudPoint {
+    CloudPoint {
+        p: [c.position.x, c.position.y, c.position.z],
+        n: [c.normal.x, c.normal.y, c.normal.z],
+    }
+}
+
+fn contact_point(c: &CloudPoint) -> ContactPoint {
+    ContactPoint {
+        position: Point3::new(c.p[0], c.p[1], c.p[2]),
+        normal: Vector3::new(c.n[0], c.n[1], c.n[2]),
+    }
+}
+
+/// Identifies one trial attempt on the wire.
+#[derive(Debug, Clone)]
+pub struct TrialTag {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    pub attempt: u32,
+    pub worker: String,
+}
+
+/// The clouds message of a simulated trial (raw clouds only; models are the metric's job).
+pub fn clouds_from_outcome(tag: &TrialTag, outcome: &TrialOutcome, at_ms: i64) -> ContactClouds {
+    let measured = MeasuredTrial::from_outcome(outcome);
+    ContactClouds {
+        run_id: tag.run_id.clone(),
+        trial_id: tag.trial_id,
+        attempt: tag.attempt,
+        worker: tag.worker.clone(),
+        hand: measured.hand.clone(),
+        palm_pose: pose(&measured.palm_pose),
+        fingers: measured
+            .fingers
+            .iter()
+            .map(|f| FingerCloud {
+                finger: f.finger.map(|i| i as u32),
+                links: f.links.clone(),
+                points: f.points.iter().map(cloud_point).collect(),
+            })
+            .collect(),
+        min_gap: measured.min_gap,
+        error: None,
+        executed_ms: at_ms,
+    }
+}
+
+/// What the hand measured, from its message.
+pub fn measured_from_clouds(clouds: &ContactClouds) -> MeasuredTrial {
+    MeasuredTrial {
+        hand: clouds.hand.clone(),
+        palm_pose: isometry(&clouds.palm_pose),
+        fingers: clouds
+            .fingers
+            .iter()
+            .map(|f| MeasuredFinger {
+                finger: f.finger.map(|i| i as usize),
+                links: f.links.clone(),
+                points: f.points.iter().map(contact_point).collect(),
+            })
+            .collect(),
+        min_gap: clouds.min_gap,
+    }
+}
+
+/// Metric values on the wire.
+pub fn metric_values(m: &Metrics) -> MetricValues {
+    MetricValues {
+        rank: m.rank as u32,
+        force_closure: m.force_closure,
+        epsilon: m.epsilon,
+        volume: m.volume,
+        distance: m.distance,
+        bw: m.bw,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn poses_round_trip() {
+        let iso = Isometry3::from_parts(
+            Translation3::new(0.1, -0.2, 0.3),
+            UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1),
+        );
+        let back = isometry(&pose(&iso));
+        assert!((back.to_homogeneous() - iso.to_homogeneous()).norm() < 1e-12);
+        assert!(pose(&iso).validate("pose").is_ok());
+    }
+
+    #[test]
+    fn an_estimate_places_the_named_object() {
+        let iso = Isometry3::translation(0.01, 0.0, 0.0);
+        let estimate = ObjectEstimate {
+            run_id: RunId::new("r").unwrap(),
+            object: "cuboid".into(),
+            mesh: None,
+            pose: pose(&iso),
+            seq: 1,
+            stamp_ms: 0,
+            source: "test".into(),
+        };
+        let placed = object_from_estimate(&estimate).unwrap();
+        let base = Object::by_name("cuboid").unwrap();
+        let shift = placed.centre_of_mass() - base.centre_of_mass();
+        assert!((shift - Vector3::new(0.01, 0.0, 0.0)).norm() < 1e-12);
+        let mut bad = estimate.clone();
+        bad.object = "teapot".into();
+        assert!(object_from_estimate(&bad).is_err());
+    }
+
+    #[test]
+    fn a_mesh_estimate_rebuilds_the_object() {
+        let base = Object::by_name("cuboid").unwrap();
+        let estimate = ObjectEstimate {
+            run_id: RunId::new("r").unwrap(),
+            object: "my_box".into(),
+            mesh: Some(mesh_data(&base)),
+            pose: Pose::IDENTITY,
+            seq: 1,
+            stamp_ms: 0,
+            source: "test".into(),
+        };
+        let rebuilt = object_from_estimate(&estimate).unwrap();
+        assert!((rebuilt.centre_of_mass() - base.centre_of_mass()).norm() < 1e-9);
+    }
+}

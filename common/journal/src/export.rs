@@ -1,0 +1,129 @@
+//! A run's trials as CSV (one row per trial) or JSON (`{"run": .., "trials": [..]}`).
+
+use std::borrow::Cow;
+use std::io::Write;
+
+use crate::error::Result;
+use crate::journal::Journal;
+use crate::types::TrialRow;
+
+/// The columns after `completed_ms` and the parameter columns.
+const RESULT_COLUMNS: [&str; 11] = [
+    "score",
+    "rank",
+    "force_closure",
+    "epsilon",
+    "volume",
+    "distance",
+    "bw",
+    "contacts",
+    "fingers_in_contact",
+    "cloud_points",
+    "error",
+];
+
+/// Writes the run's trials as CSV, one row per trial by trial id.
+///
+/// Header: `trial,state,attempts,worker,issued_ms,completed_ms,<param
+/// names...>,score,rank,force_closure,epsilon,volume,distance,bw,contacts,
+/// fingers_in_contact,cloud_points,error`. A `None` is an empty field, and so
+/// are the result columns of a trial without a result. Numbers are written
+/// so that they parse back to the same f64. Fields containing a comma, a
+/// double quote, CR or LF are quoted per RFC 4180; lines end with `\n`.
+/// An unknown run is [`crate::JournalError::UnknownRun`].
+pub fn write_csv(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result<()> {
+    let export = journal.export(run_id)?;
+    let mut header: Vec<&str> = vec![
+        "trial",
+        "state",
+        "attempts",
+        "worker",
+        "issued_ms",
+        "completed_ms",
+    ];
+    header.extend(export.run.param_names.iter().map(String::as_str));
+    header.extend(RESULT_COLUMNS);
+    let mut line = String::new();
+    push_record(&mut line, header.iter().map(|h| Cow::Borrowed(*h)));
+    out.write_all(line.as_bytes())?;
+    for trial in &export.trials {
+        line.clear();
+        push_record(&mut line, trial_fields(trial));
+        out.write_all(line.as_bytes())?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// Writes `{"run": RunRecord, "trials": [TrialRow, ...]}` as pretty JSON
+/// (a [`crate::RunExport`]); an unknown run is [`crate::JournalError::UnknownRun`].
+pub fn write_json(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result<()> {
+    let export = journal.export(run_id)?;
+    serde_json::to_writer_pretty(&mut *out, &export)?;
+    out.write_all(b"\n")?;
+    out.flush()?;
+    Ok(())
+}
+
+fn num<T: std::fmt::Debug>(v: T) -> Cow<'static, str> {
+    // Debug of f64 is the shortest text that parses back to the same value
+    // (with an exponent for very large or small magnitudes); for integers it
+    // is the plain number.
+    Cow::Owned(format!("{v:?}"))
+}
+
+fn opt<T: std::fmt::Debug>(v: Option<T>) -> Cow<'static, str> {
+    v.map_or(Cow::Borrowed(""), num)
+}
+
+fn trial_fields(t: &TrialRow) -> Vec<Cow<'_, str>> {
+    let mut f: Vec<Cow<'_, str>> = vec![
+        num(t.trial_id),
+        Cow::Borrowed(t.state.as_str()),
+        num(t.attempts),
+        Cow::Borrowed(t.worker.as_str()),
+        num(t.issued_ms),
+        opt(t.completed_ms),
+    ];
+    f.extend(t.params.iter().map(|p| num(*p)));
+    let m = t.metrics.as_ref();
+    let has_result = t.score.is_some();
+    f.push(opt(t.score));
+    f.push(opt(m.map(|m| m.rank)));
+    f.push(opt(m.map(|m| m.force_closure)));
+    f.push(opt(m.map(|m| m.epsilon)));
+    f.push(opt(m.and_then(|m| m.volume)));
+    f.push(opt(m.map(|m| m.distance)));
+    f.push(opt(m.map(|m| m.bw)));
+    f.push(opt(has_result.then_some(t.contacts)));
+    f.push(opt(has_result.then_some(t.fingers_in_contact)));
+    f.push(opt(has_result.then_some(t.cloud_points)));
+    f.push(t.error.as_deref().map_or(Cow::Borrowed(""), Cow::Borrowed));
+    f
+}
+
+/// Appends one CSV record (with its line end) to `line`.
+fn push_record<'a>(line: &mut String, fields: impl IntoIterator<Item = Cow<'a, str>>) {
+    for (i, field) in fields.into_iter().enumerate() {
+        if i > 0 {
+            line.push(',');
+        }
+        push_field(line, &field);
+    }
+    line.push('\n');
+}
+
+fn push_field(line: &mut String, field: &str) {
+    if field.contains([',', '"', '\r', '\n']) {
+        line.push('"');
+        for c in field.chars() {
+            if c == '"' {
+                line.push('"');
+            }
+            line.push(c);
+        }
+        line.push('"');
+    } else {
+        line.push_str(field);
+    }
+}

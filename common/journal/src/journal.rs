@@ -1,0 +1,737 @@
+//! The [`Journal`]: one SQLite connection and the operations on it.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use rusqlite::types::Type;
+use rusqlite::{Connection, OptionalExtension, Row, Transaction, TransactionBehavior, params};
+
+use crate::error::{JournalError, Result};
+use crate::schema;
+use crate::types::{
+    EventRow, MetricValues, ResultOutcome, RunExport, RunRecord, RunStatus, StateCounts,
+    TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+};
+
+/// How long a statement waits for another connection's lock before failing.
+const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Columns read into a [`TrialRow`], in the order [`trial_from_row`] expects.
+const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, issued_ms, \
+     lease_until_ms, completed_ms, result_attempt, score, rank, force_closure, epsilon, volume, \
+     distance, bw, contacts, fingers_in_contact, cloud_points, details_json, error";
+
+/// The durable trial journal: runs, trials and their event log in one SQLite
+/// database file (write-ahead log, so a killed process loses at most the
+/// transaction it was in, and readers in other connections never block the writer).
+///
+/// Every write method is one transaction. The journal is `Send` but not
+/// `Sync`: one thread (or a mutex) owns it.
+pub struct Journal {
+    conn: Connection,
+    path: Option<PathBuf>,
+}
+
+impl std::fmt::Debug for Journal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Journal").field("path", &self.path).finish()
+    }
+}
+
+impl Journal {
+    /// Opens (creating if needed) the journal at `path`: WAL mode,
+    /// `synchronous=NORMAL` (survives a kill -9 of the process at any point;
+    /// a power loss may lose the last transactions but never corrupts),
+    /// foreign keys on, busy timeout 5 s, schema created or checked.
+    pub fn open(path: &Path) -> Result<Journal> {
+        let conn = Connection::open(path)?;
+        conn.busy_timeout(BUSY_TIMEOUT)?;
+        let mode: String = conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get(0))?;
+        if !mode.eq_ignore_ascii_case("wal") {
+            return Err(JournalError::JournalMode(mode));
+        }
+        Self::init(conn, Some(path.to_path_buf()))
+    }
+
+    /// A journal that lives only as long as this value (for tests and dry runs).
+    pub fn open_in_memory() -> Result<Journal> {
+        let conn = Connection::open_in_memory()?;
+        conn.busy_timeout(BUSY_TIMEOUT)?;
+        Self::init(conn, None)
+    }
+
+    fn init(mut conn: Connection, path: Option<PathBuf>) -> Result<Journal> {
+        conn.execute_batch("PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON;")?;
+        let fk: i64 = conn.query_row("PRAGMA foreign_keys", [], |r| r.get(0))?;
+        if fk != 1 {
+            return Err(JournalError::Schema(
+                "this SQLite build cannot enforce foreign keys".to_string(),
+            ));
+        }
+        schema::ensure(&mut conn)?;
+        Ok(Journal { conn, path })
+    }
+
+    /// The file this journal was opened from (`None` in memory).
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    fn write_tx(&mut self) -> Result<Transaction<'_>> {
+        Ok(self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)?)
+    }
+
+    /// A read transaction, so that multi-statement reads see one snapshot even
+    /// while another process writes.
+    fn read_tx(&self) -> Result<Transaction<'_>> {
+        Ok(self.conn.unchecked_transaction()?)
+    }
+
+    // ----------------------------------------------------------------- runs
+
+    /// Records a new run. Idempotent when the same run id exists with the same
+    /// config (equal text, or equal JSON values) and parameter names; otherwise
+    /// [`JournalError::ConfigMismatch`] naming the run, and nothing changes.
+    pub fn create_run(&mut self, run: &RunRecord) -> Result<()> {
+        let names_json = serde_json::to_string(&run.param_names)?;
+        let tx = self.write_tx()?;
+        let existing: Option<(String, String)> = tx
+            .query_row(
+                "SELECT config_json, param_names FROM runs WHERE run_id = ?1",
+                [&run.run_id],
+                |r| Ok((r.get(0)?, r.get(1)?)),
+            )
+            .optional()?;
+        match existing {
+            Some((config, names)) => {
+                let names: Vec<String> = serde_json::from_str(&names)?;
+                if same_json(&config, &run.config_json) && names == run.param_names {
+                    Ok(())
+                } else {
+                    Err(JournalError::ConfigMismatch {
+                        run_id: run.run_id.clone(),
+                    })
+                }
+            }
+            None => {
+                tx.execute(
+                    "INSERT INTO runs (run_id, created_ms, config_json, param_names, status, status_ms)
+                     VALUES (?1, ?2, ?3, ?4, ?5, ?2)",
+                    params![
+                        run.run_id,
+                        run.created_ms,
+                        run.config_json,
+                        names_json,
+                        run.status.as_str()
+                    ],
+                )?;
+                tx.commit()?;
+                Ok(())
+            }
+        }
+    }
+
+    /// The run, if the journal has it.
+    pub fn run(&self, run_id: &str) -> Result<Option<RunRecord>> {
+        let mut stmt = self.conn.prepare_cached(
+            "SELECT run_id, created_ms, config_json, param_names, status FROM runs WHERE run_id = ?1",
+        )?;
+        Ok(stmt.query_row([run_id], run_from_row).optional()?)
+    }
+
+    /// All runs, oldest first (ties in insertion order).
+    pub fn runs(&self) -> Result<Vec<RunRecord>> {
+        let mut stmt = self.conn.prepare_cached(
+            "SELECT run_id, created_ms, config_json, param_names, status FROM runs
+             ORDER BY created_ms, rowid",
+        )?;
+        let rows = stmt
+            .query_map([], run_from_row)?
+            .collect::<rusqlite::Result<Vec<_>>>()?;
+        Ok(rows)
+    }
+
+    /// Sets a run's status; [`JournalError::UnknownRun`] if there is no such run.
+    pub fn set_run_status(&mut self, run_id: &str, status: RunStatus, at_ms: i64) -> Result<()> {
+        let tx = self.write_tx()?;
+        let n = tx.execute(
+            "UPDATE runs SET status = ?2, status_ms = ?3 WHERE run_id = ?1",
+            params![run_id, status.as_str(), at_ms],
+        )?;
+        if n == 0 {
+            return Err(JournalError::UnknownRun(run_id.to_string()));
+        }
+        tx.commit()?;
+        Ok(())
+    }
+
+    // --------------------------------------------------------------- trials
+
+    /// A trial issued to a worker (attempt 1: inserts the trial row, event
+    /// `issued`) or re-issued (attempt n+1: updates attempts, worker and lease,
+    /// event `reissued` whose note is `reason`). The state is Running.
+    ///
+    /// Refused, with nothing written: an unknown run; a parameter count that
+    /// differs from the run's parameter names; a non-finite parameter; an
+    /// attempt that is not the next one; re-issuing a completed or failed
+    /// trial; re-issuing with different parameters.
+    pub fn record_issue(&mut self, issue: &TrialIssue) -> Result<()> {
+        for (i, p) in issue.params.iter().enumerate() {
+            check_finite(|| format!("params[{i}]"), *p)?;
+        }
+        let id = db_id(issue.trial_id)?;
+        let params_json = serde_json::to_string(&issue.params)?;
+        let tx = self.write_tx()?;
+        let names: Option<String> = tx
+            .query_row(
+                "SELECT param_names FROM runs WHERE run_id = ?1",
+                [&issue.run_id],
+                |r| r.get(0),
+            )
+            .optional()?;
+        let Some(names) = names else {
+            return Err(JournalError::UnknownRun(issue.run_id.clone()));
+        };
+        let names: Vec<String> = serde_json::from_str(&names)?;
+        if names.len() != issue.params.len() {
+            return Err(JournalError::ParamCount {
+                run_id: issue.run_id.clone(),
+                trial_id: issue.trial_id,
+                expected: names.len(),
+                found: issue.params.len(),
+            });
+        }
+        let existing: Option<(String, u32, String)> = tx
+            .query_row(
+                "SELECT state, attempts, params FROM trials WHERE run_id = ?1 AND trial_id = ?2",
+                params![issue.run_id, id],
+                |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
+            )
+            .optional()?;
+        match existing {
+            None => {
+                if issue.attempt != 1 {
+                    return Err(JournalError::AttemptMismatch {
+                        run_id: issue.run_id.clone(),
+                        trial_id: issue.trial_id,
+                        expected: 1,
+                        found: issue.attempt,
+                    });
+                }
+                tx.execute(
+                    "INSERT INTO trials (run_id, trial_id, state, attempts, params, worker,
+                                         issued_ms, lease_until_ms)
+                     VALUES (?1, ?2, 'running', 1, ?3, ?4, ?5, ?6)",
+                    params![
+                        issue.run_id,
+                        id,
+                        params_json,
+                        issue.worker,
+                        issue.at_ms,
+                        issue.lease_until_ms
+                    ],
+                )?;
+                insert_event(
+                    &tx,
+                    &issue.run_id,
+                    id,
+                    issue.attempt,
+                    event_kind::ISSUED,
+                    &issue.worker,
+                    issue.at_ms,
+                    issue.reason.as_deref(),
+                )?;
+            }
+            Some((state, attempts, stored_params)) => {
+                let state = parse_state(&state)?;
+                if state != TrialState::Running {
+                    return Err(JournalError::TrialClosed {
+                        run_id: issue.run_id.clone(),
+                        trial_id: issue.trial_id,
+                        state,
+                    });
+                }
+                let expected = attempts.saturating_add(1);
+                if issue.attempt != expected {
+                    return Err(JournalError::AttemptMismatch {
+                        run_id: issue.run_id.clone(),
+                        trial_id: issue.trial_id,
+                        expected,
+                        found: issue.attempt,
+                    });
+                }
+                let stored: Vec<f64> = serde_json::from_str(&stored_params)?;
+                if !same_bits(&stored, &issue.params) {
+                    return Err(JournalError::ParamsMismatch {
+                        run_id: issue.run_id.clone(),
+                        trial_id: issue.trial_id,
+                    });
+                }
+                tx.execute(
+                    "UPDATE trials SET attempts = ?3, worker = ?4, lease_until_ms = ?5
+                     WHERE run_id = ?1 AND trial_id = ?2",
+                    params![
+                        issue.run_id,
+                        id,
+                        issue.attempt,
+                        issue.worker,
+                        issue.lease_until_ms
+                    ],
+                )?;
+                insert_event(
+                    &tx,
+                    &issue.run_id,
+                    id,
+                    issue.attempt,
+                    event_kind::REISSUED,
+                    &issue.worker,
+                    issue.at_ms,
+                    issue.reason.as_deref(),
+                )?;
+            }
+        }
+        tx.commit()?;
+        Ok(())
+    }
+
+    /// A trial's result, accepted exactly once per (run, trial).
+    ///
+    /// - Running trial: completed with this result → `Accepted` (event
+    ///   `result`; if the result's attempt is older than the latest issue the
+    ///   note says so, and `result_attempt` records which attempt did the work).
+    /// - Trial already completed or failed: → `Duplicate`; the trial row is
+    ///   unchanged and a `duplicate` event is written.
+    /// - Unknown run or trial: → `UnknownTrial`, nothing written.
+    ///
+    /// A NaN or infinite score or metric is an error naming the field, and
+    /// nothing is written.
+    pub fn record_result(&mut self, result: &TrialResultRecord) -> Result<ResultOutcome> {
+        check_finite(|| "score".to_string(), result.score)?;
+        if let Some(m) = &result.metrics {
+            check_finite(|| "metrics.epsilon".to_string(), m.epsilon)?;
+            if let Some(v) = m.volume {
+                check_finite(|| "metrics.volume".to_string(), v)?;
+            }
+            check_finite(|| "metrics.distance".to_string(), m.distance)?;
+            check_finite(|| "metrics.bw".to_string(), m.bw)?;
+        }
+        let Ok(id) = db_id(result.trial_id) else {
+            return Ok(ResultOutcome::UnknownTrial);
+        };
+        let tx = self.write_tx()?;
+        let existing: Option<(String, u32, Option<u32>)> = tx
+            .query_row(
+                "SELECT state, attempts, result_attempt FROM trials
+                 WHERE run_id = ?1 AND trial_id = ?2",
+                params![result.run_id, id],
+                |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
+            )
+            .optional()?;
+        let Some((state, attempts, result_attempt)) = existing else {
+            return Ok(ResultOutcome::UnknownTrial);
+        };
+        let outcome = match parse_state(&state)? {
+            TrialState::Completed | TrialState::Failed => {
+                let note = match result_attempt {
+                    Some(a) => format!("trial already completed by attempt {a}"),
+                    None => "trial already failed".to_string(),
+                };
+                insert_event(
+                    &tx,
+                    &result.run_id,
+                    id,
+                    result.attempt,
+                    event_kind::DUPLICATE,
+                    &result.worker,
+                    result.at_ms,
+                    Some(&note),
+                )?;
+                ResultOutcome::Duplicate
+            }
+            TrialState::Running => {
+                let note = if result.attempt < attempts {
+                    Some(format!(
+                        "late result from attempt {} (latest attempt {attempts})",
+                        result.attempt
+                    ))
+                } else if result.attempt > attempts {
+                    Some(format!(
+                        "result from attempt {} which was never issued (latest attempt {attempts})",
+                        result.attempt
+                    ))
+                } else {
+                    None
+                };
+                let m = result.metrics.as_ref();
+                tx.execute(
+                    "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
+                         result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
+                         epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
+                         fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16
+                     WHERE run_id = ?1 AND trial_id = ?2",
+                    params![
+                        result.run_id,
+                        id,
+                        result.worker,
+                        result.at_ms,
+                        result.attempt,
+                        result.score,
+                        m.map(|m| m.rank),
+                        m.map(|m| m.force_closure),
+                        m.map(|m| m.epsilon),
+                        m.and_then(|m| m.volume),
+                        m.map(|m| m.distance),
+                        m.map(|m| m.bw),
+                        result.contacts,
+                        result.fingers_in_contact,
+                        result.cloud_points,
+                        result.details_json,
+                    ],
+                )?;
+                insert_event(
+                    &tx,
+                    &result.run_id,
+                    id,
+                    result.attempt,
+                    event_kind::RESULT,
+                    &result.worker,
+                    result.at_ms,
+                    note.as_deref(),
+                )?;
+                ResultOutcome::Accepted
+            }
+        };
+        tx.commit()?;
+        Ok(outcome)
+    }
+
+    /// A trial that failed permanently: state Failed with `message` (event
+    /// `failed`, note = message, worker = the trial's latest worker).
+    /// Returns false, writing nothing, when the trial is already completed or
+    /// failed, or when the run or trial is unknown.
+    pub fn record_failure(
+        &mut self,
+        run_id: &str,
+        trial_id: u64,
+        attempt: u32,
+        message: &str,
+        at_ms: i64,
+    ) -> Result<bool> {
+        let Ok(id) = db_id(trial_id) else {
+            return Ok(false);
+        };
+        let tx = self.write_tx()?;
+        let existing: Option<(String, String)> = tx
+            .query_row(
+                "SELECT state, worker FROM trials WHERE run_id = ?1 AND trial_id = ?2",
+                params![run_id, id],
+                |r| Ok((r.get(0)?, r.get(1)?)),
+            )
+            .optional()?;
+        let Some((state, worker)) = existing else {
+            return Ok(false);
+        };
+        if parse_state(&state)? != TrialState::Running {
+            return Ok(false);
+        }
+        tx.execute(
+            "UPDATE trials SET state = 'failed', error = ?3 WHERE run_id = ?1 AND trial_id = ?2",
+            params![run_id, id, message],
+        )?;
+        insert_event(
+            &tx,
+            run_id,
+            id,
+            attempt,
+            event_kind::FAILED,
+            &worker,
+            at_ms,
+            Some(message),
+        )?;
+        tx.commit()?;
+        Ok(true)
+    }
+
+    // ---------------------------------------------------------------- reads
+
+    /// A run's trials by trial id; [`JournalError::UnknownRun`] for an unknown run.
+    pub fn trials(&self, run_id: &str) -> Result<Vec<TrialRow>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        query_trials(&tx, run_id)
+    }
+
+    /// One trial, if the run has it; [`JournalError::UnknownRun`] for an unknown run.
+    pub fn trial(&self, run_id: &str, trial_id: u64) -> Result<Option<TrialRow>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let Ok(id) = db_id(trial_id) else {
+            return Ok(None);
+        };
+        let mut stmt = tx.prepare_cached(&format!(
+            "SELECT {TRIAL_COLUMNS} FROM trials WHERE run_id = ?1 AND trial_id = ?2"
+        ))?;
+        Ok(stmt
+            .query_row(params![run_id, id], trial_from_row)
+            .optional()?)
+    }
+
+    /// A run's events in insertion order; [`JournalError::UnknownRun`] for an unknown run.
+    pub fn events(&self, run_id: &str) -> Result<Vec<EventRow>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let mut stmt = tx.prepare_cached(
+            "SELECT seq, run_id, trial_id, attempt, kind, worker, at_ms, note FROM events
+             WHERE run_id = ?1 ORDER BY seq",
+        )?;
+        let rows = stmt
+            .query_map([run_id], |r| {
+                Ok(EventRow {
+                    seq: r.get(0)?,
+                    run_id: r.get(1)?,
+                    trial_id: u64_col(r, 2)?,
+                    attempt: r.get(3)?,
+                    kind: r.get(4)?,
+                    worker: r.get(5)?,
+                    at_ms: r.get(6)?,
+                    note: r.get(7)?,
+                })
+            })?
+            .collect::<rusqlite::Result<Vec<_>>>()?;
+        Ok(rows)
+    }
+
+    /// The completed trial with the highest score (ties: lowest trial id).
+    pub fn best(&self, run_id: &str) -> Result<Option<TrialRow>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let mut stmt = tx.prepare_cached(&format!(
+            "SELECT {TRIAL_COLUMNS} FROM trials WHERE run_id = ?1 AND state = 'completed'
+             ORDER BY score DESC, trial_id ASC LIMIT 1"
+        ))?;
+        Ok(stmt.query_row([run_id], trial_from_row).optional()?)
+    }
+
+    /// How many of the run's trials are running, completed and failed.
+    pub fn counts(&self, run_id: &str) -> Result<StateCounts> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let mut stmt = tx.prepare_cached(
+            "SELECT state, count(*) FROM trials WHERE run_id = ?1 GROUP BY state",
+        )?;
+        let mut counts = StateCounts::default();
+        let rows = stmt
+            .query_map([run_id], |r| {
+                Ok((r.get::<_, String>(0)?, r.get::<_, i64>(1)?))
+            })?
+            .collect::<rusqlite::Result<Vec<_>>>()?;
+        for (state, n) in rows {
+            let n = usize::try_from(n).unwrap_or(0);
+            match parse_state(&state)? {
+                TrialState::Running => counts.running = n,
+                TrialState::Completed => counts.completed = n,
+                TrialState::Failed => counts.failed = n,
+            }
+        }
+        Ok(counts)
+    }
+
+    /// The highest trial id the run has issued (`None` before the first issue):
+    /// a restarted coordinator continues from here.
+    pub fn max_trial_id(&self, run_id: &str) -> Result<Option<u64>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let max: Option<i64> = tx.query_row(
+            "SELECT max(trial_id) FROM trials WHERE run_id = ?1",
+            [run_id],
+            |r| r.get(0),
+        )?;
+        Ok(max.and_then(|m| u64::try_from(m).ok()))
+    }
+
+    /// Running trials whose lease ended before `now_ms`, by trial id: what a
+    /// restarted coordinator should re-issue.
+    pub fn expired_leases(&self, run_id: &str, now_ms: i64) -> Result<Vec<TrialRow>> {
+        let tx = self.read_tx()?;
+        require_run(&tx, run_id)?;
+        let mut stmt = tx.prepare_cached(&format!(
+            "SELECT {TRIAL_COLUMNS} FROM trials
+             WHERE run_id = ?1 AND state = 'running' AND lease_until_ms < ?2 ORDER BY trial_id"
+        ))?;
+        let rows = stmt
+            .query_map(params![run_id, now_ms], trial_from_row)?
+            .collect::<rusqlite::Result<Vec<_>>>()?;
+        Ok(rows)
+    }
+
+    /// The run and all its trials, read in one snapshot (what the exports write).
+    pub fn export(&self, run_id: &str) -> Result<RunExport> {
+        let tx = self.read_tx()?;
+        let run = tx
+            .query_row(
+                "SELECT run_id, created_ms, config_json, param_names, status FROM runs
+                 WHERE run_id = ?1",
+                [run_id],
+                run_from_row,
+            )
+            .optional()?
+            .ok_or_else(|| JournalError::UnknownRun(run_id.to_string()))?;
+        let trials = query_trials(&tx, run_id)?;
+        Ok(RunExport { run, trials })
+    }
+
+    /// `PRAGMA integrity_check` reports "ok".
+    pub fn integrity_check(&self) -> Result<bool> {
+        let mut stmt = self.conn.prepare("PRAGMA integrity_check")?;
+        let lines = stmt
+            .query_map([], |r| r.get::<_, String>(0))?
+            .collect::<rusqlite::Result<Vec<_>>>()?;
+        Ok(lines.len() == 1 && lines[0] == "ok")
+    }
+}
+
+fn db_id(trial_id: u64) -> Result<i64> {
+    i64::try_from(trial_id).map_err(|_| JournalError::TrialIdRange(trial_id))
+}
+
+fn check_finite(field: impl FnOnce() -> String, v: f64) -> Result<()> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(JournalError::NonFinite { field: field() })
+    }
+}
+
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// Equal text, or both valid JSON with equal values (key order and spacing ignored).
+fn same_json(a: &str, b: &str) -> bool {
+    if a == b {
+        return true;
+    }
+    match (
+        serde_json::from_str::<serde_json::Value>(a),
+        serde_json::from_str::<serde_json::Value>(b),
+    ) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+fn parse_state(s: &str) -> Result<TrialState> {
+    TrialState::parse(s)
+        .ok_or_else(|| JournalError::Schema(format!("unknown trial state {s:?} in the database")))
+}
+
+fn require_run(conn: &Connection, run_id: &str) -> Result<()> {
+    let mut stmt = conn.prepare_cached("SELECT 1 FROM runs WHERE run_id = ?1")?;
+    if stmt.exists([run_id])? {
+        Ok(())
+    } else {
+        Err(JournalError::UnknownRun(run_id.to_string()))
+    }
+}
+
+fn query_trials(conn: &Connection, run_id: &str) -> Result<Vec<TrialRow>> {
+    let mut stmt = conn.prepare_cached(&format!(
+        "SELECT {TRIAL_COLUMNS} FROM trials WHERE run_id = ?1 ORDER BY trial_id"
+    ))?;
+    let rows = stmt
+        .query_map([run_id], trial_from_row)?
+        .collect::<rusqlite::Result<Vec<_>>>()?;
+    Ok(rows)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn insert_event(
+    conn: &Connection,
+    run_id: &str,
+    trial_id: i64,
+    attempt: u32,
+    kind: &str,
+    worker: &str,
+    at_ms: i64,
+    note: Option<&str>,
+) -> Result<()> {
+    let mut stmt = conn.prepare_cached(
+        "INSERT INTO events (run_id, trial_id, attempt, kind, worker, at_ms, note)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+    )?;
+    stmt.execute(params![
+        run_id, trial_id, attempt, kind, worker, at_ms, note
+    ])?;
+    Ok(())
+}
+
+fn conversion_error(
+    idx: usize,
+    ty: Type,
+    err: impl Into<Box<dyn std::error::Error + Send + Sync>>,
+) -> rusqlite::Error {
+    rusqlite::Error::FromSqlConversionFailure(idx, ty, err.into())
+}
+
+fn u64_col(r: &Row<'_>, idx: usize) -> rusqlite::Result<u64> {
+    let v: i64 = r.get(idx)?;
+    u64::try_from(v).map_err(|e| conversion_error(idx, Type::Integer, e))
+}
+
+fn run_from_row(r: &Row<'_>) -> rusqlite::Result<RunRecord> {
+    let names: String = r.get(3)?;
+    let param_names: Vec<String> =
+        serde_json::from_str(&names).map_err(|e| conversion_error(3, Type::Text, e))?;
+    let status: String = r.get(4)?;
+    let status = RunStatus::parse(&status)
+        .ok_or_else(|| conversion_error(4, Type::Text, format!("unknown run status {status:?}")))?;
+    Ok(RunRecord {
+        run_id: r.get(0)?,
+        created_ms: r.get(1)?,
+        config_json: r.get(2)?,
+        param_names,
+        status,
+    })
+}
+
+/// Reads a row selected with [`TRIAL_COLUMNS`].
+fn trial_from_row(r: &Row<'_>) -> rusqlite::Result<TrialRow> {
+    let state: String = r.get(2)?;
+    let state = TrialState::parse(&state)
+        .ok_or_else(|| conversion_error(2, Type::Text, format!("unknown trial state {state:?}")))?;
+    let params: String = r.get(4)?;
+    let params: Vec<f64> =
+        serde_json::from_str(&params).map_err(|e| conversion_error(4, Type::Text, e))?;
+    let metrics = match r.get::<_, Option<u32>>(11)? {
+        None => None,
+        Some(rank) => Some(MetricValues {
+            rank,
+            force_closure: r.get(12)?,
+            epsilon: r.get(13)?,
+            volume: r.get(14)?,
+            distance: r.get(15)?,
+            bw: r.get(16)?,
+        }),
+    };
+    Ok(TrialRow {
+        run_id: r.get(0)?,
+        trial_id: u64_col(r, 1)?,
+        state,
+        attempts: r.get(3)?,
+        params,
+        worker: r.get(5)?,
+        issued_ms: r.get(6)?,
+        lease_until_ms: r.get(7)?,
+        completed_ms: r.get(8)?,
+        result_attempt: r.get(9)?,
+        score: r.get(10)?,
+        metrics,
+        contacts: r.get::<_, Option<u32>>(17)?.unwrap_or(0),
+        fingers_in_contact: r.get::<_, Option<u32>>(18)?.unwrap_or(0),
+        cloud_points: r.get::<_, Option<u32>>(19)?.unwrap_or(0),
+        details_json: r.get(20)?,
+        error: r.get(21)?,
+    })
+}

@@ -1,0 +1,28 @@
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+//! The graspopt trial journal: every trial of every run, durable in an
+//! embedded SQLite database.
+//!
+//! This crate owns the journal's database: its schema and version, the
+//! recording rules (a trial is issued, maybe re-issued, and ends exactly once,
+//! completed by one result or failed), the event log of every issue, result,
+//! duplicate and failure, and the CSV/JSON exports of a run.
+//!
+//! It must not know the network or the bus, the planner, the simulator or any
+//! other graspopt crate: it defines its own plain record types, and the caller
+//! converts. It reads no clock (every timestamp is given by the caller) and
+//! starts no thread: one owner (a thread, a task or a mutex) calls it; a
+//! [`Journal`] is `Send`, not `Sync`.
+
+mod error;
+pub mod export;
+mod journal;
+mod schema;
+mod types;
+
+pub use error::{JournalError, Result};
+pub use journal::Journal;
+pub use schema::SCHEMA_VERSION;
+pub use types::{
+    EventRow, MetricValues, ResultOutcome, RunExport, RunRecord, RunStatus, StateCounts,
+    TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+};

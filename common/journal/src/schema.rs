@@ -1,0 +1,177 @@
+//! The database layout, its version, and the check made at open.
+
+use rusqlite::{Connection, TransactionBehavior};
+
+use crate::error::{JournalError, Result};
+
+/// The schema version stored in `PRAGMA user_version`.
+pub const SCHEMA_VERSION: i64 = 1;
+
+/// Version 1 of the layout. Tables are STRICT, so a value of the wrong type
+/// is refused by SQLite itself rather than stored silently.
+pub(crate) const DDL: &str = "
+CREATE TABLE runs (
+    run_id      TEXT    NOT NULL PRIMARY KEY,
+    created_ms  INTEGER NOT NULL,
+    config_json TEXT    NOT NULL,
+    param_names TEXT    NOT NULL,
+    status      TEXT    NOT NULL CHECK (status IN ('running', 'finished', 'stopped')),
+    status_ms   INTEGER NOT NULL
+) STRICT;
+
+CREATE TABLE trials (
+    run_id             TEXT    NOT NULL REFERENCES runs (run_id),
+    trial_id           INTEGER NOT NULL CHECK (trial_id >= 0),
+    state              TEXT    NOT NULL CHECK (state IN ('running', 'completed', 'failed')),
+    attempts           INTEGER NOT NULL CHECK (attempts >= 1),
+    params             TEXT    NOT NULL,
+    worker             TEXT    NOT NULL,
+    issued_ms          INTEGER NOT NULL,
+    lease_until_ms     INTEGER NOT NULL,
+    completed_ms       INTEGER,
+    result_attempt     INTEGER,
+    score              REAL,
+    rank               INTEGER,
+    force_closure      INTEGER CHECK (force_closure IN (0, 1)),
+    epsilon            REAL,
+    volume             REAL,
+    distance           REAL,
+    bw                 REAL,
+    contacts           INTEGER,
+    fingers_in_contact INTEGER,
+    cloud_points       INTEGER,
+    details_json       TEXT,
+    error              TEXT,
+    PRIMARY KEY (run_id, trial_id),
+    CHECK ((state = 'completed') = (score IS NOT NULL AND completed_ms IS NOT NULL)),
+    CHECK ((state = 'failed') = (error IS NOT NULL))
+) STRICT;
+
+CREATE INDEX trials_by_score ON trials (run_id, state, score);
+
+CREATE TABLE events (
+    seq      INTEGER PRIMARY KEY AUTOINCREMENT,
+    run_id   TEXT    NOT NULL,
+    trial_id INTEGER NOT NULL,
+    attempt  INTEGER NOT NULL,
+    kind     TEXT    NOT NULL
+             CHECK (kind IN ('issued', 'reissued', 'result', 'duplicate', 'failed')),
+    worker   TEXT    NOT NULL,
+    at_ms    INTEGER NOT NULL,
+    note     TEXT,
+    FOREIGN KEY (run_id, trial_id) REFERENCES trials (run_id, trial_id)
+) STRICT;
+
+CREATE INDEX events_by_run ON events (run_id, seq);
+";
+
+/// The columns each table must have, in order.
+const LAYOUT: &[(&str, &[&str])] = &[
+    (
+        "runs",
+        &[
+            "run_id",
+            "created_ms",
+            "config_json",
+            "param_names",
+            "status",
+            "status_ms",
+        ],
+    ),
+    (
+        "trials",
+        &[
+            "run_id",
+            "trial_id",
+            "state",
+            "attempts",
+            "params",
+            "worker",
+            "issued_ms",
+            "lease_until_ms",
+            "completed_ms",
+            "result_attempt",
+            "score",
+            "rank",
+            "force_closure",
+            "epsilon",
+            "volume",
+            "distance",
+            "bw",
+            "contacts",
+            "fingers_in_contact",
+            "cloud_points",
+            "details_json",
+            "error",
+        ],
+    ),
+    (
+        "events",
+        &[
+            "seq", "run_id", "trial_id", "attempt", "kind", "worker", "at_ms", "note",
+        ],
+    ),
+];
+
+fn user_version(conn: &Connection) -> Result<i64> {
+    Ok(conn.query_row("PRAGMA user_version", [], |r| r.get(0))?)
+}
+
+/// Creates the schema in an empty database, or checks an existing one.
+pub(crate) fn ensure(conn: &mut Connection) -> Result<()> {
+    match user_version(conn)? {
+        0 => create(conn),
+        SCHEMA_VERSION => check_layout(conn),
+        found => Err(JournalError::SchemaVersion {
+            found,
+            expected: SCHEMA_VERSION,
+        }),
+    }
+}
+
+fn create(conn: &mut Connection) -> Result<()> {
+    // Take the write lock first and look again: another process may be
+    // creating the same journal right now.
+    let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+    match user_version(&tx)? {
+        0 => {}
+        SCHEMA_VERSION => {
+            drop(tx);
+            return check_layout(conn);
+        }
+        found => {
+            return Err(JournalError::SchemaVersion {
+                found,
+                expected: SCHEMA_VERSION,
+            });
+        }
+    }
+    let objects: i64 = tx.query_row("SELECT count(*) FROM sqlite_schema", [], |r| r.get(0))?;
+    if objects != 0 {
+        return Err(JournalError::Schema(format!(
+            "the database holds {objects} schema objects but no journal schema version"
+        )));
+    }
+    tx.execute_batch(DDL)?;
+    tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
+    tx.commit()?;
+    Ok(())
+}
+
+fn check_layout(conn: &Connection) -> Result<()> {
+    let mut stmt = conn.prepare("SELECT name FROM pragma_table_info(?1) ORDER BY cid")?;
+    for (table, expected) in LAYOUT {
+        let found = stmt
+            .query_map([table], |r| r.get::<_, String>(0))?
+            .collect::<rusqlite::Result<Vec<String>>>()?;
+        if found.is_empty() {
+            return Err(JournalError::Schema(format!("table {table} is missing")));
+        }
+        if found != *expected {
+            return Err(JournalError::Schema(format!(
+                "table {table} has columns {found:?}, expected {expected:?}"
+            )));
+        }
+    }
+    Ok(())
+}

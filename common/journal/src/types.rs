@@ -1,0 +1,207 @@
+//! The journal's plain record types: what goes in and what comes out.
+
+use serde::{Deserialize, Serialize};
+
+/// One optimisation run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    pub run_id: String,
+    /// Creation time, milliseconds since the Unix epoch (the caller's clock).
+    pub created_ms: i64,
+    /// The run's configuration as JSON text (stored verbatim).
+    pub config_json: String,
+    /// Names of the search-space dimensions, in the order of `TrialIssue::params`.
+    pub param_names: Vec<String>,
+    pub status: RunStatus,
+}
+
+/// Lifecycle of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunStatus {
+    Running,
+    Finished,
+    Stopped,
+}
+
+impl RunStatus {
+    /// The text stored in the database (the serde name).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RunStatus::Running => "running",
+            RunStatus::Finished => "finished",
+            RunStatus::Stopped => "stopped",
+        }
+    }
+
+    /// Inverse of [`RunStatus::as_str`].
+    pub fn parse(s: &str) -> Option<RunStatus> {
+        match s {
+            "running" => Some(RunStatus::Running),
+            "finished" => Some(RunStatus::Finished),
+            "stopped" => Some(RunStatus::Stopped),
+            _ => None,
+        }
+    }
+}
+
+/// A trial handed to a worker: attempt 1 is the first issue, attempt n+1 a re-issue.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialIssue {
+    pub run_id: String,
+    pub trial_id: u64,
+    pub attempt: u32,
+    pub params: Vec<f64>,
+    pub worker: String,
+    pub at_ms: i64,
+    pub lease_until_ms: i64,
+    /// Why the trial is re-issued; stored as the note of the `reissued` (or
+    /// `issued`) event.
+    pub reason: Option<String>,
+}
+
+/// A worker's result for one attempt of a trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialResultRecord {
+    pub run_id: String,
+    pub trial_id: u64,
+    pub attempt: u32,
+    pub worker: String,
+    pub at_ms: i64,
+    pub score: f64,
+    pub metrics: Option<MetricValues>,
+    pub contacts: u32,
+    pub fingers_in_contact: u32,
+    pub cloud_points: u32,
+    /// Free-form JSON from the worker, stored verbatim.
+    pub details_json: String,
+}
+
+/// Grasp-quality metrics of one trial, stored as real columns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MetricValues {
+    pub rank: u32,
+    pub force_closure: bool,
+    pub epsilon: f64,
+    pub volume: Option<f64>,
+    pub distance: f64,
+    pub bw: f64,
+}
+
+/// What `record_result` did with a result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ResultOutcome {
+    /// The result completed the trial.
+    Accepted,
+    /// The trial already had its final outcome; the trial row is unchanged and
+    /// a `duplicate` event was written.
+    Duplicate,
+    /// The run (or the run's trial) is not in the journal; nothing was written.
+    UnknownTrial,
+}
+
+/// State of a trial, stored as its snake_case name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TrialState {
+    Running,
+    Completed,
+    Failed,
+}
+
+impl TrialState {
+    /// The text stored in the database (the serde name).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TrialState::Running => "running",
+            TrialState::Completed => "completed",
+            TrialState::Failed => "failed",
+        }
+    }
+
+    /// Inverse of [`TrialState::as_str`].
+    pub fn parse(s: &str) -> Option<TrialState> {
+        match s {
+            "running" => Some(TrialState::Running),
+            "completed" => Some(TrialState::Completed),
+            "failed" => Some(TrialState::Failed),
+            _ => None,
+        }
+    }
+}
+
+/// One trial as stored.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialRow {
+    pub run_id: String,
+    pub trial_id: u64,
+    pub state: TrialState,
+    /// Number of times the trial was issued (1 + re-issues).
+    pub attempts: u32,
+    pub params: Vec<f64>,
+    /// The last worker involved: the latest issue's worker, or the worker
+    /// whose result completed the trial.
+    pub worker: String,
+    /// Time of the first issue.
+    pub issued_ms: i64,
+    /// Lease deadline of the latest issue.
+    pub lease_until_ms: i64,
+    /// Set only for a completed trial: the accepted result's time.
+    pub completed_ms: Option<i64>,
+    /// Which attempt produced the accepted result (may be older than `attempts`).
+    pub result_attempt: Option<u32>,
+    pub score: Option<f64>,
+    pub metrics: Option<MetricValues>,
+    /// Result counts; 0 while the trial has no result.
+    pub contacts: u32,
+    pub fingers_in_contact: u32,
+    pub cloud_points: u32,
+    pub details_json: Option<String>,
+    /// The failure message of a failed trial.
+    pub error: Option<String>,
+}
+
+/// One line of a run's event log.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventRow {
+    /// Journal-wide insertion order.
+    pub seq: i64,
+    pub run_id: String,
+    pub trial_id: u64,
+    pub attempt: u32,
+    /// One of the [`event_kind`](crate::event_kind) names.
+    pub kind: String,
+    pub worker: String,
+    pub at_ms: i64,
+    pub note: Option<String>,
+}
+
+/// The `kind` values of [`EventRow`].
+pub mod event_kind {
+    /// First issue of a trial (attempt 1).
+    pub const ISSUED: &str = "issued";
+    /// A later attempt; `note` is the reason given.
+    pub const REISSUED: &str = "reissued";
+    /// The accepted result; `note` says when it came from an older attempt.
+    pub const RESULT: &str = "result";
+    /// A result for a trial that already had its final outcome.
+    pub const DUPLICATE: &str = "duplicate";
+    /// The trial failed permanently; `note` is the message.
+    pub const FAILED: &str = "failed";
+}
+
+/// Number of a run's trials in each state.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct StateCounts {
+    pub running: usize,
+    pub completed: usize,
+    pub failed: usize,
+}
+
+/// A whole run as exported by [`crate::export::write_json`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunExport {
+    pub run: RunRecord,
+    pub trials: Vec<TrialRow>,
+}

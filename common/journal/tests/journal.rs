@@ -1,0 +1,1094 @@
+//! Behaviour of the trial journal: recording rules, durability, exports.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use graspopt_journal::export::{write_csv, write_json};
+use graspopt_journal::{
+    EventRow, Journal, JournalError, MetricValues, ResultOutcome, RunExport, RunRecord, RunStatus,
+    SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+};
+
+// ------------------------------------------------------------------ helpers
+
+/// A directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let nanos = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .unwrap()
+            .as_nanos();
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!(
+            "graspopt-journal-{tag}-{}-{nanos}-{n}",
+            std::process::id()
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+
+    fn db(&self) -> PathBuf {
+        self.0.join("journal.sqlite")
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const RUN: &str = "run-a";
+
+fn run_record(run_id: &str) -> RunRecord {
+    RunRecord {
+        run_id: run_id.to_string(),
+        created_ms: 1_000,
+        config_json: r#"{"objective":"epsilon","budget":50,"hand":{"fingers":3}}"#.to_string(),
+        param_names: vec!["approach_x".into(), "roll".into(), "aperture".into()],
+        status: RunStatus::Running,
+    }
+}
+
+/// Parameters that are hard to round-trip through text.
+fn params_for(trial: u64) -> Vec<f64> {
+    vec![
+        0.1 + 0.2 + trial as f64,
+        f64::MIN_POSITIVE / 3.0 * (trial as f64 + 1.0), // subnormal
+        -(trial as f64 + 1.0) / 7.0,
+    ]
+}
+
+fn issue(run_id: &str, trial: u64, attempt: u32, worker: &str, at_ms: i64) -> TrialIssue {
+    TrialIssue {
+        run_id: run_id.to_string(),
+        trial_id: trial,
+        attempt,
+        params: params_for(trial),
+        worker: worker.to_string(),
+        at_ms,
+        lease_until_ms: at_ms + 30_000,
+        reason: None,
+    }
+}
+
+fn metrics_for(trial: u64) -> MetricValues {
+    MetricValues {
+        rank: 6,
+        force_closure: trial.is_multiple_of(2),
+        epsilon: 0.0123456789012345 * (trial as f64 + 1.0),
+        volume: Some(1.0 / 3.0 + trial as f64),
+        distance: 2.0f64.sqrt(),
+        bw: 1e-17 * (trial as f64 + 1.0),
+    }
+}
+
+fn score_for(trial: u64) -> f64 {
+    (trial as f64 + 1.0).ln() / 3.0
+}
+
+fn result(
+    run_id: &str,
+    trial: u64,
+    attempt: u32,
+    worker: &str,
+    at_ms: i64,
+    score: f64,
+) -> TrialResultRecord {
+    TrialResultRecord {
+        run_id: run_id.to_string(),
+        trial_id: trial,
+        attempt,
+        worker: worker.to_string(),
+        at_ms,
+        score,
+        metrics: Some(metrics_for(trial)),
+        contacts: 7,
+        fingers_in_contact: 3,
+        cloud_points: 4096,
+        details_json: format!(r#"{{"trial":{trial},"note":"ok"}}"#),
+    }
+}
+
+fn journal_with_run() -> Journal {
+    let mut j = Journal::open_in_memory().unwrap();
+    j.create_run(&run_record(RUN)).unwrap();
+    j
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+fn kinds(events: &[EventRow]) -> Vec<&str> {
+    events.iter().map(|e| e.kind.as_str()).collect()
+}
+
+/// A minimal RFC 4180 reader: records of fields, quoted fields may hold
+/// commas, doubled quotes and line breaks.
+fn parse_csv(text: &str) -> Vec<Vec<String>> {
+    let mut records = Vec::new();
+    let mut record = Vec::new();
+    let mut field = String::new();
+    let mut chars = text.chars().peekable();
+    let mut in_quotes = false;
+    while let Some(c) = chars.next() {
+        if in_quotes {
+            match c {
+                '"' if chars.peek() == Some(&'"') => {
+                    chars.next();
+                    field.push('"');
+                }
+                '"' => in_quotes = false,
+                _ => field.push(c),
+            }
+        } else {
+            match c {
+                '"' => {
+                    assert!(field.is_empty(), "quote inside an unquoted field");
+                    in_quotes = true;
+                }
+                ',' => record.push(std::mem::take(&mut field)),
+                '\n' => {
+                    record.push(std::mem::take(&mut field));
+                    records.push(std::mem::take(&mut record));
+                }
+                _ => field.push(c),
+            }
+        }
+    }
+    assert!(!in_quotes, "unterminated quoted field");
+    assert!(field.is_empty() && record.is_empty(), "last line not ended");
+    records
+}
+
+// -------------------------------------------------------------------- tests
+
+#[test]
+fn journal_is_send() {
+    fn assert_send<T: Send>() {}
+    assert_send::<Journal>();
+    // And usable behind a mutex from another thread.
+    let j = std::sync::Mutex::new(journal_with_run());
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let mut j = j.lock().unwrap();
+            j.record_issue(&issue(RUN, 1, 1, "w1", 10)).unwrap();
+        });
+    });
+    assert_eq!(j.lock().unwrap().counts(RUN).unwrap().running, 1);
+}
+
+#[test]
+fn issue_result_round_trip() {
+    let mut j = journal_with_run();
+    let mut iss = issue(RUN, 1, 1, "worker-1", 2_000);
+    iss.params = vec![0.1 + 0.2, 5e-324, -0.0];
+    j.record_issue(&iss).unwrap();
+
+    let running = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(running.state, TrialState::Running);
+    assert_eq!(running.attempts, 1);
+    assert_eq!(running.worker, "worker-1");
+    assert_eq!(running.issued_ms, 2_000);
+    assert_eq!(running.lease_until_ms, 32_000);
+    assert_eq!(running.score, None);
+    assert_eq!(running.metrics, None);
+    assert_eq!(running.completed_ms, None);
+    assert_eq!(bits(&running.params), bits(&[0.1 + 0.2, 5e-324, -0.0]));
+    assert!(running.params[2].is_sign_negative());
+
+    let res = result(RUN, 1, 1, "worker-1", 2_500, 0.734_251_998_123_456_7);
+    assert_eq!(j.record_result(&res).unwrap(), ResultOutcome::Accepted);
+
+    let row = j.trial(RUN, 1).unwrap().unwrap();
+    let expected = TrialRow {
+        run_id: RUN.to_string(),
+        trial_id: 1,
+        state: TrialState::Completed,
+        attempts: 1,
+        params: iss.params.clone(),
+        worker: "worker-1".to_string(),
+        issued_ms: 2_000,
+        lease_until_ms: 32_000,
+        completed_ms: Some(2_500),
+        result_attempt: Some(1),
+        score: Some(0.734_251_998_123_456_7),
+        metrics: Some(metrics_for(1)),
+        contacts: 7,
+        fingers_in_contact: 3,
+        cloud_points: 4096,
+        details_json: Some(r#"{"trial":1,"note":"ok"}"#.to_string()),
+        error: None,
+    };
+    assert_eq!(row, expected);
+    assert_eq!(bits(&row.params), bits(&iss.params));
+    let m = row.metrics.as_ref().unwrap();
+    let want = metrics_for(1);
+    assert_eq!(m.epsilon.to_bits(), want.epsilon.to_bits());
+    assert_eq!(m.bw.to_bits(), want.bw.to_bits());
+    assert_eq!(m.volume.unwrap().to_bits(), want.volume.unwrap().to_bits());
+
+    // Metrics absent, and metrics with no volume, read back as such.
+    j.record_issue(&issue(RUN, 2, 1, "worker-2", 3_000))
+        .unwrap();
+    let mut r2 = result(RUN, 2, 1, "worker-2", 3_100, -1.5);
+    r2.metrics = None;
+    j.record_result(&r2).unwrap();
+    j.record_issue(&issue(RUN, 3, 1, "worker-2", 3_200))
+        .unwrap();
+    let mut r3 = result(RUN, 3, 1, "worker-2", 3_300, f64::MAX);
+    r3.metrics.as_mut().unwrap().volume = None;
+    j.record_result(&r3).unwrap();
+    assert_eq!(j.trial(RUN, 2).unwrap().unwrap().metrics, None);
+    assert_eq!(j.trial(RUN, 2).unwrap().unwrap().score, Some(-1.5));
+    assert_eq!(j.trial(RUN, 3).unwrap().unwrap().metrics, r3.metrics);
+    assert_eq!(j.trial(RUN, 3).unwrap().unwrap().score, Some(f64::MAX));
+
+    let events = j.events(RUN).unwrap();
+    assert_eq!(
+        kinds(&events),
+        ["issued", "result", "issued", "result", "issued", "result"]
+    );
+    assert_eq!(
+        events[1],
+        EventRow {
+            seq: events[1].seq,
+            run_id: RUN.to_string(),
+            trial_id: 1,
+            attempt: 1,
+            kind: event_kind::RESULT.to_string(),
+            worker: "worker-1".to_string(),
+            at_ms: 2_500,
+            note: None,
+        }
+    );
+    assert!(events.windows(2).all(|w| w[0].seq < w[1].seq));
+    assert_eq!(j.trial(RUN, 4).unwrap(), None);
+}
+
+#[test]
+fn exactly_once_duplicate_result() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    let first = result(RUN, 1, 1, "w1", 200, 0.5);
+    let mut second = result(RUN, 1, 1, "w1", 300, 0.9);
+    second.contacts = 1;
+    assert_eq!(j.record_result(&first).unwrap(), ResultOutcome::Accepted);
+    let after_first = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(j.record_result(&second).unwrap(), ResultOutcome::Duplicate);
+    let after_second = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(after_second, after_first);
+    assert_eq!(after_second.score, Some(0.5));
+    assert_eq!(after_second.completed_ms, Some(200));
+    assert_eq!(after_second.contacts, 7);
+
+    let events = j.events(RUN).unwrap();
+    assert_eq!(kinds(&events), ["issued", "result", "duplicate"]);
+    assert_eq!(events[2].at_ms, 300);
+    assert_eq!(events[2].attempt, 1);
+    assert!(
+        events[2].note.as_deref().unwrap().contains("attempt 1"),
+        "{:?}",
+        events[2].note
+    );
+    assert_eq!(
+        j.counts(RUN).unwrap(),
+        StateCounts {
+            running: 0,
+            completed: 1,
+            failed: 0
+        }
+    );
+}
+
+#[test]
+fn unknown_trial_writes_nothing() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    let before_trials = j.trials(RUN).unwrap();
+    let before_events = j.events(RUN).unwrap();
+
+    assert_eq!(
+        j.record_result(&result(RUN, 99, 1, "w1", 200, 0.5))
+            .unwrap(),
+        ResultOutcome::UnknownTrial
+    );
+    assert_eq!(
+        j.record_result(&result("no-such-run", 1, 1, "w1", 200, 0.5))
+            .unwrap(),
+        ResultOutcome::UnknownTrial
+    );
+    assert_eq!(
+        j.record_result(&result(RUN, u64::MAX, 1, "w1", 200, 0.5))
+            .unwrap(),
+        ResultOutcome::UnknownTrial
+    );
+    assert!(!j.record_failure(RUN, 99, 1, "boom", 300).unwrap());
+    assert!(!j.record_failure("no-such-run", 1, 1, "boom", 300).unwrap());
+
+    assert_eq!(j.trials(RUN).unwrap(), before_trials);
+    assert_eq!(j.events(RUN).unwrap(), before_events);
+    assert_eq!(j.trials(RUN).unwrap().len(), 1);
+    assert_eq!(j.events(RUN).unwrap().len(), 1);
+    assert_eq!(j.runs().unwrap().len(), 1);
+}
+
+#[test]
+fn reissue_then_late_result_accepted_once() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    let mut re = issue(RUN, 1, 2, "w2", 40_000);
+    re.reason = Some("lease expired (w1 silent)".to_string());
+    j.record_issue(&re).unwrap();
+
+    let row = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(row.state, TrialState::Running);
+    assert_eq!(row.attempts, 2);
+    assert_eq!(row.worker, "w2");
+    assert_eq!(row.issued_ms, 100, "issued_ms is the first issue");
+    assert_eq!(row.lease_until_ms, 70_000);
+
+    let events = j.events(RUN).unwrap();
+    assert_eq!(kinds(&events), ["issued", "reissued"]);
+    assert_eq!(events[1].attempt, 2);
+    assert_eq!(events[1].worker, "w2");
+    assert_eq!(events[1].at_ms, 40_000);
+    assert_eq!(events[1].note.as_deref(), Some("lease expired (w1 silent)"));
+
+    // The late result of attempt 1 arrives: the work was done, accept it.
+    let late = result(RUN, 1, 1, "w1", 41_000, 0.25);
+    assert_eq!(j.record_result(&late).unwrap(), ResultOutcome::Accepted);
+    let done = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(done.state, TrialState::Completed);
+    assert_eq!(done.attempts, 2);
+    assert_eq!(done.result_attempt, Some(1));
+    assert_eq!(done.worker, "w1");
+    assert_eq!(done.score, Some(0.25));
+
+    // Attempt 2's result, and a repeat of attempt 1's, are duplicates.
+    let current = result(RUN, 1, 2, "w2", 42_000, 0.75);
+    assert_eq!(j.record_result(&current).unwrap(), ResultOutcome::Duplicate);
+    assert_eq!(j.record_result(&late).unwrap(), ResultOutcome::Duplicate);
+    assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), done);
+
+    let events = j.events(RUN).unwrap();
+    assert_eq!(
+        kinds(&events),
+        ["issued", "reissued", "result", "duplicate", "duplicate"]
+    );
+    assert_eq!(events[2].attempt, 1);
+    assert!(events[2].note.as_deref().unwrap().contains("late"));
+    assert_eq!(events[3].worker, "w2");
+
+    // A completed trial cannot be re-issued.
+    let err = j.record_issue(&issue(RUN, 1, 3, "w3", 50_000)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::TrialClosed {
+                trial_id: 1,
+                state: TrialState::Completed,
+                ..
+            }
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn issue_validation() {
+    let mut j = journal_with_run();
+    // First issue must be attempt 1.
+    let err = j.record_issue(&issue(RUN, 1, 2, "w1", 100)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::AttemptMismatch {
+                expected: 1,
+                found: 2,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    // Re-issue must be the next attempt.
+    let err = j.record_issue(&issue(RUN, 1, 3, "w2", 200)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::AttemptMismatch {
+                expected: 2,
+                found: 3,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let err = j.record_issue(&issue(RUN, 1, 1, "w2", 200)).unwrap_err();
+    assert!(matches!(err, JournalError::AttemptMismatch { .. }), "{err}");
+    // Re-issue with other parameters.
+    let mut other = issue(RUN, 1, 2, "w2", 200);
+    other.params[0] += 1e-12;
+    let err = j.record_issue(&other).unwrap_err();
+    assert!(
+        matches!(err, JournalError::ParamsMismatch { trial_id: 1, .. }),
+        "{err}"
+    );
+    // Wrong number of parameters for the run.
+    let mut short = issue(RUN, 2, 1, "w1", 300);
+    short.params.pop();
+    let err = j.record_issue(&short).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::ParamCount {
+                expected: 3,
+                found: 2,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    // Unknown run.
+    let err = j
+        .record_issue(&issue("ghost", 1, 1, "w1", 300))
+        .unwrap_err();
+    assert!(
+        matches!(&err, JournalError::UnknownRun(r) if r == "ghost"),
+        "{err}"
+    );
+    // Trial ids beyond i64 are refused.
+    let err = j
+        .record_issue(&issue(RUN, u64::MAX, 1, "w1", 300))
+        .unwrap_err();
+    assert!(matches!(err, JournalError::TrialIdRange(u64::MAX)), "{err}");
+
+    // None of the refused issues wrote anything.
+    let trials = j.trials(RUN).unwrap();
+    assert_eq!(trials.len(), 1);
+    assert_eq!(trials[0].attempts, 1);
+    assert_eq!(trials[0].worker, "w1");
+    assert_eq!(kinds(&j.events(RUN).unwrap()), ["issued"]);
+}
+
+#[test]
+fn failure_is_final_and_once() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.record_issue(&issue(RUN, 2, 1, "w2", 100)).unwrap();
+    j.record_result(&result(RUN, 2, 1, "w2", 200, 0.4)).unwrap();
+
+    assert!(
+        j.record_failure(RUN, 1, 1, "hand fault: tendon 3", 300)
+            .unwrap()
+    );
+    let failed = j.trial(RUN, 1).unwrap().unwrap();
+    assert_eq!(failed.state, TrialState::Failed);
+    assert_eq!(failed.error.as_deref(), Some("hand fault: tendon 3"));
+    assert_eq!(failed.score, None);
+    assert_eq!(failed.completed_ms, None);
+
+    // Failing again, or failing a completed trial, changes nothing.
+    assert!(!j.record_failure(RUN, 1, 1, "second message", 400).unwrap());
+    assert!(!j.record_failure(RUN, 2, 1, "too late", 400).unwrap());
+    assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), failed);
+    assert_eq!(
+        j.trial(RUN, 2).unwrap().unwrap().state,
+        TrialState::Completed
+    );
+    assert_eq!(j.trial(RUN, 2).unwrap().unwrap().error, None);
+
+    // A result after the failure is a duplicate: the trial already ended.
+    assert_eq!(
+        j.record_result(&result(RUN, 1, 1, "w1", 500, 0.9)).unwrap(),
+        ResultOutcome::Duplicate
+    );
+    assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), failed);
+    // ... and it cannot be re-issued.
+    let err = j.record_issue(&issue(RUN, 1, 2, "w3", 600)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::TrialClosed {
+                state: TrialState::Failed,
+                ..
+            }
+        ),
+        "{err}"
+    );
+
+    let events = j.events(RUN).unwrap();
+    assert_eq!(
+        kinds(&events),
+        ["issued", "issued", "result", "failed", "duplicate"]
+    );
+    assert_eq!(events[3].note.as_deref(), Some("hand fault: tendon 3"));
+    assert_eq!(events[3].worker, "w1");
+    assert_eq!(events[4].note.as_deref(), Some("trial already failed"));
+}
+
+#[test]
+fn durability_reopen_and_wal_reader() {
+    let dir = TempDir::new("durable");
+    let db = dir.db();
+    {
+        let mut writer = Journal::open(&db).unwrap();
+        assert_eq!(writer.path(), Some(db.as_path()));
+        writer.create_run(&run_record(RUN)).unwrap();
+        writer.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        writer
+            .record_result(&result(RUN, 1, 1, "w1", 200, 0.5))
+            .unwrap();
+
+        // A second connection while the first is open sees committed rows.
+        let reader = Journal::open(&db).unwrap();
+        assert_eq!(reader.trials(RUN).unwrap(), writer.trials(RUN).unwrap());
+        assert_eq!(reader.trial(RUN, 1).unwrap().unwrap().score, Some(0.5));
+
+        // The file is in WAL mode, with a -wal file beside it while open.
+        let raw = rusqlite::Connection::open(&db).unwrap();
+        let mode: String = raw
+            .query_row("PRAGMA journal_mode", [], |r| r.get(0))
+            .unwrap();
+        assert_eq!(mode, "wal");
+        let version: i64 = raw
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .unwrap();
+        assert_eq!(version, SCHEMA_VERSION);
+        drop(raw);
+        let mut wal = db.clone().into_os_string();
+        wal.push("-wal");
+        assert!(Path::new(&wal).exists());
+
+        // Later writes by the first are seen by the open second.
+        writer.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+        assert_eq!(reader.trials(RUN).unwrap().len(), 2);
+        assert_eq!(reader.counts(RUN).unwrap().running, 1);
+        writer
+            .set_run_status(RUN, RunStatus::Finished, 900)
+            .unwrap();
+        assert_eq!(
+            reader.run(RUN).unwrap().unwrap().status,
+            RunStatus::Finished
+        );
+    }
+    let reopened = Journal::open(&db).unwrap();
+    assert!(reopened.integrity_check().unwrap());
+    let trials = reopened.trials(RUN).unwrap();
+    assert_eq!(trials.len(), 2);
+    assert_eq!(trials[0].state, TrialState::Completed);
+    assert_eq!(trials[0].score, Some(0.5));
+    assert_eq!(bits(&trials[0].params), bits(&params_for(1)));
+    assert_eq!(trials[1].state, TrialState::Running);
+    assert_eq!(
+        kinds(&reopened.events(RUN).unwrap()),
+        ["issued", "result", "issued"]
+    );
+    let run = reopened.run(RUN).unwrap().unwrap();
+    assert_eq!(
+        run,
+        RunRecord {
+            status: RunStatus::Finished,
+            ..run_record(RUN)
+        }
+    );
+}
+
+#[test]
+fn schema_version_checked_at_open() {
+    let dir = TempDir::new("schema");
+    let db = dir.db();
+    Journal::open(&db).unwrap();
+    {
+        let raw = rusqlite::Connection::open(&db).unwrap();
+        raw.execute_batch("PRAGMA user_version = 99").unwrap();
+    }
+    let err = Journal::open(&db).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            JournalError::SchemaVersion {
+                found: 99,
+                expected: SCHEMA_VERSION
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("99"), "{err}");
+
+    // Some other SQLite database is not taken for an empty journal.
+    let other = dir.0.join("other.sqlite");
+    {
+        let raw = rusqlite::Connection::open(&other).unwrap();
+        raw.execute_batch("CREATE TABLE notes (body TEXT)").unwrap();
+    }
+    let err = Journal::open(&other).unwrap_err();
+    assert!(matches!(err, JournalError::Schema(_)), "{err}");
+
+    // Right version number, wrong layout.
+    let tampered = dir.0.join("tampered.sqlite");
+    Journal::open(&tampered).unwrap();
+    {
+        let raw = rusqlite::Connection::open(&tampered).unwrap();
+        raw.execute_batch("ALTER TABLE trials ADD COLUMN extra TEXT")
+            .unwrap();
+    }
+    let err = Journal::open(&tampered).unwrap_err();
+    assert!(
+        matches!(&err, JournalError::Schema(m) if m.contains("trials")),
+        "{err}"
+    );
+}
+
+#[test]
+fn create_run_idempotent_and_config_mismatch() {
+    let mut j = Journal::open_in_memory().unwrap();
+    let run = run_record(RUN);
+    j.create_run(&run).unwrap();
+    j.create_run(&run).unwrap();
+    // Same JSON value, other spelling: still the same config.
+    let mut respelled = run.clone();
+    respelled.config_json =
+        r#"{ "hand": {"fingers": 3}, "budget": 50, "objective": "epsilon" }"#.to_string();
+    j.create_run(&respelled).unwrap();
+    assert_eq!(j.runs().unwrap(), vec![run.clone()]);
+
+    let mut changed = run.clone();
+    changed.config_json = r#"{"objective":"epsilon","budget":60,"hand":{"fingers":3}}"#.into();
+    let err = j.create_run(&changed).unwrap_err();
+    assert!(
+        matches!(&err, JournalError::ConfigMismatch { run_id } if run_id == RUN),
+        "{err}"
+    );
+    assert!(err.to_string().contains(RUN), "{err}");
+
+    let mut renamed = run.clone();
+    renamed.param_names[1] = "pitch".into();
+    let err = j.create_run(&renamed).unwrap_err();
+    assert!(matches!(err, JournalError::ConfigMismatch { .. }), "{err}");
+    assert_eq!(j.run(RUN).unwrap().unwrap(), run);
+
+    // runs() is by creation time, not by id or insertion.
+    let mut late = run_record("a-late");
+    late.created_ms = 5_000;
+    let mut early = run_record("z-early");
+    early.created_ms = 10;
+    j.create_run(&late).unwrap();
+    j.create_run(&early).unwrap();
+    let ids: Vec<String> = j.runs().unwrap().into_iter().map(|r| r.run_id).collect();
+    assert_eq!(ids, ["z-early", RUN, "a-late"]);
+
+    j.set_run_status("a-late", RunStatus::Stopped, 6_000)
+        .unwrap();
+    assert_eq!(j.run("a-late").unwrap().unwrap().status, RunStatus::Stopped);
+    let err = j
+        .set_run_status("ghost", RunStatus::Stopped, 6_000)
+        .unwrap_err();
+    assert!(
+        matches!(&err, JournalError::UnknownRun(r) if r == "ghost"),
+        "{err}"
+    );
+    assert_eq!(j.run("ghost").unwrap(), None);
+}
+
+#[test]
+fn non_finite_values_refused() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    let before = j.trial(RUN, 1).unwrap().unwrap();
+
+    let cases: Vec<(&str, TrialResultRecord)> = vec![
+        ("score", result(RUN, 1, 1, "w1", 200, f64::NAN)),
+        ("score", result(RUN, 1, 1, "w1", 200, f64::INFINITY)),
+        ("metrics.epsilon", {
+            let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
+            r.metrics.as_mut().unwrap().epsilon = f64::NEG_INFINITY;
+            r
+        }),
+        ("metrics.volume", {
+            let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
+            r.metrics.as_mut().unwrap().volume = Some(f64::NAN);
+            r
+        }),
+        ("metrics.distance", {
+            let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
+            r.metrics.as_mut().unwrap().distance = f64::NAN;
+            r
+        }),
+        ("metrics.bw", {
+            let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
+            r.metrics.as_mut().unwrap().bw = f64::INFINITY;
+            r
+        }),
+    ];
+    for (field, r) in cases {
+        let err = j.record_result(&r).unwrap_err();
+        assert!(
+            matches!(&err, JournalError::NonFinite { field: f } if f == field),
+            "{field}: {err}"
+        );
+        assert!(err.to_string().contains(field), "{err}");
+    }
+    assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), before);
+    assert_eq!(kinds(&j.events(RUN).unwrap()), ["issued"]);
+
+    let mut bad = issue(RUN, 2, 1, "w1", 100);
+    bad.params[1] = f64::NAN;
+    let err = j.record_issue(&bad).unwrap_err();
+    assert!(
+        matches!(&err, JournalError::NonFinite { field } if field == "params[1]"),
+        "{err}"
+    );
+    assert_eq!(j.trial(RUN, 2).unwrap(), None);
+    assert_eq!(j.events(RUN).unwrap().len(), 1);
+
+    // The valid result still goes through afterwards.
+    assert_eq!(
+        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap(),
+        ResultOutcome::Accepted
+    );
+}
+
+#[test]
+fn best_and_counts() {
+    let mut j = journal_with_run();
+    assert_eq!(j.best(RUN).unwrap(), None);
+    assert_eq!(j.counts(RUN).unwrap(), StateCounts::default());
+    for t in 1..=6 {
+        j.record_issue(&issue(RUN, t, 1, "w", 100 + t as i64))
+            .unwrap();
+    }
+    j.record_result(&result(RUN, 1, 1, "w", 200, 0.3)).unwrap();
+    j.record_result(&result(RUN, 2, 1, "w", 200, 0.8)).unwrap();
+    j.record_result(&result(RUN, 3, 1, "w", 200, -2.0)).unwrap();
+    j.record_result(&result(RUN, 4, 1, "w", 200, 0.8)).unwrap(); // tie with 2
+    j.record_failure(RUN, 5, 1, "hand error", 300).unwrap();
+
+    let best = j.best(RUN).unwrap().unwrap();
+    assert_eq!(best.trial_id, 2);
+    assert_eq!(best.score, Some(0.8));
+    assert_eq!(
+        j.counts(RUN).unwrap(),
+        StateCounts {
+            running: 1,
+            completed: 4,
+            failed: 1
+        }
+    );
+
+    // A better late result moves best; a duplicate that would be better does not.
+    j.record_result(&result(RUN, 6, 1, "w", 400, 0.95)).unwrap();
+    j.record_result(&result(RUN, 3, 1, "w", 500, 10.0)).unwrap();
+    assert_eq!(j.best(RUN).unwrap().unwrap().trial_id, 6);
+    assert_eq!(
+        j.counts(RUN).unwrap(),
+        StateCounts {
+            running: 0,
+            completed: 5,
+            failed: 1
+        }
+    );
+
+    // Other runs do not leak in.
+    j.create_run(&run_record("run-b")).unwrap();
+    assert_eq!(j.best("run-b").unwrap(), None);
+    assert_eq!(j.counts("run-b").unwrap(), StateCounts::default());
+}
+
+#[test]
+fn leases_and_max_trial_id() {
+    let mut j = journal_with_run();
+    assert_eq!(j.max_trial_id(RUN).unwrap(), None);
+    j.record_issue(&issue(RUN, 1, 1, "w1", 0)).unwrap(); // lease to 30_000
+    j.record_issue(&issue(RUN, 2, 1, "w2", 10_000)).unwrap(); // lease to 40_000
+    j.record_issue(&issue(RUN, 3, 1, "w3", 0)).unwrap();
+    j.record_result(&result(RUN, 3, 1, "w3", 100, 0.1)).unwrap();
+    assert_eq!(j.max_trial_id(RUN).unwrap(), Some(3));
+    let ids = |rows: Vec<TrialRow>| rows.into_iter().map(|t| t.trial_id).collect::<Vec<_>>();
+    assert_eq!(ids(j.expired_leases(RUN, 35_000).unwrap()), [1]);
+    assert_eq!(ids(j.expired_leases(RUN, 45_000).unwrap()), [1, 2]);
+    assert!(j.expired_leases(RUN, 1_000).unwrap().is_empty());
+}
+
+#[test]
+fn unknown_run_reads_are_errors() {
+    let j = journal_with_run();
+    let ghost = "ghost-run";
+    let check = |err: JournalError| {
+        assert!(
+            matches!(&err, JournalError::UnknownRun(r) if r == ghost),
+            "{err}"
+        );
+        assert!(err.to_string().contains(ghost), "{err}");
+    };
+    check(j.trials(ghost).unwrap_err());
+    check(j.trial(ghost, 1).unwrap_err());
+    check(j.events(ghost).unwrap_err());
+    check(j.best(ghost).unwrap_err());
+    check(j.counts(ghost).unwrap_err());
+    check(j.export(ghost).unwrap_err());
+    let mut out = Vec::new();
+    check(write_csv(&j, ghost, &mut out).unwrap_err());
+    check(write_json(&j, ghost, &mut out).unwrap_err());
+    assert!(out.is_empty());
+    assert!(j.trials(RUN).unwrap().is_empty());
+}
+
+#[test]
+fn csv_export_fields() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
+        .unwrap();
+    j.record_issue(&issue(RUN, 2, 1, "w,2", 300)).unwrap();
+    let message = "hand error: finger 2, \"jammed\" at 3 N";
+    assert!(j.record_failure(RUN, 2, 1, message, 400).unwrap());
+    j.record_issue(&issue(RUN, 3, 1, "w3", 500)).unwrap();
+    let mut r3 = result(RUN, 3, 1, "w3", 600, 1.0);
+    r3.metrics = None;
+    j.record_result(&r3).unwrap();
+    j.record_issue(&issue(RUN, 4, 1, "w4", 700)).unwrap();
+
+    let mut out = Vec::new();
+    write_csv(&j, RUN, &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    // The message is quoted and its quotes doubled, per RFC 4180.
+    assert!(
+        text.contains(r#","hand error: finger 2, ""jammed"" at 3 N""#),
+        "{text}"
+    );
+    assert!(text.contains(r#","w,2","#), "{text}");
+
+    let records = parse_csv(&text);
+    assert_eq!(records.len(), 5, "{text}");
+    assert_eq!(
+        records[0],
+        [
+            "trial",
+            "state",
+            "attempts",
+            "worker",
+            "issued_ms",
+            "completed_ms",
+            "approach_x",
+            "roll",
+            "aperture",
+            "score",
+            "rank",
+            "force_closure",
+            "epsilon",
+            "volume",
+            "distance",
+            "bw",
+            "contacts",
+            "fingers_in_contact",
+            "cloud_points",
+            "error"
+        ]
+    );
+    assert!(records.iter().all(|r| r.len() == 20), "{records:?}");
+    let f64_at = |rec: &[String], i: usize| rec[i].parse::<f64>().unwrap().to_bits();
+
+    let done = &records[1];
+    assert_eq!(&done[..6], ["1", "completed", "1", "w1", "100", "250"]);
+    for (k, p) in params_for(1).iter().enumerate() {
+        assert_eq!(
+            f64_at(done, 6 + k),
+            p.to_bits(),
+            "param {k}: {}",
+            done[6 + k]
+        );
+    }
+    let m = metrics_for(1);
+    assert_eq!(f64_at(done, 9), (0.1f64 + 0.2).to_bits());
+    assert_eq!(done[10], "6");
+    assert_eq!(done[11], "false");
+    assert_eq!(f64_at(done, 12), m.epsilon.to_bits());
+    assert_eq!(f64_at(done, 13), m.volume.unwrap().to_bits());
+    assert_eq!(f64_at(done, 14), m.distance.to_bits());
+    assert_eq!(f64_at(done, 15), m.bw.to_bits());
+    assert_eq!(&done[16..], ["7", "3", "4096", ""]);
+
+    let failed = &records[2];
+    assert_eq!(&failed[..6], ["2", "failed", "1", "w,2", "300", ""]);
+    assert!(failed[9..19].iter().all(String::is_empty), "{failed:?}");
+    assert_eq!(failed[19], message);
+
+    let no_metrics = &records[3];
+    assert_eq!(no_metrics[9], "1.0");
+    assert!(
+        no_metrics[10..16].iter().all(String::is_empty),
+        "{no_metrics:?}"
+    );
+    assert_eq!(&no_metrics[16..], ["7", "3", "4096", ""]);
+
+    let running = &records[4];
+    assert_eq!(&running[..6], ["4", "running", "1", "w4", "700", ""]);
+    assert!(running[9..].iter().all(String::is_empty), "{running:?}");
+}
+
+#[test]
+fn json_export_parses_back() {
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
+        .unwrap();
+    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+    j.record_failure(RUN, 2, 1, "hand error, \"jammed\"", 400)
+        .unwrap();
+
+    let mut out = Vec::new();
+    write_json(&j, RUN, &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("\n  \"run\": {"), "pretty: {text}");
+
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(value["run"]["run_id"], RUN);
+    assert_eq!(value["run"]["status"], "running");
+    assert_eq!(value["trials"][0]["state"], "completed");
+    assert_eq!(value["trials"][1]["state"], "failed");
+    assert_eq!(value["trials"].as_array().unwrap().len(), 2);
+
+    let back: RunExport = serde_json::from_str(&text).unwrap();
+    assert_eq!(back.run, run_record(RUN));
+    assert_eq!(back.trials, j.trials(RUN).unwrap());
+    assert_eq!(
+        bits(&back.trials[0].params),
+        bits(&params_for(1)),
+        "exact f64 through JSON"
+    );
+    assert_eq!(
+        back.trials[0].score.unwrap().to_bits(),
+        (0.1f64 + 0.2).to_bits()
+    );
+}
+
+// ------------------------------------------------------------ kill -9 test
+
+const CHILD_ENV: &str = "JOURNAL_CHILD_DB";
+const KILL_RUN: &str = "kill-run";
+const READY: &str = "JOURNAL_CHILD_READY";
+
+/// Not a test on its own: the body of the child process of
+/// `kill9_leaves_consistent_prefix`, which re-runs this binary with
+/// `JOURNAL_CHILD_DB` set. Without it, it returns at once.
+#[test]
+fn child_writer() {
+    let Ok(path) = std::env::var(CHILD_ENV) else {
+        return;
+    };
+    let mut j = Journal::open(Path::new(&path)).unwrap();
+    j.create_run(&run_record(KILL_RUN)).unwrap();
+    let mut next = j.max_trial_id(KILL_RUN).unwrap().unwrap_or(0);
+    // A trial left running by the previous kill is finished first.
+    if next > 0 && j.trial(KILL_RUN, next).unwrap().unwrap().state == TrialState::Running {
+        j.record_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
+            .unwrap();
+    }
+    println!("{READY}");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while Instant::now() < deadline {
+        next += 1;
+        j.record_issue(&issue(KILL_RUN, next, 1, "child", 0))
+            .unwrap();
+        j.record_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
+            .unwrap();
+    }
+    panic!("child writer was not killed within 30 s");
+}
+
+/// Checks that the journal holds trials 1..=n, all completed with the right
+/// result except possibly the last (issued, not yet completed), with exactly
+/// the matching events. Returns n.
+fn check_prefix(j: &Journal) -> usize {
+    let trials = j.trials(KILL_RUN).unwrap();
+    let events = j.events(KILL_RUN).unwrap();
+    let mut per_trial: BTreeMap<u64, Vec<&str>> = BTreeMap::new();
+    for e in &events {
+        per_trial
+            .entry(e.trial_id)
+            .or_default()
+            .push(e.kind.as_str());
+    }
+    for (i, t) in trials.iter().enumerate() {
+        let id = i as u64 + 1;
+        assert_eq!(t.trial_id, id, "trial ids must be contiguous from 1");
+        assert_eq!(bits(&t.params), bits(&params_for(id)), "trial {id}");
+        let is_last = i + 1 == trials.len();
+        match t.state {
+            TrialState::Completed => {
+                assert_eq!(t.score.map(f64::to_bits), Some(score_for(id).to_bits()));
+                assert_eq!(t.metrics, Some(metrics_for(id)));
+                assert_eq!(t.cloud_points, 4096);
+                assert_eq!(per_trial[&id], ["issued", "result"], "trial {id}");
+            }
+            TrialState::Running => {
+                assert!(
+                    is_last,
+                    "only the last trial may be unfinished (trial {id})"
+                );
+                assert_eq!(t.score, None);
+                assert_eq!(per_trial[&id], ["issued"], "trial {id}");
+            }
+            TrialState::Failed => panic!("trial {id} failed"),
+        }
+    }
+    assert_eq!(per_trial.len(), trials.len(), "events for unknown trials");
+    trials.len()
+}
+
+#[test]
+fn kill9_leaves_consistent_prefix() {
+    let dir = TempDir::new("kill9");
+    let db = dir.db();
+    let exe = std::env::current_exe().unwrap();
+    let mut previous = 0;
+    for round in 0..3 {
+        let mut child = Command::new(&exe)
+            .args(["--exact", "child_writer", "--nocapture", "--test-threads=1"])
+            .env(CHILD_ENV, &db)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let mut lines = BufReader::new(stdout).lines();
+        loop {
+            match lines.next() {
+                // libtest prints "test child_writer ... " before the body runs.
+                Some(Ok(line)) if line.trim_end().ends_with(READY) => break,
+                Some(Ok(_)) => {}
+                other => {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    panic!("child ended before it was ready: {other:?}");
+                }
+            }
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        child.kill().unwrap(); // SIGKILL on Unix
+        let status = child.wait().unwrap();
+        assert!(!status.success(), "round {round}: child was not killed");
+
+        let j = Journal::open(&db).unwrap();
+        assert!(j.integrity_check().unwrap(), "round {round}");
+        let n = check_prefix(&j);
+        let last = j.trial(KILL_RUN, n as u64).unwrap().map(|t| t.state);
+        println!("round {round}: {n} trials, last {last:?}");
+        assert!(
+            n > previous,
+            "round {round}: no progress ({n} trials, {previous} before)"
+        );
+        previous = n;
+    }
+}

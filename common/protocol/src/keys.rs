@@ -1,0 +1,367 @@
+//! The key-expression scheme. Every key is `graspopt/<run>/...`:
+//!
+//! | key                                   | message            | published by        |
+//! |---------------------------------------|--------------------|---------------------|
+//! | `graspopt/<run>/object`               | [`ObjectEstimate`] | perception          |
+//! | `graspopt/<run>/hand/<worker>/command`| [`TrialCommand`]   | coordinator         |
+//! | `graspopt/<run>/clouds`               | [`ContactClouds`]  | hand                |
+//! | `graspopt/<run>/result`               | [`TrialResult`]    | metric              |
+//! | `graspopt/<run>/status`               | [`RunStatus`]      | coordinator         |
+//! | `graspopt/<run>/planner/suggest`      | [`SuggestRequest`] -> [`SuggestReply`] (query) | planner answers |
+//! | `graspopt/<run>/coordinator/state`    | [`RunStatus`] (query) | coordinator answers |
+//! | `graspopt/<run>/alive/<kind>/<host>/<id>` | liveliness token | every agent       |
+//!
+//! Run ids, hosts and agent ids are single key chunks: ASCII letters, digits, `-`, `_` and `.`.
+//!
+//! [`ObjectEstimate`]: crate::ObjectEstimate
+//! [`TrialCommand`]: crate::TrialCommand
+//! [`ContactClouds`]: crate::ContactClouds
+//! [`TrialResult`]: crate::TrialResult
+//! [`RunStatus`]: crate::RunStatus
+//! [`SuggestRequest`]: crate::SuggestRequest
+//! [`SuggestReply`]: crate::SuggestReply
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// The first chunk of every key.
+pub const ROOT: &str = "graspopt";
+
+/// A key chunk that is not valid (empty, too long or with a character outside the allowed set).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "invalid {what} {value:?}: use 1 to 64 ASCII letters, digits, '-', '_' or '.' (not starting with '.')"
+)]
+pub struct KeyError {
+    pub what: &'static str,
+    pub value: String,
+}
+
+fn check_chunk(what: &'static str, value: &str) -> Result<(), KeyError> {
+    let ok = !value.is_empty()
+        && value.len() <= 64
+        && !value.starts_with('.')
+        && value
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(KeyError {
+            what,
+            value: value.to_string(),
+        })
+    }
+}
+
+/// Turns any text (a host name, say) into a valid key chunk: invalid characters become `_`,
+/// and the result is cut to 64 characters. Empty text becomes `unnamed`.
+pub fn sanitize_chunk(text: &str) -> String {
+    let mut s: String = text
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(64)
+        .collect();
+    if s.starts_with('.') {
+        s.replace_range(0..1, "_");
+    }
+    if s.is_empty() {
+        s = "unnamed".to_string();
+    }
+    s
+}
+
+/// A run id: one key chunk.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct RunId(String);
+
+impl RunId {
+    /// Checks and wraps a run id.
+    pub fn new(id: &str) -> Result<Self, KeyError> {
+        check_chunk("run id", id)?;
+        Ok(RunId(id.to_string()))
+    }
+
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+
+    fn prefix(&self) -> String {
+        format!("{ROOT}/{}", self.0)
+    }
+
+    /// `graspopt/<run>/object`
+    pub fn object_key(&self) -> String {
+        format!("{}/object", self.prefix())
+    }
+
+    /// `graspopt/<run>/hand/<worker>/command`
+    pub fn command_key(&self, worker: &str) -> String {
+        format!("{}/hand/{worker}/command", self.prefix())
+    }
+
+    /// `graspopt/<run>/clouds`
+    pub fn clouds_key(&self) -> String {
+        format!("{}/clouds", self.prefix())
+    }
+
+    /// `graspopt/<run>/result`
+    pub fn result_key(&self) -> String {
+        format!("{}/result", self.prefix())
+    }
+
+    /// `graspopt/<run>/status`
+    pub fn status_key(&self) -> String {
+        format!("{}/status", self.prefix())
+    }
+
+    /// `graspopt/<run>/planner/suggest`
+    pub fn suggest_key(&self) -> String {
+        format!("{}/planner/suggest", self.prefix())
+    }
+
+    /// `graspopt/<run>/coordinator/state`
+    pub fn state_key(&self) -> String {
+        format!("{}/coordinator/state", self.prefix())
+    }
+
+    /// `graspopt/<run>/alive/<kind>/<host>/<id>`
+    pub fn alive_key(&self, kind: AgentKind, host: &str, id: &str) -> String {
+        format!("{}/alive/{}/{host}/{id}", self.prefix(), kind.as_str())
+    }
+
+    /// `graspopt/<run>/alive/<kind>/**`
+    pub fn alive_kind_key(&self, kind: AgentKind) -> String {
+        format!("{}/alive/{}/**", self.prefix(), kind.as_str())
+    }
+
+    /// `graspopt/<run>/alive/**`
+    pub fn alive_all_key(&self) -> String {
+        format!("{}/alive/**", self.prefix())
+    }
+
+    /// Everything of this run: `graspopt/<run>/**`.
+    pub fn all_key(&self) -> String {
+        format!("{}/**", self.prefix())
+    }
+
+    /// The name of the shared-memory service that carries this run's contact clouds on a host.
+    pub fn shm_clouds_service(&self) -> String {
+        format!("{}/clouds", self.prefix())
+    }
+}
+
+impl fmt::Display for RunId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl TryFrom<String> for RunId {
+    type Error = KeyError;
+    fn try_from(value: String) -> Result<Self, Self::Error> {
+        check_chunk("run id", &value)?;
+        Ok(RunId(value))
+    }
+}
+
+impl From<RunId> for String {
+    fn from(value: RunId) -> Self {
+        value.0
+    }
+}
+
+/// Checks an agent id or host name used in a key.
+pub fn check_agent_id(id: &str) -> Result<(), KeyError> {
+    check_chunk("agent id", id)
+}
+
+/// The kinds of agent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AgentKind {
+    Perception,
+    Hand,
+    Metric,
+    Planner,
+    Coordinator,
+}
+
+impl AgentKind {
+    pub const ALL: [AgentKind; 5] = [
+        AgentKind::Perception,
+        AgentKind::Hand,
+        AgentKind::Metric,
+        AgentKind::Planner,
+        AgentKind::Coordinator,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AgentKind::Perception => "perception",
+            AgentKind::Hand => "hand",
+            AgentKind::Metric => "metric",
+            AgentKind::Planner => "planner",
+            AgentKind::Coordinator => "coordinator",
+        }
+    }
+
+    /// Parses a kind name.
+    pub fn parse(name: &str) -> Option<AgentKind> {
+        AgentKind::ALL.into_iter().find(|k| k.as_str() == name)
+    }
+}
+
+impl fmt::Display for AgentKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A liveliness key taken apart.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AliveKey {
+    pub run: RunId,
+    pub kind: AgentKind,
+    pub host: String,
+    pub id: String,
+}
+
+/// Parses `graspopt/<run>/alive/<kind>/<host>/<id>`.
+pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
+    let parts: Vec<&str> = key.split('/').collect();
+    match parts.as_slice() {
+        [root, run, "alive", kind, host, id] if *root == ROOT => Some(AliveKey {
+            run: RunId::new(run).ok()?,
+            kind: AgentKind::parse(kind)?,
+            host: (*host).to_string(),
+            id: (*id).to_string(),
+        }),
+        _ => None,
+    }
+}
+
+/// The published topics, for tools that list and decode them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Topic {
+    Object,
+    Command,
+    Clouds,
+    Result,
+    Status,
+}
+
+impl Topic {
+    pub const ALL: [Topic; 5] = [
+        Topic::Object,
+        Topic::Command,
+        Topic::Clouds,
+        Topic::Result,
+        Topic::Status,
+    ];
+
+    /// The message type carried.
+    pub fn message_type(self) -> &'static str {
+        match self {
+            Topic::Object => "ObjectEstimate",
+            Topic::Command => "TrialCommand",
+            Topic::Clouds => "ContactClouds",
+            Topic::Result => "TrialResult",
+            Topic::Status => "RunStatus",
+        }
+    }
+
+    /// Who publishes it.
+    pub fn publisher(self) -> AgentKind {
+        match self {
+            Topic::Object => AgentKind::Perception,
+            Topic::Command => AgentKind::Coordinator,
+            Topic::Clouds => AgentKind::Hand,
+            Topic::Result => AgentKind::Metric,
+            Topic::Status => AgentKind::Coordinator,
+        }
+    }
+
+    /// Which topic a concrete key belongs to, with its run.
+    pub fn classify(key: &str) -> Option<(RunId, Topic)> {
+        let parts: Vec<&str> = key.split('/').collect();
+        let (root, run, rest) = match parts.as_slice() {
+            [root, run, rest @ ..] => (*root, *run, rest),
+            _ => return None,
+        };
+        if root != ROOT {
+            return None;
+        }
+        let run = RunId::new(run).ok()?;
+        let topic = match rest {
+            ["object"] => Topic::Object,
+            ["hand", _, "command"] => Topic::Command,
+            ["clouds"] => Topic::Clouds,
+            ["result"] => Topic::Result,
+            ["status"] => Topic::Status,
+            _ => return None,
+        };
+        Some((run, topic))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_ids_are_single_chunks() {
+        assert!(RunId::new("mug-2026_11.22").is_ok());
+        for bad in ["", "a/b", "a*", "$x", "a b", ".hidden", &"x".repeat(65)] {
+            let e = RunId::new(bad).unwrap_err();
+            assert_eq!(e.value, bad);
+        }
+        assert!(serde_json::from_str::<RunId>("\"a/b\"").is_err());
+    }
+
+    #[test]
+    fn keys_classify_back_to_their_topic() {
+        let run = RunId::new("r1").unwrap();
+        let cases = [
+            (run.object_key(), Topic::Object),
+            (run.command_key("w-1"), Topic::Command),
+            (run.clouds_key(), Topic::Clouds),
+            (run.result_key(), Topic::Result),
+            (run.status_key(), Topic::Status),
+        ];
+        for (key, topic) in cases {
+            assert_eq!(Topic::classify(&key), Some((run.clone(), topic)), "{key}");
+        }
+        assert_eq!(Topic::classify("graspopt/r1/unknown"), None);
+        assert_eq!(Topic::classify("other/r1/result"), None);
+    }
+
+    #[test]
+    fn alive_keys_parse() {
+        let run = RunId::new("r1").unwrap();
+        let key = run.alive_key(AgentKind::Hand, "host-a", "hand-1");
+        assert_eq!(key, "graspopt/r1/alive/hand/host-a/hand-1");
+        let parsed = parse_alive_key(&key).unwrap();
+        assert_eq!(parsed.kind, AgentKind::Hand);
+        assert_eq!(parsed.host, "host-a");
+        assert_eq!(parsed.id, "hand-1");
+        assert!(parse_alive_key("graspopt/r1/alive/robot/h/i").is_none());
+    }
+
+    #[test]
+    fn sanitize_makes_valid_chunks() {
+        for text in ["my host.local", "", ".x", "a/b*c"] {
+            let s = sanitize_chunk(text);
+            assert!(check_agent_id(&s).is_ok(), "{text:?} -> {s:?}");
+        }
+        assert_eq!(sanitize_chunk("a b/c"), "a_b_c");
+    }
+}

@@ -1,0 +1,23 @@
+//! graspopt's wire protocol: what agents say to each other, and where.
+//!
+//! - [`messages`]: every message as a serde type. Each carries the run id and, where it concerns
+//!   a trial, the trial id and attempt, so results are idempotent by trial id.
+//! - [`keys`]: the key-expression scheme, in one place. Every key starts with
+//!   `graspopt/<run>/`.
+//! - [`codec`]: bincode 2 (the default) and JSON (for agents written in other languages), each
+//!   payload prefixed by the [`WIRE_VERSION`].
+//!
+//! This crate knows the shape of the conversation, not the network: it has no Zenoh, no
+//! sockets, no files. `docs/protocol.md` describes the same scheme for agent writers.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod codec;
+pub mod keys;
+pub mod messages;
+
+pub use codec::{DecodeError, Encoding, decode, encode};
+pub use keys::{AgentKind, RunId, Topic};
+pub use messages::*;
+
+/// The wire version every payload carries. Bumped on any incompatible change of a message.
+pub const WIRE_VERSION: u16 = 1;

@@ -1,0 +1,438 @@
+//! Every message between agents. Plain data: arrays for vectors and poses, so an agent in
+//! another language (a real hand, say) can produce them from `docs/protocol.md` alone.
+//!
+//! Each message type implements [`Message`]: its name, its run id and a validity check that
+//! decoders run on every payload (finite numbers, unit normals, consistent sizes), so an agent
+//! never acts on a message it could not have meant.
+
+use serde::{Deserialize, Serialize};
+
+use crate::keys::RunId;
+
+/// Implemented by every message type.
+pub trait Message: Serialize + for<'de> Deserialize<'de> {
+    /// The type name used in documents and tools.
+    const TYPE: &'static str;
+    /// The run this message belongs to.
+    fn run_id(&self) -> &RunId;
+    /// Checks the content; the error names the field.
+    fn validate(&self) -> Result<(), String>;
+}
+
+fn finite(field: &str, values: &[f64]) -> Result<(), String> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(format!("{field}[{i}] is not finite ({})", values[i])),
+        None => Ok(()),
+    }
+}
+
+/// A rigid pose: translation (metres) and a unit quaternion `[w, x, y, z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    pub translation: [f64; 3],
+    pub rotation: [f64; 4],
+}
+
+impl Pose {
+    pub const IDENTITY: Pose = Pose {
+        translation: [0.0; 3],
+        rotation: [1.0, 0.0, 0.0, 0.0],
+    };
+
+    /// Finite, with a quaternion of norm 1 within 1e-6.
+    pub fn validate(&self, field: &str) -> Result<(), String> {
+        finite(&format!("{field}.translation"), &self.translation)?;
+        finite(&format!("{field}.rotation"), &self.rotation)?;
+        let n = self.rotation.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if (n - 1.0).abs() > 1e-6 {
+            return Err(format!(
+                "{field}.rotation is not a unit quaternion (norm {n})"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A triangle mesh sent with an object (user meshes; built-in objects are sent by name).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshData {
+    pub vertices: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// perception -> everyone: the object the trials are planned against, in the world frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ObjectEstimate {
+    pub run_id: RunId,
+    /// A built-in object name (`mug`, `sphere`, ...) or the user mesh's name.
+    pub object: String,
+    /// The mesh, for objects that are not built in.
+    pub mesh: Option<MeshData>,
+    /// The estimated pose of the object's frame in the world.
+    pub pose: Pose,
+    /// Increases with every new estimate.
+    pub seq: u64,
+    pub stamp_ms: i64,
+    /// Who estimated it (an agent id).
+    pub source: String,
+}
+
+impl Message for ObjectEstimate {
+    const TYPE: &'static str = "ObjectEstimate";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        if self.object.trim().is_empty() {
+            return Err("object is empty".into());
+        }
+        self.pose.validate("pose")?;
+        if let Some(mesh) = &self.mesh {
+            for (i, v) in mesh.vertices.iter().enumerate() {
+                finite(&format!("mesh.vertices[{i}]"), v)?;
+            }
+            let n = mesh.vertices.len();
+            for (i, t) in mesh.triangles.iter().enumerate() {
+                if t.iter().any(|&k| k as usize >= n) {
+                    return Err(format!("mesh.triangles[{i}] refers to a missing vertex"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// coordinator -> one hand worker: execute this trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialCommand {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    /// 1 for the first issue, incremented on every re-issue.
+    pub attempt: u32,
+    /// The worker the trial is leased to.
+    pub worker: String,
+    /// The hand model the trial was planned for (`barrett`, `parallel_jaw`).
+    pub hand: String,
+    /// The trial parameters (the run's parameter names, in order).
+    pub params: Vec<f64>,
+    /// Where to put the palm (world frame), computed from the parameters and the object
+    /// estimate.
+    pub palm_pose: Pose,
+    /// The lease: the coordinator re-issues the trial if no result arrives within this time.
+    pub lease_ms: u64,
+    pub issued_ms: i64,
+}
+
+impl Message for TrialCommand {
+    const TYPE: &'static str = "TrialCommand";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        finite("params", &self.params)?;
+        self.palm_pose.validate("palm_pose")?;
+        if self.attempt == 0 {
+            return Err("attempt must be >= 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// One raw contact point: a position on the object's surface and the unit normal pointing
+/// into the object (world frame).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CloudPoint {
+    pub p: [f64; 3],
+    pub n: [f64; 3],
+}
+
+/// The raw contact cloud of one finger (`finger: None` for the palm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FingerCloud {
+    pub finger: Option<u32>,
+    pub links: Vec<String>,
+    pub points: Vec<CloudPoint>,
+}
+
+/// hand -> metric: what the hand touched in one trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactClouds {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    pub attempt: u32,
+    /// The hand worker that executed the trial.
+    pub worker: String,
+    pub hand: String,
+    /// The palm pose actually reached (world).
+    pub palm_pose: Pose,
+    /// One cloud per finger in finger order, then the palm's.
+    pub fingers: Vec<FingerCloud>,
+    /// Smallest distance between a link and the object (metres) when nothing touches; the
+    /// metric's no-contact score uses it. `None` when unknown.
+    pub min_gap: Option<f64>,
+    /// Set when the hand could not execute the trial (unreachable pose, hardware fault); the
+    /// clouds are then empty.
+    pub error: Option<String>,
+    pub executed_ms: i64,
+}
+
+impl ContactClouds {
+    /// Total number of points.
+    pub fn point_count(&self) -> usize {
+        self.fingers.iter().map(|f| f.points.len()).sum()
+    }
+}
+
+impl Message for ContactClouds {
+    const TYPE: &'static str = "ContactClouds";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        self.palm_pose.validate("palm_pose")?;
+        if let Some(g) = self.min_gap
+            && !(g.is_finite() && g >= 0.0)
+        {
+            return Err(format!("min_gap must be finite and >= 0, got {g}"));
+        }
+        for (f, finger) in self.fingers.iter().enumerate() {
+            for (i, pt) in finger.points.iter().enumerate() {
+                finite(&format!("fingers[{f}].points[{i}].p"), &pt.p)?;
+                finite(&format!("fingers[{f}].points[{i}].n"), &pt.n)?;
+                let n = pt.n.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if (n - 1.0).abs() > 1e-3 {
+                    return Err(format!(
+                        "fingers[{f}].points[{i}].n is not a unit normal (norm {n})"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The grasp-quality metrics of a trial (thesis chapter 2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MetricValues {
+    pub rank: u32,
+    pub force_closure: bool,
+    pub epsilon: f64,
+    pub volume: Option<f64>,
+    pub distance: f64,
+    pub bw: f64,
+}
+
+/// metric -> coordinator: the score of one trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialResult {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    pub attempt: u32,
+    /// The hand worker that executed the trial.
+    pub worker: String,
+    /// The metric agent that scored it.
+    pub scorer: String,
+    /// The objective the planner maximises.
+    pub score: f64,
+    /// The metrics, when anything was touched.
+    pub metrics: Option<MetricValues>,
+    /// Modelled contact points scored.
+    pub contacts: u32,
+    pub fingers_in_contact: u32,
+    /// Raw cloud points received.
+    pub cloud_points: u32,
+    /// How the clouds reached the scorer: `shm`, `zenoh` (empty when unknown).
+    pub cloud_transport: String,
+    /// Set when the trial failed (the hand's error, or a scoring error): the trial is
+    /// recorded as failed and not re-issued.
+    pub error: Option<String>,
+}
+
+impl Message for TrialResult {
+    const TYPE: &'static str = "TrialResult";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        if self.error.is_none() {
+            finite("score", &[self.score])?;
+        }
+        if let Some(m) = &self.metrics {
+            finite(
+                "metrics",
+                &[m.epsilon, m.distance, m.bw, m.volume.unwrap_or(0.0)],
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// One observation for the planner.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Observation {
+    pub x: Vec<f64>,
+    pub y: f64,
+}
+
+/// How the planner proposes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PlannerMethod {
+    /// Bayesian optimization (GP + EI + DIRECT).
+    #[default]
+    Bo,
+    /// Uniform random search.
+    Random,
+}
+
+/// coordinator -> planner (query): propose `count` trials.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SuggestRequest {
+    pub run_id: RunId,
+    pub request_id: u64,
+    pub method: PlannerMethod,
+    /// `[lower, upper]` per parameter.
+    pub bounds: Vec<[f64; 2]>,
+    pub seed: u64,
+    /// Size of the random initial design (`None`: the engine's default).
+    pub initial: Option<u32>,
+    /// Every completed trial, in completion order.
+    pub observations: Vec<Observation>,
+    /// Trials issued and not yet completed.
+    pub pending: Vec<Vec<f64>>,
+    pub count: u32,
+}
+
+impl Message for SuggestRequest {
+    const TYPE: &'static str = "SuggestRequest";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        let d = self.bounds.len();
+        if d == 0 {
+            return Err("bounds is empty".into());
+        }
+        for (i, b) in self.bounds.iter().enumerate() {
+            finite(&format!("bounds[{i}]"), b)?;
+            if b[0] >= b[1] {
+                return Err(format!("bounds[{i}] is empty ({} >= {})", b[0], b[1]));
+            }
+        }
+        for (i, o) in self.observations.iter().enumerate() {
+            if o.x.len() != d {
+                return Err(format!(
+                    "observations[{i}].x has {} values, not {d}",
+                    o.x.len()
+                ));
+            }
+            finite(&format!("observations[{i}].x"), &o.x)?;
+            finite(&format!("observations[{i}].y"), &[o.y])?;
+        }
+        for (i, p) in self.pending.iter().enumerate() {
+            if p.len() != d {
+                return Err(format!("pending[{i}] has {} values, not {d}", p.len()));
+            }
+            finite(&format!("pending[{i}]"), p)?;
+        }
+        if self.count == 0 || self.count > 1024 {
+            return Err(format!("count must be 1..=1024, got {}", self.count));
+        }
+        Ok(())
+    }
+}
+
+/// planner -> coordinator (reply).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SuggestReply {
+    pub run_id: RunId,
+    pub request_id: u64,
+    pub points: Vec<Vec<f64>>,
+    /// Set when the planner could not propose.
+    pub error: Option<String>,
+}
+
+impl Message for SuggestReply {
+    const TYPE: &'static str = "SuggestReply";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        for (i, p) in self.points.iter().enumerate() {
+            finite(&format!("points[{i}]"), p)?;
+        }
+        Ok(())
+    }
+}
+
+/// The phase of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunPhase {
+    /// Waiting for the object estimate, a planner or workers.
+    Waiting,
+    Running,
+    Finished,
+}
+
+/// The best trial so far.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BestTrial {
+    pub trial_id: u64,
+    pub score: f64,
+    pub params: Vec<f64>,
+    pub force_closure: Option<bool>,
+}
+
+/// A live hand worker.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WorkerStatus {
+    pub id: String,
+    pub host: String,
+    /// The trial it holds, if any.
+    pub trial: Option<u64>,
+}
+
+/// Counters of what the coordinator refused or repaired.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct ErrorCounts {
+    /// Payloads that did not decode or failed validation.
+    pub bad_messages: u64,
+    /// Results for trials this run does not know.
+    pub unknown_trial: u64,
+    /// Second and later results for a completed trial.
+    pub duplicates: u64,
+    /// Trials re-issued after a lost worker or an expired lease.
+    pub reissued: u64,
+    /// Trials that failed.
+    pub failed: u64,
+}
+
+/// coordinator -> monitors: the state of a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunStatus {
+    pub run_id: RunId,
+    pub phase: RunPhase,
+    pub object: String,
+    pub param_names: Vec<String>,
+    pub budget: u64,
+    pub completed: u64,
+    pub running: u64,
+    pub failed: u64,
+    pub best: Option<BestTrial>,
+    /// Best score after each completed trial.
+    pub best_history: Vec<f64>,
+    pub workers: Vec<WorkerStatus>,
+    pub errors: ErrorCounts,
+    pub stamp_ms: i64,
+}
+
+impl Message for RunStatus {
+    const TYPE: &'static str = "RunStatus";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn validate(&self) -> Result<(), String> {
+        Ok(())
+    }
+}

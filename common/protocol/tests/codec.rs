@@ -1,0 +1,215 @@
+//! Round trips of every message in both encodings, and refusal of bad payloads.
+
+use graspopt_protocol::codec::BINCODE_MIME;
+use graspopt_protocol::*;
+
+fn run() -> RunId {
+    RunId::new("run-1").unwrap()
+}
+
+fn clouds() -> ContactClouds {
+    ContactClouds {
+        run_id: run(),
+        trial_id: 7,
+        attempt: 2,
+        worker: "hand-1".into(),
+        hand: "barrett".into(),
+        palm_pose: Pose {
+            translation: [0.1, -0.2, 0.3],
+            rotation: [0.5, 0.5, 0.5, 0.5],
+        },
+        fingers: vec![
+            FingerCloud {
+                finger: Some(0),
+                links: vec!["f1_distal".into()],
+                points: vec![CloudPoint {
+                    p: [0.01, 0.1 + 0.2, 1e-300],
+                    n: [0.0, 0.6, 0.8],
+                }],
+            },
+            FingerCloud {
+                finger: None,
+                links: vec!["palm".into()],
+                points: vec![],
+            },
+        ],
+        min_gap: None,
+        error: None,
+        executed_ms: 1_700_000_000_000,
+    }
+}
+
+fn result() -> TrialResult {
+    TrialResult {
+        run_id: run(),
+        trial_id: 7,
+        attempt: 1,
+        worker: "hand-1".into(),
+        scorer: "metric-1".into(),
+        score: 0.123_456_789_012_345_67,
+        metrics: Some(MetricValues {
+            rank: 6,
+            force_closure: true,
+            epsilon: 0.123_456_789_012_345_67,
+            volume: None,
+            distance: 0.0,
+            bw: 0.123_456_789_012_345_67,
+        }),
+        contacts: 63,
+        fingers_in_contact: 3,
+        cloud_points: 120,
+        cloud_transport: "zenoh".into(),
+        error: None,
+    }
+}
+
+#[test]
+fn every_message_round_trips_exactly_in_both_encodings() {
+    let c = clouds();
+    let r = result();
+    let cmd = TrialCommand {
+        run_id: run(),
+        trial_id: 3,
+        attempt: 1,
+        worker: "hand-2".into(),
+        hand: "barrett".into(),
+        params: vec![-0.031_415_926_535_897_93, 0.02],
+        palm_pose: Pose::IDENTITY,
+        lease_ms: 30_000,
+        issued_ms: 5,
+    };
+    let req = SuggestRequest {
+        run_id: run(),
+        request_id: 9,
+        method: PlannerMethod::Bo,
+        bounds: vec![[-0.16, 0.02], [-0.05, 0.05]],
+        seed: 42,
+        initial: Some(5),
+        observations: vec![Observation {
+            x: vec![0.0, 0.01],
+            y: -1.5,
+        }],
+        pending: vec![vec![0.01, 0.0]],
+        count: 3,
+    };
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        assert_eq!(
+            decode::<ContactClouds>(&encode(&c, enc).unwrap(), enc).unwrap(),
+            c
+        );
+        assert_eq!(
+            decode::<TrialResult>(&encode(&r, enc).unwrap(), enc).unwrap(),
+            r
+        );
+        assert_eq!(
+            decode::<TrialCommand>(&encode(&cmd, enc).unwrap(), enc).unwrap(),
+            cmd
+        );
+        assert_eq!(
+            decode::<SuggestRequest>(&encode(&req, enc).unwrap(), enc).unwrap(),
+            req
+        );
+    }
+}
+
+#[test]
+fn bincode_payload_starts_with_the_wire_version() {
+    let bytes = encode(&result(), Encoding::Bincode).unwrap();
+    assert_eq!(u16::from_le_bytes([bytes[0], bytes[1]]), WIRE_VERSION);
+    let json: serde_json::Value =
+        serde_json::from_slice(&encode(&result(), Encoding::Json).unwrap()).unwrap();
+    assert_eq!(json["wire"], serde_json::json!(WIRE_VERSION));
+    assert_eq!(Encoding::from_mime(BINCODE_MIME), Encoding::Bincode);
+    assert_eq!(
+        Encoding::from_mime("application/json;charset=utf-8"),
+        Encoding::Json
+    );
+}
+
+#[test]
+fn a_hand_written_json_result_decodes() {
+    // What an agent in another language writes, from docs/protocol.md.
+    let text = r#"{"wire": 1, "run_id": "run-1", "trial_id": 4, "attempt": 1,
+        "worker": "py-hand", "scorer": "py", "score": -2.5, "metrics": null,
+        "contacts": 0, "fingers_in_contact": 0, "cloud_points": 0, "cloud_transport": "",
+        "error": null}"#;
+    let r: TrialResult = decode(text.as_bytes(), Encoding::Json).unwrap();
+    assert_eq!(r.trial_id, 4);
+    assert_eq!(r.score, -2.5);
+}
+
+#[test]
+fn wrong_version_is_refused_by_name() {
+    let mut bytes = encode(&result(), Encoding::Bincode).unwrap();
+    bytes[0] = 9;
+    let e = decode::<TrialResult>(&bytes, Encoding::Bincode).unwrap_err();
+    assert!(
+        matches!(e, DecodeError::WrongVersion { found: 9, .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("TrialResult"));
+    let text = r#"{"wire": 2, "run_id": "r"}"#;
+    let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
+    assert!(
+        matches!(e, DecodeError::WrongVersion { found: 2, .. }),
+        "{e}"
+    );
+}
+
+#[test]
+fn garbage_truncation_and_trailing_bytes_are_refused() {
+    let bytes = encode(&clouds(), Encoding::Bincode).unwrap();
+    for cut in 0..bytes.len() {
+        assert!(decode::<ContactClouds>(&bytes[..cut], Encoding::Bincode).is_err());
+    }
+    let mut long = bytes.clone();
+    long.push(0);
+    let e = decode::<ContactClouds>(&long, Encoding::Bincode).unwrap_err();
+    assert!(e.to_string().contains("trailing"), "{e}");
+    // A huge length prefix must not allocate: the 64 MiB limit refuses it.
+    let mut huge = WIRE_VERSION.to_le_bytes().to_vec();
+    huge.extend_from_slice(&[5, b'r', b'u', b'n', b'-', b'1', 7, 2, 0xfd]);
+    huge.extend_from_slice(&u64::MAX.to_le_bytes());
+    assert!(decode::<ContactClouds>(&huge, Encoding::Bincode).is_err());
+    // Pseudo-random bytes.
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    for len in 0..2000 {
+        let junk: Vec<u8> = (0..len % 300)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 32) as u8
+            })
+            .collect();
+        let _ = decode::<ContactClouds>(&junk, Encoding::Bincode);
+        let _ = decode::<TrialResult>(&junk, Encoding::Json);
+    }
+}
+
+#[test]
+fn invalid_content_is_refused_naming_the_field() {
+    let mut c = clouds();
+    c.fingers[0].points[0].p[1] = f64::NAN;
+    // JSON cannot carry NaN: bincode can, and validation catches it.
+    let bytes = encode(&c, Encoding::Bincode).unwrap();
+    let e = decode::<ContactClouds>(&bytes, Encoding::Bincode).unwrap_err();
+    assert!(matches!(e, DecodeError::Invalid { .. }));
+    assert!(e.to_string().contains("fingers[0].points[0].p[1]"), "{e}");
+
+    let mut c = clouds();
+    c.fingers[0].points[0].n = [0.0, 0.0, 0.0];
+    let e = decode::<ContactClouds>(&encode(&c, Encoding::Bincode).unwrap(), Encoding::Bincode)
+        .unwrap_err();
+    assert!(e.to_string().contains("unit normal"), "{e}");
+
+    let mut r = result();
+    r.score = f64::INFINITY;
+    let e = decode::<TrialResult>(&encode(&r, Encoding::Bincode).unwrap(), Encoding::Bincode)
+        .unwrap_err();
+    assert!(e.to_string().contains("score"), "{e}");
+
+    let text = r#"{"wire": 1, "run_id": "a/b", "trial_id": 4}"#;
+    let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
+    assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
+}

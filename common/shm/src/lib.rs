@@ -1,0 +1,985 @@
+//! Byte-message channels between processes on one host, over iceoryx2 shared
+//! memory (publish-subscribe, no daemon).
+//!
+//! # What this crate owns
+//!
+//! - [`ShmConfig`]: the iceoryx2 prefix that isolates one run (or one test)
+//!   from every other, and the capacities of each service.
+//! - [`ShmPublisher`]: copies a byte slice into a loaned shared-memory slice,
+//!   sends it, then wakes the subscribers through an iceoryx2 event service of
+//!   the same name.
+//! - [`ShmSubscriber`]: a dedicated thread that sleeps on that event service,
+//!   drains the samples and hands each payload to a callback.
+//! - The small protocol on that event service: wake-ups from publishers to
+//!   subscribers, and "connected" acknowledgements from each subscriber to a
+//!   new publisher.
+//! - [`available`] and [`clean_stale`]: the start-up probe that decides
+//!   between shared memory and the network, and the removal of resources left
+//!   by processes that died.
+//!
+//! # What it must not know
+//!
+//! Nothing of Zenoh, of the network fallback, or of graspopt message types
+//! and their encoding: it moves opaque bytes (`&[u8]` in, `&[u8]` out). The
+//! caller decides what a service name means and what the bytes are.
+//!
+//! # Threading
+//!
+//! Ports are built on `iceoryx2::service::ipc_threadsafe::Service`, whose
+//! node, port factories and ports are `Send` (the plain `ipc::Service` ports
+//! are not). A publisher therefore needs no thread of its own: its ports live
+//! behind a mutex and [`ShmPublisher::send`] copies straight from the caller's
+//! slice into shared memory on the caller's thread. Each subscriber owns one
+//! thread, because iceoryx2 has no async API and its wait calls block.
+//!
+//! # Wake-up
+//!
+//! After each send the publisher notifies the subscribers' listeners on the
+//! event service (a Unix datagram, sent only if the listener is not already
+//! notified); a subscriber thread blocks in the listener's wait, so it uses
+//! no CPU between messages and wakes within microseconds. The wait also times
+//! out every 20 ms, which bounds how long dropping a subscriber takes and
+//! covers a lost wake-up.
+//!
+//! # Delivery
+//!
+//! Services are created without safe overflow: when a subscriber's buffer is
+//! full, `send` waits for it to make room, for at most
+//! [`ShmConfig::delivery_timeout`]; after that the message is dropped for that
+//! subscriber only (counted by [`ShmPublisher::discarded_deliveries`]) and the
+//! service is scanned for dead processes. A live subscriber thread drains its
+//! buffer as fast as its callback returns, so nothing is lost in normal
+//! operation and a stuck or killed subscriber cannot block a publisher forever.
+//!
+//! iceoryx2 drops, rather than waits, when the full buffer belongs to a
+//! subscriber that has not yet connected to the publisher (its own thread
+//! connects it). Both `open`s therefore return only once the connections
+//! exist: [`ShmSubscriber::open`] connects to every existing publisher before
+//! it returns, and [`ShmPublisher::open`] waits until every existing
+//! subscriber has acknowledged the new publisher.
+//!
+//! # Stale resources
+//!
+//! A process killed with SIGKILL leaves its node, ports and shared memory
+//! behind. Creating a node and opening a service remove those of dead
+//! processes (iceoryx2's dead-node cleanup, enabled explicitly in the
+//! configuration), so a new process can always open the same service;
+//! [`clean_stale`] does it on demand, and a publisher also scans when a
+//! delivery times out and, at most once a second, in
+//! [`ShmPublisher::subscriber_count`].
+
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+use std::fmt::Display;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, Once};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use iceoryx2::identifiers::{UniqueNodeId, UniquePublisherId};
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::{BackpressureAction, BackpressureInfo};
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
+
+/// iceoryx2 service variant whose ports may move between threads.
+type Ipc = ipc_threadsafe::Service;
+
+/// Longest accepted [`ShmConfig::prefix`], in bytes.
+///
+/// The prefix is part of every file iceoryx2 creates, including the Unix
+/// socket path of each event listener (`/tmp/iceoryx2/<prefix><39
+/// digits>.event`), which must fit in the 108 bytes of `sun_path`.
+pub const MAX_PREFIX_LEN: usize = 32;
+
+/// Text every prefix made by [`run_prefix`] starts with.
+pub const PREFIX_BASE: &str = "graspopt_";
+
+/// How long a subscriber thread sleeps at most between two looks at its stop
+/// flag and its buffer (publishers wake it earlier through the event service).
+/// Bounds the time [`ShmSubscriber`]'s drop waits for the thread.
+const SUBSCRIBER_POLL: Duration = Duration::from_millis(20);
+
+/// Port name of each subscriber's wake-up listener.
+const WAKE_LISTENER: &str = "graspopt-shm-wake";
+/// Port name of each publisher's listener for "connected" acknowledgements.
+const ACK_LISTENER: &str = "graspopt-shm-ack";
+/// Event id of a wake-up (publisher to subscribers).
+const WAKE: EventId = EventId::new(0);
+/// Event id of a "connected" acknowledgement (subscriber to one publisher).
+const ACK: EventId = EventId::new(1);
+
+/// Pause of a subscriber thread after a failed wait.
+const ERROR_BACKOFF: Duration = Duration::from_millis(1);
+
+/// Least time between two dead-process scans from
+/// [`ShmPublisher::subscriber_count`].
+const STALE_SCAN_INTERVAL: Duration = Duration::from_secs(1);
+
+/// How long [`clean_stale`] waits for another process that is already cleaning
+/// up the same dead node.
+const CLEANUP_WAIT: Duration = Duration::from_millis(200);
+
+/// Errors of this crate. Each names the service (or prefix) and the operation
+/// that failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ShmError {
+    /// The [`ShmConfig`] cannot be used (bad prefix, zero capacity).
+    #[error("invalid shared-memory config: {0}")]
+    InvalidConfig(String),
+    /// The service name is not a valid iceoryx2 service name.
+    #[error("invalid shared-memory service name {service:?}: {reason}")]
+    InvalidServiceName {
+        /// The name that was refused.
+        service: String,
+        /// Why.
+        reason: String,
+    },
+    /// An operation on one service failed.
+    #[error("shared-memory service {service:?}: {operation} failed: {detail}")]
+    Service {
+        /// The service name.
+        service: String,
+        /// What was being done.
+        operation: &'static str,
+        /// The underlying error.
+        detail: String,
+    },
+    /// An operation over all services of a prefix failed.
+    #[error("shared memory (prefix {prefix:?}): {operation} failed: {detail}")]
+    Host {
+        /// The iceoryx2 prefix.
+        prefix: String,
+        /// What was being done.
+        operation: &'static str,
+        /// The underlying error.
+        detail: String,
+    },
+}
+
+/// Result type of this crate.
+pub type Result<T, E = ShmError> = std::result::Result<T, E>;
+
+/// Maps an iceoryx2 error to [`ShmError::Service`].
+fn service_err<'a, E: Display>(
+    service: &'a str,
+    operation: &'static str,
+) -> impl FnOnce(E) -> ShmError + 'a {
+    move |e| ShmError::Service {
+        service: service.to_owned(),
+        operation,
+        detail: e.to_string(),
+    }
+}
+
+/// Settings shared by every process that uses the same services: processes
+/// that open one service must agree on all of them except `delivery_timeout`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ShmConfig {
+    /// iceoryx2 `global.prefix`: every file and shared-memory object starts
+    /// with it, so two prefixes never see each other's services. Use
+    /// [`run_prefix`] (or [`ShmConfig::for_run`]) to build one from arbitrary
+    /// run text; `open` refuses anything but ASCII letters, digits, `_`, `-`
+    /// and `.` (not first), up to [`MAX_PREFIX_LEN`] bytes.
+    pub prefix: String,
+    /// Most publishers on one service (default 16).
+    pub max_publishers: usize,
+    /// Most subscribers on one service (default 8).
+    pub max_subscribers: usize,
+    /// Messages a subscriber can have queued before publishers wait
+    /// (default 64).
+    pub subscriber_buffer: usize,
+    /// Bytes of each publisher's first shared-memory slices (default 64 KiB);
+    /// a larger message makes the publisher reallocate to the next power of
+    /// two.
+    pub initial_payload: usize,
+    /// How long `send` waits for one subscriber with a full buffer before it
+    /// drops the message for that subscriber, and how long
+    /// [`ShmPublisher::open`] waits for the existing subscribers to connect
+    /// (default 1 s).
+    pub delivery_timeout: Duration,
+}
+
+impl Default for ShmConfig {
+    fn default() -> Self {
+        Self {
+            prefix: PREFIX_BASE.to_owned(),
+            max_publishers: 16,
+            max_subscribers: 8,
+            subscriber_buffer: 64,
+            initial_payload: 64 * 1024,
+            delivery_timeout: Duration::from_secs(1),
+        }
+    }
+}
+
+impl ShmConfig {
+    /// Default settings with the prefix [`run_prefix`]`(run)`.
+    pub fn for_run(run: &str) -> Self {
+        Self {
+            prefix: run_prefix(run),
+            ..Self::default()
+        }
+    }
+
+    /// Checks the prefix and capacities.
+    pub fn validate(&self) -> Result<()> {
+        let p = &self.prefix;
+        if p.is_empty() {
+            return Err(ShmError::InvalidConfig("the prefix is empty".into()));
+        }
+        if p.len() > MAX_PREFIX_LEN {
+            return Err(ShmError::InvalidConfig(format!(
+                "the prefix {p:?} has {} bytes, more than {MAX_PREFIX_LEN} (use run_prefix to shorten it)",
+                p.len()
+            )));
+        }
+        if let Some(c) = p.chars().find(|&c| !is_prefix_char(c)) {
+            return Err(ShmError::InvalidConfig(format!(
+                "the prefix {p:?} contains {c:?}; only ASCII letters, digits, '_', '-' and '.' are allowed (use run_prefix to sanitise it)"
+            )));
+        }
+        if p.starts_with('.') {
+            return Err(ShmError::InvalidConfig(format!(
+                "the prefix {p:?} starts with '.'"
+            )));
+        }
+        for (name, value) in [
+            ("max_publishers", self.max_publishers),
+            ("max_subscribers", self.max_subscribers),
+            ("subscriber_buffer", self.subscriber_buffer),
+            ("initial_payload", self.initial_payload),
+        ] {
+            if value == 0 {
+                return Err(ShmError::InvalidConfig(format!(
+                    "{name} must be at least 1"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The iceoryx2 configuration: iceoryx2's defaults (no config file is
+    /// read, so every process agrees) with this prefix.
+    fn iceoryx(&self) -> Result<Config> {
+        self.validate()?;
+        let mut config = Config::default();
+        config.global.prefix = FileName::new(self.prefix.as_bytes()).map_err(|e| {
+            ShmError::InvalidConfig(format!(
+                "iceoryx2 refuses the prefix {:?}: {e:?}",
+                self.prefix
+            ))
+        })?;
+        // Already iceoryx2's defaults; stated because stale-resource recovery
+        // relies on them.
+        config.global.node.cleanup_dead_nodes_on_creation = true;
+        config.global.node.cleanup_dead_nodes_on_destruction = true;
+        config.global.service.cleanup_dead_nodes_on_open = true;
+        Ok(config)
+    }
+
+    /// Nodes that may open one service: one per publisher and subscriber.
+    fn max_nodes(&self) -> usize {
+        self.max_publishers.saturating_add(self.max_subscribers)
+    }
+}
+
+fn is_prefix_char(c: char) -> bool {
+    c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.')
+}
+
+/// A valid prefix for one run: `"graspopt_" + run + "_"`, with every
+/// character outside `[A-Za-z0-9_-.]` replaced by `_`. Run text too long for
+/// [`MAX_PREFIX_LEN`] is cut and followed by a hash of the whole text, so two
+/// long run names that share a beginning still get different prefixes.
+pub fn run_prefix(run: &str) -> String {
+    let clean: String = run
+        .chars()
+        .map(|c| if is_prefix_char(c) { c } else { '_' })
+        .collect();
+    let room = MAX_PREFIX_LEN - PREFIX_BASE.len() - 1;
+    let body = if clean.len() <= room {
+        clean
+    } else {
+        // FNV-1a over the original text: stable across builds and platforms.
+        let hash = run.bytes().fold(0x811c_9dc5_u32, |h, b| {
+            (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+        });
+        let keep = room - 9;
+        format!("{}-{hash:08x}", &clean[..keep])
+    };
+    format!("{PREFIX_BASE}{body}_")
+}
+
+/// Sets iceoryx2's log level once: `IOX2_LOG_LEVEL` if set, otherwise
+/// warnings and errors only (its default, info, is noisy on stderr).
+fn init_logging() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| set_log_level_from_env_or(LogLevel::Warn));
+}
+
+fn port_name(service: &str, name: &str) -> Result<PortName> {
+    PortName::new(name).map_err(service_err(service, "name port"))
+}
+
+/// The node and the two services (data and events) behind one name.
+/// Field order is drop order.
+struct Endpoints {
+    events: EventFactory<Ipc>,
+    pubsub: PubSubFactory<Ipc, [u8], ()>,
+    _node: Node<Ipc>,
+}
+
+impl Endpoints {
+    fn open(config: &ShmConfig, service: &str, role: &str) -> Result<Self> {
+        init_logging();
+        let ice = config.iceoryx()?;
+        let name = ServiceName::new(service).map_err(|e| ShmError::InvalidServiceName {
+            service: service.to_owned(),
+            reason: format!("{e:?}"),
+        })?;
+        let node_name = NodeName::new(role).map_err(service_err(service, "name node"))?;
+        let node = NodeBuilder::new()
+            .name(&node_name)
+            .config(&ice)
+            // The host process owns SIGINT/SIGTERM; iceoryx2 must not install handlers.
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<Ipc>()
+            .map_err(service_err(service, "create iceoryx2 node"))?;
+        let pubsub = node
+            .service_builder(&name)
+            .publish_subscribe::<[u8]>()
+            .max_publishers(config.max_publishers)
+            .max_subscribers(config.max_subscribers)
+            .max_nodes(config.max_nodes())
+            .subscriber_max_buffer_size(config.subscriber_buffer)
+            .subscriber_max_borrowed_samples(1)
+            .history_size(0)
+            .enable_safe_overflow(false)
+            .open_or_create()
+            .map_err(service_err(service, "open publish-subscribe service"))?;
+        let events = node
+            .service_builder(&name)
+            .event()
+            // Each publisher and each subscriber has one notifier and one
+            // listener: wake-ups go one way, acknowledgements the other.
+            .max_notifiers(config.max_nodes())
+            .max_listeners(config.max_nodes())
+            .max_nodes(config.max_nodes())
+            .open_or_create()
+            .map_err(service_err(service, "open event service"))?;
+        Ok(Self {
+            events,
+            pubsub,
+            _node: node,
+        })
+    }
+}
+
+/// Publisher ports. Field order is drop order: ports before their services.
+struct PublisherPorts {
+    notifier: Notifier<Ipc>,
+    publisher: Publisher<Ipc, [u8], ()>,
+    acks: Listener<Ipc>,
+    endpoints: Endpoints,
+    wake_name: PortName,
+    last_stale_scan: Instant,
+}
+
+impl PublisherPorts {
+    fn open(
+        config: &ShmConfig,
+        service: &str,
+        timed_out: Arc<AtomicBool>,
+        discarded: Arc<AtomicU64>,
+    ) -> Result<Self> {
+        let endpoints = Endpoints::open(config, service, "graspopt-shm-publisher")?;
+        // Before the publisher port: a subscriber that sees the publisher
+        // must find this listener to acknowledge to.
+        let acks = endpoints
+            .events
+            .listener_builder()
+            .name(&port_name(service, ACK_LISTENER)?)
+            .create()
+            .map_err(service_err(service, "create acknowledgement listener"))?;
+        let timeout = config.delivery_timeout;
+        let publisher = endpoints
+            .pubsub
+            .publisher_builder()
+            .initial_max_slice_len(config.initial_payload)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .max_loaned_samples(1)
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .set_backpressure_handler(move |info: &BackpressureInfo| {
+                if info.elapsed_time < timeout {
+                    BackpressureAction::Retry
+                } else {
+                    timed_out.store(true, Ordering::Relaxed);
+                    discarded.fetch_add(1, Ordering::Relaxed);
+                    BackpressureAction::DiscardData
+                }
+            })
+            .create()
+            .map_err(service_err(service, "create publisher"))?;
+        let notifier = endpoints
+            .events
+            .notifier_builder()
+            .default_event_id(WAKE)
+            .create()
+            .map_err(service_err(service, "create notifier"))?;
+        let ports = Self {
+            notifier,
+            publisher,
+            acks,
+            endpoints,
+            wake_name: port_name(service, WAKE_LISTENER)?,
+            last_stale_scan: Instant::now(),
+        };
+        ports.wait_for_subscribers(config.delivery_timeout);
+        Ok(ports)
+    }
+
+    /// Wakes every subscriber thread on the service (not the publishers'
+    /// acknowledgement listeners).
+    fn wake_subscribers(&self) {
+        self.notifier.for_each_listener(|listener, details| {
+            if details.listener_name == self.wake_name {
+                // A failed wake-up only delays delivery until the
+                // subscriber's next poll.
+                let _ = listener.notify();
+            }
+            CallbackProgression::Continue
+        });
+    }
+
+    /// Waits until every subscriber on the service has connected to this
+    /// publisher, or `timeout` passed.
+    ///
+    /// A subscriber connects from its own thread. Until it has, iceoryx2
+    /// queues messages for it but, once its queue is full, drops further ones
+    /// instead of waiting (it cannot tell a slow subscriber from one that will
+    /// never connect). So a publisher that sent more than `subscriber_buffer`
+    /// messages right after opening could lose some; each subscriber instead
+    /// acknowledges the new publisher once connected, and `open` waits for
+    /// the acknowledgements.
+    fn wait_for_subscribers(&self, timeout: Duration) -> bool {
+        let start = Instant::now();
+        let mut acknowledged = 0u64;
+        self.wake_subscribers();
+        loop {
+            let subscribers = self
+                .endpoints
+                .pubsub
+                .dynamic_config()
+                .number_of_subscribers() as u64;
+            if acknowledged >= subscribers {
+                return true;
+            }
+            let left = timeout.saturating_sub(start.elapsed());
+            if left.is_zero() {
+                return false;
+            }
+            let _ = self.acks.timed_wait(
+                |event| {
+                    if event.id == ACK {
+                        acknowledged += event.count;
+                    }
+                },
+                left.min(SUBSCRIBER_POLL),
+            );
+        }
+    }
+
+    fn send(&self, service: &str, bytes: &[u8]) -> Result<()> {
+        let sample = self
+            .publisher
+            .loan_slice_uninit(bytes.len())
+            .map_err(service_err(service, "loan shared-memory slice"))?;
+        sample
+            .write_from_slice(bytes)
+            .send()
+            .map_err(service_err(service, "send"))?;
+        self.wake_subscribers();
+        Ok(())
+    }
+}
+
+struct PublisherShared {
+    service: String,
+    timed_out: Arc<AtomicBool>,
+    discarded: Arc<AtomicU64>,
+    ports: Mutex<PublisherPorts>,
+}
+
+/// Sends byte messages on one service. `Send + Sync + Clone`; clones share the
+/// same iceoryx2 node and publisher (dropped with the last clone), and sends
+/// from clones are serialised.
+#[derive(Clone)]
+pub struct ShmPublisher {
+    shared: Arc<PublisherShared>,
+}
+
+impl std::fmt::Debug for ShmPublisher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmPublisher")
+            .field("service", &self.shared.service)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ShmPublisher {
+    /// Opens (creating if needed) `service`, a name like
+    /// `"graspopt/run-1/clouds"`, and a publisher on it. Resources of dead
+    /// processes are removed first. Returns once every subscriber already on
+    /// the service has connected to the new publisher (so a burst sent at
+    /// once is not lost), or after [`ShmConfig::delivery_timeout`] if one
+    /// does not answer (its thread stuck in a callback).
+    pub fn open(config: &ShmConfig, service: &str) -> Result<ShmPublisher> {
+        let timed_out = Arc::new(AtomicBool::new(false));
+        let discarded = Arc::new(AtomicU64::new(0));
+        let ports = PublisherPorts::open(config, service, timed_out.clone(), discarded.clone())?;
+        Ok(ShmPublisher {
+            shared: Arc::new(PublisherShared {
+                service: service.to_owned(),
+                timed_out,
+                discarded,
+                ports: Mutex::new(ports),
+            }),
+        })
+    }
+
+    /// The service name.
+    pub fn service(&self) -> &str {
+        &self.shared.service
+    }
+
+    fn lock(&self, operation: &'static str) -> Result<MutexGuard<'_, PublisherPorts>> {
+        self.shared.ports.lock().map_err(|_| ShmError::Service {
+            service: self.shared.service.clone(),
+            operation,
+            detail: "the publisher lock is poisoned (an earlier call panicked)".into(),
+        })
+    }
+
+    /// Copies `bytes` into a loaned shared-memory slice, sends it to every
+    /// connected subscriber and wakes them. Returns once the message is in
+    /// every subscriber's queue (or dropped for a subscriber whose queue stayed
+    /// full for [`ShmConfig::delivery_timeout`]). Messages larger than
+    /// [`ShmConfig::initial_payload`] make the publisher reallocate its
+    /// shared memory to the next power of two.
+    pub fn send(&self, bytes: &[u8]) -> Result<()> {
+        let ports = self.lock("send")?;
+        let sent = ports.send(&self.shared.service, bytes);
+        if self.shared.timed_out.swap(false, Ordering::Relaxed) {
+            // A subscriber stayed full: if its process died, remove it so the
+            // next send does not wait for it again.
+            ports.endpoints.pubsub.try_cleanup_dead_nodes();
+        }
+        sent
+    }
+
+    /// Number of subscribers currently on the service (from its dynamic
+    /// config), whichever process they are in. At most once a second this
+    /// also removes subscribers of dead processes, so a killed subscriber is
+    /// not counted for long.
+    pub fn subscriber_count(&self) -> Result<usize> {
+        let mut ports = self.lock("count subscribers")?;
+        if ports.last_stale_scan.elapsed() >= STALE_SCAN_INTERVAL {
+            ports.endpoints.pubsub.try_cleanup_dead_nodes();
+            ports.last_stale_scan = Instant::now();
+        }
+        Ok(ports
+            .endpoints
+            .pubsub
+            .dynamic_config()
+            .number_of_subscribers())
+    }
+
+    /// Deliveries dropped so far because a subscriber's queue stayed full
+    /// for [`ShmConfig::delivery_timeout`] (one per message and subscriber).
+    pub fn discarded_deliveries(&self) -> u64 {
+        self.shared.discarded.load(Ordering::Relaxed)
+    }
+}
+
+/// Subscriber ports. Field order is drop order.
+struct SubscriberPorts {
+    wake: Listener<Ipc>,
+    acks: Notifier<Ipc>,
+    subscriber: Subscriber<Ipc, [u8], ()>,
+    endpoints: Endpoints,
+    ack_name: PortName,
+    /// Publishers this subscriber has connected to and acknowledged.
+    known_publishers: Vec<UniquePublisherId>,
+}
+
+impl SubscriberPorts {
+    fn open(config: &ShmConfig, service: &str) -> Result<Self> {
+        let endpoints = Endpoints::open(config, service, "graspopt-shm-subscriber")?;
+        let wake = endpoints
+            .events
+            .listener_builder()
+            .name(&port_name(service, WAKE_LISTENER)?)
+            .create()
+            .map_err(service_err(service, "create listener"))?;
+        let acks = endpoints
+            .events
+            .notifier_builder()
+            .default_event_id(ACK)
+            .create()
+            .map_err(service_err(service, "create acknowledgement notifier"))?;
+        let subscriber = endpoints
+            .pubsub
+            .subscriber_builder()
+            .buffer_size(config.subscriber_buffer)
+            .create()
+            .map_err(service_err(service, "create subscriber"))?;
+        let mut ports = Self {
+            wake,
+            acks,
+            subscriber,
+            endpoints,
+            ack_name: port_name(service, ACK_LISTENER)?,
+            known_publishers: Vec::new(),
+        };
+        // Connected to every existing publisher before `open` returns, so
+        // nothing sent afterwards is dropped for want of a connection.
+        ports
+            .connect_publishers()
+            .map_err(service_err(service, "connect to publishers"))?;
+        Ok(ports)
+    }
+
+    /// Connects to the publishers that appeared since the last call and
+    /// acknowledges each to its publisher (which waits for it in `open`).
+    fn connect_publishers(&mut self) -> Result<(), impl Display + use<>> {
+        let mut current: Vec<(UniquePublisherId, UniqueNodeId)> = Vec::new();
+        self.endpoints
+            .pubsub
+            .dynamic_config()
+            .list_publishers(|details| {
+                current.push((details.publisher_id, details.node_id));
+                CallbackProgression::Continue
+            });
+        if current.len() == self.known_publishers.len()
+            && current
+                .iter()
+                .all(|(id, _)| self.known_publishers.contains(id))
+        {
+            return Ok(());
+        }
+        let connected = self.subscriber.update_connections();
+        let new_nodes: Vec<UniqueNodeId> = current
+            .iter()
+            .filter(|(id, _)| !self.known_publishers.contains(id))
+            .map(|&(_, node)| node)
+            .collect();
+        if !new_nodes.is_empty() {
+            self.acks.for_each_listener(|listener, details| {
+                if details.listener_name == self.ack_name && new_nodes.contains(&details.node_id) {
+                    // Unacknowledged, the publisher only waits longer.
+                    let _ = listener.notify();
+                }
+                CallbackProgression::Continue
+            });
+        }
+        self.known_publishers = current.into_iter().map(|(id, _)| id).collect();
+        connected
+    }
+
+    /// Hands every queued payload to `on_message`; false if `stop` was set.
+    fn drain(
+        &self,
+        stop: &AtomicBool,
+        errors: &AtomicU64,
+        on_message: &mut impl FnMut(&[u8]),
+    ) -> bool {
+        loop {
+            if stop.load(Ordering::Acquire) {
+                return false;
+            }
+            match self.subscriber.receive() {
+                Ok(Some(sample)) => on_message(sample.payload()),
+                Ok(None) => return true,
+                Err(_) => {
+                    errors.fetch_add(1, Ordering::Relaxed);
+                    return true;
+                }
+            }
+        }
+    }
+
+    fn run(mut self, stop: &AtomicBool, errors: &AtomicU64, mut on_message: impl FnMut(&[u8])) {
+        while self.drain(stop, errors, &mut on_message) {
+            if self.connect_publishers().is_err() {
+                errors.fetch_add(1, Ordering::Relaxed);
+            }
+            // Sleep until a publisher's notification, or the poll period
+            // (which bounds how long a stop request waits). Notifications
+            // sent while draining are kept, so none is missed.
+            match self.wake.timed_wait(|_| {}, SUBSCRIBER_POLL) {
+                // A signal delivered to this thread: just look again.
+                Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
+                Err(_) => {
+                    errors.fetch_add(1, Ordering::Relaxed);
+                    // Do not spin if the wait keeps failing.
+                    std::thread::sleep(ERROR_BACKOFF);
+                }
+            }
+        }
+    }
+}
+
+/// Receives byte messages on one service on a dedicated thread.
+///
+/// Dropping it stops the thread (within about 20 ms plus the callback in
+/// progress), waits for it, and releases the iceoryx2 resources; the callback
+/// is never called after the drop returns.
+pub struct ShmSubscriber {
+    service: String,
+    stop: Arc<AtomicBool>,
+    errors: Arc<AtomicU64>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for ShmSubscriber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmSubscriber")
+            .field("service", &self.service)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ShmSubscriber {
+    /// Opens (creating if needed) `service` and subscribes to it. Every
+    /// message sent after this returns is handed to `on_message`, in order
+    /// per publisher, on the subscriber's thread; the slice points into shared
+    /// memory and is valid only during the call. A slow callback makes
+    /// publishers wait (see [`ShmConfig::delivery_timeout`]); a callback that
+    /// panics ends the subscription (the thread stops and its ports close).
+    pub fn open(
+        config: &ShmConfig,
+        service: &str,
+        on_message: impl FnMut(&[u8]) + Send + 'static,
+    ) -> Result<ShmSubscriber> {
+        let ports = SubscriberPorts::open(config, service)?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let errors = Arc::new(AtomicU64::new(0));
+        let thread = {
+            let stop = stop.clone();
+            let errors = errors.clone();
+            std::thread::Builder::new()
+                .name(format!("shm-sub {service}"))
+                .spawn(move || ports.run(&stop, &errors, on_message))
+                .map_err(service_err(service, "spawn subscriber thread"))?
+        };
+        Ok(ShmSubscriber {
+            service: service.to_owned(),
+            stop,
+            errors,
+            thread: Some(thread),
+        })
+    }
+
+    /// The service name.
+    pub fn service(&self) -> &str {
+        &self.service
+    }
+
+    /// Receive or wait errors met by the thread so far (it carries on after
+    /// each).
+    pub fn receive_errors(&self) -> u64 {
+        self.errors.load(Ordering::Relaxed)
+    }
+}
+
+impl Drop for ShmSubscriber {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        if let Some(thread) = self.thread.take() {
+            // Dropped from inside its own callback: the thread ends when the
+            // callback returns; joining itself would deadlock.
+            if thread.thread().id() != std::thread::current().id() {
+                // A panic in the callback already ended the thread.
+                let _ = thread.join();
+            }
+        }
+    }
+}
+
+/// True if iceoryx2 works here: a throwaway service under `config.prefix`
+/// carries one message from a publisher to a subscriber. Takes a few
+/// milliseconds; call it once at start-up to choose between shared memory and
+/// the network.
+pub fn available(config: &ShmConfig) -> bool {
+    std::panic::catch_unwind(|| probe(config).is_ok()).unwrap_or(false)
+}
+
+fn probe(config: &ShmConfig) -> Result<()> {
+    static PROBES: AtomicU64 = AtomicU64::new(0);
+    let service = format!(
+        "graspopt/shm-probe/{}/{}",
+        std::process::id(),
+        PROBES.fetch_add(1, Ordering::Relaxed)
+    );
+    let config = ShmConfig {
+        max_publishers: 1,
+        max_subscribers: 1,
+        subscriber_buffer: 1,
+        initial_payload: 64,
+        ..config.clone()
+    };
+    // Publisher first: the subscriber connects to it while opening, and no
+    // thread of the subscriber's has to acknowledge it.
+    let publisher = PublisherPorts::open(
+        &config,
+        &service,
+        Arc::new(AtomicBool::new(false)),
+        Arc::new(AtomicU64::new(0)),
+    )?;
+    let subscriber = SubscriberPorts::open(&config, &service)?;
+    let message = b"graspopt shm probe";
+    publisher.send(&service, message)?;
+    match subscriber.subscriber.receive() {
+        Ok(Some(sample)) if sample.payload() == message => Ok(()),
+        Ok(_) => Err(ShmError::Service {
+            service,
+            operation: "probe",
+            detail: "the probe message did not arrive".into(),
+        }),
+        Err(e) => Err(service_err(&service, "probe receive")(e)),
+    }
+}
+
+/// Removes the resources of dead processes (nodes whose process is gone,
+/// with their ports, connections and services nobody else uses) under
+/// `config.prefix`, and returns how many dead nodes were removed. Opening a
+/// publisher or subscriber also does this; call it at start-up to reclaim
+/// shared memory early.
+pub fn clean_stale(config: &ShmConfig) -> Result<usize> {
+    init_logging();
+    let ice = config.iceoryx()?;
+    let mut removed = 0;
+    Node::<Ipc>::list(&ice, |state| {
+        if let NodeState::Dead(dead) = state
+            && dead.blocking_remove_stale_resources(CLEANUP_WAIT).is_ok()
+        {
+            removed += 1;
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| ShmError::Host {
+        prefix: config.prefix.clone(),
+        operation: "list nodes",
+        detail: e.to_string(),
+    })?;
+    Ok(removed)
+}
+
+/// Runs [`clean_stale`] for every prefix that starts with `start` (for
+/// instance [`PREFIX_BASE`]) and has nodes on this host; returns how many
+/// dead nodes were removed in all.
+///
+/// With one prefix per run, [`clean_stale`] at start-up only sees the new
+/// run's prefix, so what a crashed earlier run left (its shared memory
+/// included) would stay until someone used that prefix again; this finds
+/// those prefixes. Best effort: a prefix whose cleanup fails is skipped. It
+/// reads iceoryx2's node directory, laid out (in iceoryx2 0.10) as
+/// `<root>/nodes/<node id>/<prefix>node.details`.
+pub fn clean_stale_prefixes(start: &str) -> Result<usize> {
+    init_logging();
+    let config = Config::default();
+    let node_dir = config.global.node_dir();
+    let suffix = format!("node{}", config.global.node.static_config_suffix.as_str());
+    let nodes = match std::fs::read_dir(node_dir.as_str()) {
+        Ok(nodes) => nodes,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+        Err(e) => {
+            return Err(ShmError::Host {
+                prefix: start.to_owned(),
+                operation: "list the node directory",
+                detail: format!("{node_dir}: {e}"),
+            });
+        }
+    };
+    let mut prefixes = std::collections::BTreeSet::new();
+    for node in nodes.flatten() {
+        // Node monitors are files next to the node directories: skipped.
+        let Ok(files) = std::fs::read_dir(node.path()) else {
+            continue;
+        };
+        for file in files.flatten() {
+            if let Some(prefix) = file
+                .file_name()
+                .to_str()
+                .and_then(|name| name.strip_suffix(suffix.as_str()))
+                && prefix.starts_with(start)
+            {
+                prefixes.insert(prefix.to_owned());
+            }
+        }
+    }
+    Ok(prefixes
+        .into_iter()
+        .filter_map(|prefix| {
+            clean_stale(&ShmConfig {
+                prefix,
+                ..ShmConfig::default()
+            })
+            .ok()
+        })
+        .sum())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handles_can_move_between_threads() {
+        fn shareable<T: Send + Sync + Clone>() {}
+        fn movable<T: Send + Sync>() {}
+        shareable::<ShmPublisher>();
+        movable::<ShmSubscriber>();
+    }
+
+    #[test]
+    fn run_prefix_sanitises_and_bounds() {
+        assert_eq!(run_prefix("run-1"), "graspopt_run-1_");
+        assert_eq!(run_prefix("a/b c:d"), "graspopt_a_b_c_d_");
+        let long = "x".repeat(100);
+        let p = run_prefix(&long);
+        assert_eq!(p.len(), MAX_PREFIX_LEN);
+        assert_ne!(p, run_prefix(&format!("{long}y")));
+        for run in ["", "é", "../..", &long] {
+            let config = ShmConfig::for_run(run);
+            config.validate().unwrap();
+            config.iceoryx().unwrap();
+        }
+    }
+
+    #[test]
+    fn bad_prefixes_are_refused() {
+        for prefix in ["", "a/b", ".hidden", "é", &"x".repeat(MAX_PREFIX_LEN + 1)] {
+            let config = ShmConfig {
+                prefix: prefix.into(),
+                ..ShmConfig::default()
+            };
+            let err = config.validate().unwrap_err();
+            assert!(
+                matches!(err, ShmError::InvalidConfig(_)),
+                "{prefix:?}: {err}"
+            );
+        }
+        let zero = ShmConfig {
+            subscriber_buffer: 0,
+            ..ShmConfig::default()
+        };
+        assert!(zero.validate().is_err());
+    }
+}

@@ -1,0 +1,125 @@
+//! Scoring contact clouds measured by a hand, real or simulated: what a metric agent does
+//! with the clouds a hand sends. The contact models are built from the raw clouds here (the
+//! surface model on the estimated object), then scored exactly as [`score_outcome`] scores a
+//! simulated trial, so a trial scored from its clouds equals the same trial scored whole.
+
+use graspopt_sim::contact::{circular_patch, mean_point, surface_model};
+use graspopt_sim::{
+    ContactCloud, ContactModelSettings, ContactPoint, FingerOutcome, Grasp, Object, TrialOutcome,
+};
+use nalgebra::Isometry3;
+
+use crate::error::TrialError;
+use crate::score::{ScoreSettings, TrialScore, score_outcome};
+
+/// One finger's raw cloud as measured (`finger: None` for the palm).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredFinger {
+    pub finger: Option<usize>,
+    pub links: Vec<String>,
+    pub points: Vec<ContactPoint>,
+}
+
+/// What a hand measured in one trial.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredTrial {
+    pub hand: String,
+    /// The palm pose reached (world).
+    pub palm_pose: Isometry3<f64>,
+    /// Fingers in order, then the palm.
+    pub fingers: Vec<MeasuredFinger>,
+    /// Smallest link-object distance when nothing touches.
+    pub min_gap: Option<f64>,
+}
+
+impl MeasuredTrial {
+    /// The measurement of a simulated trial (its raw clouds only).
+    pub fn from_outcome(outcome: &TrialOutcome) -> MeasuredTrial {
+        let finger = |f: &FingerOutcome| MeasuredFinger {
+            finger: f.finger,
+            links: f.links.clone(),
+            points: f.cloud.points.clone(),
+        };
+        let gap = outcome
+            .grasp
+            .link_distances
+            .iter()
+            .copied()
+            .filter(|d| d.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        MeasuredTrial {
+            hand: outcome.grasp.hand.clone(),
+            palm_pose: outcome.grasp.palm_pose,
+            fingers: outcome
+                .fingers
+                .iter()
+                .chain(std::iter::once(&outcome.palm))
+                .map(finger)
+                .collect(),
+            min_gap: gap.is_finite().then_some(gap),
+        }
+    }
+
+    /// Rebuilds a trial outcome on `object`: contact models from the raw clouds.
+    pub fn to_outcome(&self, object: &Object, settings: &ContactModelSettings) -> TrialOutcome {
+        let model = |m: &MeasuredFinger| FingerOutcome {
+            finger: m.finger,
+            links: m.links.clone(),
+            cloud: ContactCloud {
+                points: m.points.clone(),
+            },
+            mean_point: mean_point(&m.points),
+            circular_patch: circular_patch(&m.points, settings),
+            surface: surface_model(&m.points, object, settings),
+        };
+        let fingers: Vec<FingerOutcome> = self
+            .fingers
+            .iter()
+            .filter(|f| f.finger.is_some())
+            .map(model)
+            .collect();
+        let palm = self
+            .fingers
+            .iter()
+            .find(|f| f.finger.is_none())
+            .map(model)
+            .unwrap_or(FingerOutcome {
+                finger: None,
+                links: Vec::new(),
+                cloud: ContactCloud::default(),
+                mean_point: None,
+                circular_patch: Vec::new(),
+                surface: Vec::new(),
+            });
+        let touched = self.fingers.iter().any(|f| !f.points.is_empty());
+        TrialOutcome {
+            object: object.name().to_string(),
+            grasp: Grasp {
+                hand: self.hand.clone(),
+                requested_palm_pose: self.palm_pose,
+                palm_pose: self.palm_pose,
+                retreat: 0.0,
+                joints: Vec::new(),
+                link_poses: Vec::new(),
+                link_touching: Vec::new(),
+                link_distances: self.min_gap.into_iter().collect(),
+            },
+            fingers,
+            palm,
+            touched,
+        }
+    }
+}
+
+/// Scores measured clouds on `object` (the object estimate the trials are planned against).
+pub fn score_measured(
+    measured: &MeasuredTrial,
+    object: &Object,
+    contacts: &ContactModelSettings,
+    score: &ScoreSettings,
+) -> Result<(TrialScore, TrialOutcome), TrialError> {
+    contacts.validate()?;
+    let outcome = measured.to_outcome(object, contacts);
+    let s = score_outcome(&outcome, object, score)?;
+    Ok((s, outcome))
+}
