@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudSender, now_ms};
-use graspopt_convert::{TrialTag, clouds_from_outcome, isometry, pose};
+use graspopt_convert::{TrialTag, clouds_from_outcome, isometry};
 use graspopt_protocol::{AgentKind, ContactClouds, ObjectEstimate, RunId, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
 use serde::{Deserialize, Serialize};
@@ -79,18 +79,28 @@ impl SimulatedHand {
         let palm = isometry(&command.palm_pose);
         match run_trial(world, self.hand.as_ref(), &palm, &self.settings) {
             Ok(outcome) => clouds_from_outcome(&tag, &outcome, now_ms()),
-            Err(e) => ContactClouds {
-                run_id: tag.run_id,
-                trial_id: tag.trial_id,
-                attempt: tag.attempt,
-                worker: tag.worker,
-                hand: self.hand.name().to_string(),
-                palm_pose: pose(&palm),
-                fingers: Vec::new(),
-                min_gap: None,
-                error: Some(format!("hand could not execute the trial: {e}")),
-                executed_ms: now_ms(),
-            },
+            Err(e) => self.refuse(
+                command,
+                worker,
+                format!("hand could not execute the trial: {e}"),
+            ),
+        }
+    }
+
+    /// The answer to a command this hand does not execute: no clouds, the reason in `error`
+    /// (the coordinator records the trial as failed).
+    pub fn refuse(&self, command: &TrialCommand, worker: &str, error: String) -> ContactClouds {
+        ContactClouds {
+            run_id: command.run_id.clone(),
+            trial_id: command.trial_id,
+            attempt: command.attempt,
+            worker: worker.to_string(),
+            hand: self.hand.name().to_string(),
+            palm_pose: command.palm_pose,
+            fingers: Vec::new(),
+            min_gap: None,
+            error: Some(error),
+            executed_ms: now_ms(),
         }
     }
 }
@@ -171,10 +181,8 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
                 let h = hand.clone();
                 let id = config.id.clone();
                 let mut clouds = if command.hand != hand.name() {
-                    let mut c = h.execute(&object, &command, &id);
-                    c.fingers.clear();
-                    c.error = Some(format!("worker {} has a {} hand, the trial asks for {}", id, hand.name(), command.hand));
-                    c
+                    let why = format!("worker {id} has a {} hand, the trial asks for {}", hand.name(), command.hand);
+                    hand.refuse(&command, &id, why)
                 } else {
                     tokio::task::spawn_blocking(move || h.execute(&object, &command, &id))
                         .await

@@ -10,7 +10,7 @@ use graspopt_sim::{
 use nalgebra::Isometry3;
 
 use crate::error::TrialError;
-use crate::score::{ScoreSettings, TrialScore, score_outcome};
+use crate::score::{ScoreSettings, TrialScore, closest_gap, score_outcome};
 
 /// One finger's raw cloud as measured (`finger: None` for the palm).
 #[derive(Debug, Clone, PartialEq)]
@@ -40,13 +40,6 @@ impl MeasuredTrial {
             links: f.links.clone(),
             points: f.cloud.points.clone(),
         };
-        let gap = outcome
-            .grasp
-            .link_distances
-            .iter()
-            .copied()
-            .filter(|d| d.is_finite())
-            .fold(f64::INFINITY, f64::min);
         MeasuredTrial {
             hand: outcome.grasp.hand.clone(),
             palm_pose: outcome.grasp.palm_pose,
@@ -56,7 +49,7 @@ impl MeasuredTrial {
                 .chain(std::iter::once(&outcome.palm))
                 .map(finger)
                 .collect(),
-            min_gap: gap.is_finite().then_some(gap),
+            min_gap: closest_gap(outcome),
         }
     }
 

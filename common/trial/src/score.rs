@@ -183,6 +183,12 @@ pub fn no_contact_score(
     }
     let rho = model.torque_scale;
     let bound = wrench_norm_bound(object, model);
+    let gap = closest_gap(outcome).map_or(1.0, |g| (g / rho).min(1.0));
+    -(bound + 1.0) - gap
+}
+
+/// The closed hand's smallest finite link-object distance, if any.
+pub fn closest_gap(outcome: &TrialOutcome) -> Option<f64> {
     let gap = outcome
         .grasp
         .link_distances
@@ -190,12 +196,7 @@ pub fn no_contact_score(
         .copied()
         .filter(|d| d.is_finite())
         .fold(f64::INFINITY, f64::min);
-    let gap = if gap.is_finite() {
-        (gap / rho).min(1.0)
-    } else {
-        1.0
-    };
-    -(bound + 1.0) - gap
+    gap.is_finite().then_some(gap)
 }
 
 /// An upper bound on the norm of any contact wrench on `object` under `model`: force at

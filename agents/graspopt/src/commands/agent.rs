@@ -115,23 +115,27 @@ pub fn load<T: DeserializeOwned + Default>(path: Option<&Path>) -> Result<T> {
     }
 }
 
-async fn until_signal<F: std::future::Future<Output = Result<()>>>(agent: F) -> Result<()> {
+/// Resolves on Ctrl-C or SIGTERM.
+pub async fn shutdown_signal() {
     let term = async {
         #[cfg(unix)]
+        if let Ok(mut s) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
         {
-            if let Ok(mut s) =
-                tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-            {
-                s.recv().await;
-                return;
-            }
+            s.recv().await;
+            return;
         }
         std::future::pending::<()>().await
     };
     tokio::select! {
+        _ = tokio::signal::ctrl_c() => {},
+        _ = term => {},
+    }
+}
+
+async fn until_signal<F: std::future::Future<Output = Result<()>>>(agent: F) -> Result<()> {
+    tokio::select! {
         r = agent => r,
-        _ = tokio::signal::ctrl_c() => Ok(()),
-        _ = term => Ok(()),
+        _ = shutdown_signal() => Ok(()),
     }
 }
 

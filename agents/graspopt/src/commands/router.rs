@@ -24,20 +24,7 @@ pub fn run(args: &RouterArgs) -> Result<ExitCode> {
     runtime.block_on(async {
         let session = Bus::open(&bus).await?;
         eprintln!("graspopt router listening on {}", bus.listen.join(", "));
-        let term = async {
-            #[cfg(unix)]
-            if let Ok(mut s) =
-                tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-            {
-                s.recv().await;
-                return;
-            }
-            std::future::pending::<()>().await
-        };
-        tokio::select! {
-            _ = tokio::signal::ctrl_c() => {},
-            _ = term => {},
-        }
+        super::agent::shutdown_signal().await;
         session.close().await?;
         Ok::<(), anyhow::Error>(())
     })?;

@@ -312,7 +312,8 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn placeholder(e: &Embedded) -> RunStatus {
+/// The status before the coordinator's first one.
+pub fn placeholder(e: &Embedded) -> RunStatus {
     RunStatus {
         run_id: e.run.clone(),
         phase: graspopt_protocol::RunPhase::Waiting,
