@@ -1,6 +1,7 @@
 //! End-to-end tests live in `tests/tests/`; this library holds what they share: finding the
-//! `graspopt` binary, scratch folders, free loopback ports, and child processes that are
-//! killed when the test ends (pass or fail).
+//! `graspopt` binary, scratch folders, free loopback ports, child processes that are killed
+//! when the test ends (pass or fail), a router with agents around it, and checks of a
+//! finished run's journal.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
@@ -131,4 +132,143 @@ pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect();
     (header, rows)
+}
+
+/// Waits until something accepts TCP connections on `127.0.0.1:port`.
+pub fn wait_for_port(port: u16, timeout: Duration) {
+    let start = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            start.elapsed() < timeout,
+            "nothing listens on port {port} after {timeout:?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// A router on a free loopback port and the flags every agent of one run needs to join it.
+pub struct Cluster {
+    pub dir: PathBuf,
+    /// The router's endpoint, `tcp/127.0.0.1:<port>`.
+    pub endpoint: String,
+    pub run: String,
+    /// This cluster's shared-memory prefix (unique per test process and cluster).
+    pub shm: String,
+    router: Proc,
+}
+
+impl Cluster {
+    /// Starts the router and waits until it listens.
+    pub fn start(name: &str, run: &str) -> Cluster {
+        let dir = tempdir(name);
+        let port = free_port();
+        let endpoint = format!("tcp/127.0.0.1:{port}");
+        let router = Proc::start(
+            "router",
+            &["router", "--listen", &endpoint, "--no-multicast-scouting"],
+            &dir,
+        );
+        wait_for_port(port, Duration::from_secs(20));
+        // Short: the prefix is at most 32 characters.
+        let tag: String = name
+            .chars()
+            .filter(char::is_ascii_alphanumeric)
+            .take(6)
+            .collect();
+        let shm = format!("gpe2e_{tag}_{}_", std::process::id());
+        Cluster {
+            dir,
+            endpoint,
+            run: run.to_string(),
+            shm,
+            router,
+        }
+    }
+
+    /// Starts `graspopt agent ...` (`args` from `agent` on) with the run, router and
+    /// shared-memory flags added; its stderr goes to `<dir>/<name>.log`.
+    pub fn agent(&self, name: &str, args: &[&str]) -> Proc {
+        let mut v: Vec<&str> = vec!["agent"];
+        v.extend_from_slice(args);
+        v.extend_from_slice(&[
+            "--run",
+            &self.run,
+            "--connect",
+            &self.endpoint,
+            "--no-multicast-scouting",
+            "--shm-prefix",
+            &self.shm,
+        ]);
+        Proc::start(name, &v, &self.dir)
+    }
+
+    /// The log of one of this cluster's processes.
+    pub fn log(&self, name: &str) -> String {
+        log(&self.dir, name)
+    }
+
+    /// The router process (to check it survived).
+    pub fn router(&mut self) -> &mut Proc {
+        &mut self.router
+    }
+}
+
+/// Column index by name.
+pub fn col(header: &[String], name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+/// Checks the journal of a finished run: exactly `n` completed trials with finite scores and
+/// metrics consistent with each other (BW > 0 exactly when force closure), ids 1..=n.
+/// Returns the trials.
+pub fn check_journal(path: &Path, run: &str, n: usize) -> Vec<graspopt_journal::TrialRow> {
+    let journal = graspopt_journal::Journal::open(path).unwrap();
+    assert!(journal.integrity_check().unwrap());
+    let trials = journal.trials(run).unwrap();
+    assert_eq!(trials.len(), n, "trials in the journal");
+    for (i, t) in trials.iter().enumerate() {
+        assert_eq!(t.trial_id, i as u64 + 1);
+        assert_eq!(
+            t.state,
+            graspopt_journal::TrialState::Completed,
+            "trial {}",
+            t.trial_id
+        );
+        assert!(t.score.unwrap().is_finite());
+        if let Some(m) = &t.metrics {
+            assert!(m.bw.is_finite() && m.epsilon >= 0.0 && m.distance >= 0.0);
+            assert_eq!(m.bw > 0.0, m.force_closure, "trial {}", t.trial_id);
+        }
+    }
+    trials
+}
+
+/// The best (id, score) the journal holds for a run.
+pub fn journal_best(path: &Path, run: &str) -> (u64, f64) {
+    let journal = graspopt_journal::Journal::open(path).unwrap();
+    let best = journal.best(run).unwrap().unwrap();
+    (best.trial_id, best.score.unwrap())
+}
+
+/// The path a trial's clouds took to the metric agent (`shm` or `zenoh`), from the journal.
+pub fn cloud_transport(t: &graspopt_journal::TrialRow) -> String {
+    let details: serde_json::Value =
+        serde_json::from_str(t.details_json.as_deref().unwrap_or("{}")).unwrap();
+    details["cloud_transport"]
+        .as_str()
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// Sends a signal to a process with `kill(1)` (`STOP`, `CONT`, `KILL`).
+pub fn signal(p: &Proc, name: &str) {
+    let ok = Command::new("kill")
+        .args([format!("-{name}"), p.child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "kill -{name} {}", p.name);
 }

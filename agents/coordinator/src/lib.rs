@@ -366,10 +366,8 @@ impl Ctx<'_> {
                     ),
                 }
             }
-        } else {
-            // Let the journal log the duplicate; it changes no trial.
-            let _ = self.journal.record_result(&journal_result(result, now));
         }
+        // A duplicate is counted in the run's status and leaves the journal as it is.
         Ok(self.state.on_result(result))
     }
 }

@@ -39,6 +39,8 @@ enum Command {
     Agent(commands::agent::AgentArgs),
     /// A Zenoh router, for agents on several machines.
     Router(commands::router::RouterArgs),
+    /// Start the agents a launch file places on this machine, each its own process.
+    Launch(commands::launch::LaunchArgs),
     /// A run's trials from its journal, as CSV or JSON.
     Export(commands::export::ExportArgs),
     /// Figures of the distributed pipeline (throughput, overhead, cloud latency).
@@ -66,6 +68,7 @@ fn main() -> ExitCode {
         Command::Run(args) => commands::run::run(args),
         Command::Agent(args) => commands::agent::run(args),
         Command::Router(args) => commands::router::run(args),
+        Command::Launch(args) => commands::launch::run(args),
         Command::Export(args) => commands::export::run(args),
         Command::Bench(args) => commands::bench::run(args),
     };

@@ -17,7 +17,7 @@ use graspopt_bus::{Bus, BusArgs, CloudPath, CloudReceiver, CloudSender, free_loo
 use graspopt_protocol::{CloudPoint, ContactClouds, FingerCloud, Pose, RunId, RunStatus};
 use tokio::sync::watch;
 
-use super::run::{Embedded, Method, RunArgs, run_embedded};
+use super::run::{Embedded, Method, RunArgs, placeholder, run_embedded};
 use super::setup::SimArgs;
 
 #[derive(Args, Debug)]
@@ -82,19 +82,24 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
+/// The benchmark's object, hand and scoring: the cylinder, the Barrett hand, the defaults.
+fn bench_sim() -> SimArgs {
+    SimArgs {
+        object: "cylinder".into(),
+        mesh: None,
+        hand: "barrett".into(),
+        contacts: super::setup::Contacts::Surface,
+        metric: "bw".into(),
+        frame: super::setup::Frame::Object,
+        torque_scale: None,
+    }
+}
+
 fn embedded(tag: &str, workers: usize, trials: u64, cost: u64, method: Method) -> Result<Embedded> {
     let dir = std::env::temp_dir().join(format!("graspopt-bench-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let args = RunArgs {
-        sim: SimArgs {
-            object: "cylinder".into(),
-            mesh: None,
-            hand: "barrett".into(),
-            contacts: super::setup::Contacts::Surface,
-            metric: "bw".into(),
-            frame: super::setup::Frame::Object,
-            torque_scale: None,
-        },
+        sim: bench_sim(),
         run: format!("bench-{tag}"),
         workers,
         trials,
@@ -116,21 +121,7 @@ fn embedded(tag: &str, workers: usize, trials: u64, cost: u64, method: Method) -
 
 /// Runs an embedded run and returns the instants at which each trial completed.
 async fn timed_run(e: &Embedded) -> Result<(RunStatus, Vec<Instant>)> {
-    let (tx, mut rx) = watch::channel(RunStatus {
-        run_id: e.run.clone(),
-        phase: graspopt_protocol::RunPhase::Waiting,
-        object: String::new(),
-        param_names: Vec::new(),
-        budget: 0,
-        completed: 0,
-        running: 0,
-        failed: 0,
-        best: None,
-        best_history: Vec::new(),
-        workers: Vec::new(),
-        errors: Default::default(),
-        stamp_ms: 0,
-    });
+    let (tx, mut rx) = watch::channel(placeholder(e));
     let follow = tokio::spawn(async move {
         let mut seen = 0u64;
         let mut times = Vec::new();
@@ -162,11 +153,19 @@ async fn pipeline(
     for &w in workers {
         let trials = per_worker * w as u64;
         let e = embedded(&format!("tp{w}"), w, trials, cost, Method::Random)?;
-        let (_, times) = timed_run(&e).await?;
-        // From the first completion to the last: the steady state, without start-up.
-        let (first, last) = (times[0], times[times.len() - 1]);
-        let span = last.duration_since(first).as_secs_f64();
-        let rate = (times.len() - 1) as f64 / span;
+        timed_run(&e).await?;
+        // From the first trial's issue to the last trial's result, by the journal's clock:
+        // every trial counts, start-up (agents joining) does not.
+        let journal = graspopt_journal::Journal::open(&e.coordinator.journal)?;
+        let rows = journal.trials(e.run.as_str())?;
+        let first = rows.iter().map(|r| r.issued_ms).min().unwrap_or(0);
+        let last = rows
+            .iter()
+            .filter_map(|r| r.completed_ms)
+            .max()
+            .unwrap_or(0);
+        let span = (last - first).max(1) as f64 / 1e3;
+        let rate = rows.len() as f64 / span;
         let b = *base.get_or_insert(rate);
         println!(
             "| {w} | {trials} | {span:.2} | {rate:.2} | {:.2} | {:.2} |",
@@ -186,16 +185,7 @@ async fn pipeline(
     // The same trials executed and scored directly, in this process.
     let journal = graspopt_journal::Journal::open(&e.coordinator.journal)?;
     let rows = journal.trials(e.run.as_str())?;
-    let sim = SimArgs {
-        object: "cylinder".into(),
-        mesh: None,
-        hand: "barrett".into(),
-        contacts: super::setup::Contacts::Surface,
-        metric: "bw".into(),
-        frame: super::setup::Frame::Object,
-        torque_scale: None,
-    };
-    let ev = sim.evaluator(&e.spec.params)?;
+    let ev = bench_sim().evaluator(&e.spec.params)?;
     let mut direct = Vec::with_capacity(rows.len());
     for r in &rows {
         let t = Instant::now();

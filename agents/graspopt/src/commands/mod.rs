@@ -4,6 +4,7 @@ pub mod agent;
 pub mod bench;
 pub mod experiment;
 pub mod export;
+pub mod launch;
 pub mod optimize_function;
 pub mod quality;
 pub mod router;

@@ -1,0 +1,502 @@
+//! `graspopt launch FILE`: starts the agents a launch file places on this machine, each as
+//! its own process, and supervises them.
+//!
+//! A launch file (TOML) names the run, the router endpoint every agent connects to, an
+//! optional router, and the agents. An entry with a `host` runs only on the machine launched
+//! with that `--host` (default: this machine's host name), so one file describes a whole
+//! installation and each machine runs its part; an entry without `host` runs wherever the
+//! file is launched. `deploy/local.toml` and `deploy/two-machines.toml` are examples.
+//!
+//! The router starts first (launch waits until it accepts connections), then the agents in
+//! file order. Each process's stderr goes to `<logs>/<name>.log`; stdout is passed through
+//! (the coordinator prints the final status there). When the coordinator exits, the others
+//! are stopped (SIGTERM, then SIGKILL) and launch exits with the coordinator's status; if
+//! another process exits first, launch stops everything and names it. Ctrl-C stops all.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitCode, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use serde::Deserialize;
+
+#[derive(Args, Debug)]
+pub struct LaunchArgs {
+    /// The launch file (TOML).
+    pub file: PathBuf,
+    /// This machine's name in the launch file (default: GRASPOPT_HOST or the host name).
+    #[arg(long)]
+    pub host: Option<String>,
+    /// Override the launch file's router endpoint (agents connect to it; a router in the file
+    /// listens on it).
+    #[arg(long)]
+    pub endpoint: Option<String>,
+    /// Folder for the processes' logs (default: logs/<run>).
+    #[arg(long)]
+    pub logs: Option<PathBuf>,
+    /// Print the commands this machine would run, and exit.
+    #[arg(long)]
+    pub dry_run: bool,
+}
+
+/// A launch file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LaunchFile {
+    /// The run every agent joins.
+    pub run: String,
+    /// The router endpoint every agent connects to, e.g. `tcp/192.168.1.10:7447`.
+    pub endpoint: String,
+    /// Disable UDP multicast scouting in every process (default true: only `endpoint`).
+    #[serde(default = "yes")]
+    pub no_multicast_scouting: bool,
+    pub router: Option<RouterEntry>,
+    #[serde(default, rename = "agent")]
+    pub agents: Vec<AgentEntry>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// The router.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RouterEntry {
+    pub host: Option<String>,
+    /// Where the router listens (default: the endpoint).
+    pub listen: Option<String>,
+    /// A Zenoh configuration file for the router (json5), relative to the launch file.
+    pub zenoh_config: Option<PathBuf>,
+}
+
+/// One agent, or `count` copies of it.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AgentEntry {
+    /// perception, hand, metric, planner or coordinator.
+    pub kind: String,
+    pub host: Option<String>,
+    /// Agent id (default: the kind); with `count` > 1, `<id>-1` ... `<id>-<count>`.
+    pub id: Option<String>,
+    /// Number of copies (hand workers, say).
+    #[serde(default = "one")]
+    pub count: u32,
+    /// The agent's settings file (TOML), relative to the launch file.
+    pub config: Option<PathBuf>,
+    /// A Zenoh configuration file (json5), relative to the launch file.
+    pub zenoh_config: Option<PathBuf>,
+    /// More flags for `graspopt agent <kind>`.
+    #[serde(default)]
+    pub args: Vec<String>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+const KINDS: [&str; 5] = ["perception", "hand", "metric", "planner", "coordinator"];
+
+/// One process to start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planned {
+    /// Unique name: the agent id, or `router`.
+    pub name: String,
+    pub coordinator: bool,
+    /// Arguments of `graspopt`.
+    pub args: Vec<String>,
+    /// For the router: the port to wait for.
+    pub wait_port: Option<u16>,
+}
+
+impl LaunchFile {
+    pub fn parse(text: &str, origin: &Path) -> Result<LaunchFile> {
+        let file: LaunchFile =
+            toml::from_str(text).with_context(|| format!("launch file {}", origin.display()))?;
+        graspopt_protocol::RunId::new(&file.run)
+            .with_context(|| format!("launch file {}: run", origin.display()))?;
+        if !file.endpoint.contains('/') {
+            bail!(
+                "launch file {}: endpoint {:?} has no protocol: write e.g. tcp/{}",
+                origin.display(),
+                file.endpoint,
+                file.endpoint
+            );
+        }
+        for a in &file.agents {
+            if !KINDS.contains(&a.kind.as_str()) {
+                bail!(
+                    "launch file {}: unknown agent kind {:?} (one of {})",
+                    origin.display(),
+                    a.kind,
+                    KINDS.join(", ")
+                );
+            }
+            if a.count == 0 {
+                bail!(
+                    "launch file {}: agent {:?} has count 0",
+                    origin.display(),
+                    a.kind
+                );
+            }
+        }
+        if file
+            .agents
+            .iter()
+            .filter(|a| a.kind == "coordinator")
+            .count()
+            > 1
+        {
+            bail!(
+                "launch file {}: a run has one coordinator",
+                origin.display()
+            );
+        }
+        Ok(file)
+    }
+
+    /// The processes `host` runs, in start order. Paths are resolved against `base` (the
+    /// launch file's folder).
+    pub fn plan(&self, host: &str, base: &Path) -> Result<Vec<Planned>> {
+        let here = |h: &Option<String>| h.as_deref().is_none_or(|h| h == host);
+        let resolve = |p: &Path| base.join(p).display().to_string();
+        let mut out = Vec::new();
+        if let Some(r) = &self.router
+            && here(&r.host)
+        {
+            let listen = r.listen.clone().unwrap_or_else(|| self.endpoint.clone());
+            let mut args = vec!["router".to_string(), "--listen".into(), listen.clone()];
+            if let Some(z) = &r.zenoh_config {
+                args.extend(["--zenoh-config".into(), resolve(z)]);
+            }
+            if self.no_multicast_scouting {
+                args.push("--no-multicast-scouting".into());
+            }
+            out.push(Planned {
+                name: "router".into(),
+                coordinator: false,
+                args,
+                wait_port: loopback_port(&listen),
+            });
+        }
+        let mut names = std::collections::HashSet::new();
+        for a in self.agents.iter().filter(|a| here(&a.host)) {
+            let id = a.id.clone().unwrap_or_else(|| a.kind.clone());
+            for i in 1..=a.count {
+                let name = if a.count > 1 {
+                    format!("{id}-{i}")
+                } else {
+                    id.clone()
+                };
+                if !names.insert(name.clone()) {
+                    bail!("launch file: two agents named {name:?} on host {host}");
+                }
+                let mut args = vec![
+                    "agent".to_string(),
+                    a.kind.clone(),
+                    "--run".into(),
+                    self.run.clone(),
+                    "--id".into(),
+                    name.clone(),
+                    "--connect".into(),
+                    self.endpoint.clone(),
+                ];
+                if self.no_multicast_scouting {
+                    args.push("--no-multicast-scouting".into());
+                }
+                if let Some(c) = &a.config {
+                    args.extend(["--config".into(), resolve(c)]);
+                }
+                if let Some(z) = &a.zenoh_config {
+                    args.extend(["--zenoh-config".into(), resolve(z)]);
+                }
+                args.extend(a.args.iter().cloned());
+                out.push(Planned {
+                    name,
+                    coordinator: a.kind == "coordinator",
+                    args,
+                    wait_port: None,
+                });
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The port of a `tcp/<address>:<port>` endpoint this machine can connect to (a wildcard
+/// address is reached on loopback).
+fn loopback_port(endpoint: &str) -> Option<u16> {
+    let rest = endpoint.strip_prefix("tcp/")?;
+    let (_, port) = rest.rsplit_once(':')?;
+    port.parse().ok()
+}
+
+struct Running {
+    name: String,
+    coordinator: bool,
+    child: Child,
+    log: PathBuf,
+}
+
+fn terminate(children: &mut [Running]) {
+    for c in children.iter_mut() {
+        if matches!(c.child.try_wait(), Ok(None)) {
+            // SIGTERM first: agents close their sessions and release shared memory.
+            let _ = Command::new("kill")
+                .args(["-TERM", &c.child.id().to_string()])
+                .status();
+        }
+    }
+    let deadline = Instant::now() + Duration::from_secs(5);
+    for c in children.iter_mut() {
+        while matches!(c.child.try_wait(), Ok(None)) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        if matches!(c.child.try_wait(), Ok(None)) {
+            let _ = c.child.kill();
+            let _ = c.child.wait();
+        }
+    }
+}
+
+fn tail(path: &Path, lines: usize) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let all: Vec<&str> = text.lines().collect();
+    all[all.len().saturating_sub(lines)..].join("\n")
+}
+
+pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
+    let text = std::fs::read_to_string(&args.file)
+        .with_context(|| format!("cannot read the launch file {}", args.file.display()))?;
+    let mut file = LaunchFile::parse(&text, &args.file)?;
+    if let Some(e) = &args.endpoint {
+        file.endpoint = e.clone();
+        if let Some(r) = &mut file.router {
+            r.listen = None;
+        }
+    }
+    let host = args.host.clone().unwrap_or_else(graspopt_bus::host_name);
+    let base = args
+        .file
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let plan = file.plan(&host, &base)?;
+    if plan.is_empty() {
+        bail!(
+            "launch file {}: nothing runs on host {host:?} (use --host to pick an entry's host)",
+            args.file.display()
+        );
+    }
+    if args.dry_run {
+        for p in &plan {
+            println!("graspopt {}", p.args.join(" "));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let logs = args
+        .logs
+        .clone()
+        .unwrap_or_else(|| Path::new("logs").join(&file.run));
+    std::fs::create_dir_all(&logs)
+        .with_context(|| format!("cannot create the log folder {}", logs.display()))?;
+    let exe = std::env::current_exe().context("cannot find the graspopt executable")?;
+    let mut children: Vec<Running> = Vec::new();
+    for p in &plan {
+        let log = logs.join(format!("{}.log", p.name));
+        let err = std::fs::File::create(&log)
+            .with_context(|| format!("cannot create {}", log.display()))?;
+        let child = Command::new(&exe)
+            .args(&p.args)
+            .stdin(Stdio::null())
+            .stderr(err)
+            .spawn();
+        let child = match child {
+            Ok(c) => c,
+            Err(e) => {
+                terminate(&mut children);
+                bail!("cannot start {}: {e}", p.name);
+            }
+        };
+        eprintln!(
+            "graspopt launch: started {} (log {})",
+            p.name,
+            log.display()
+        );
+        children.push(Running {
+            name: p.name.clone(),
+            coordinator: p.coordinator,
+            child,
+            log,
+        });
+        if let Some(port) = p.wait_port {
+            let start = Instant::now();
+            while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+                if start.elapsed() > Duration::from_secs(20) {
+                    terminate(&mut children);
+                    bail!("the router does not accept connections on port {port} after 20 s");
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+    }
+    let runtime = tokio::runtime::Runtime::new()?;
+    let outcome = runtime.block_on(async {
+        let mut poll = tokio::time::interval(Duration::from_millis(100));
+        let signal = super::agent::shutdown_signal();
+        tokio::pin!(signal);
+        loop {
+            tokio::select! {
+                _ = &mut signal => return Outcome::Interrupted,
+                _ = poll.tick() => {}
+            }
+            let mut all_done = true;
+            for c in children.iter_mut() {
+                match c.child.try_wait() {
+                    Ok(Some(status)) if c.coordinator => {
+                        return Outcome::Coordinator(status.success());
+                    }
+                    Ok(Some(status)) => {
+                        return Outcome::Died(c.name.clone(), status.to_string(), c.log.clone());
+                    }
+                    Ok(None) => all_done = false,
+                    Err(e) => return Outcome::Died(c.name.clone(), e.to_string(), c.log.clone()),
+                }
+            }
+            if all_done {
+                return Outcome::Coordinator(true);
+            }
+        }
+    });
+    terminate(&mut children);
+    match outcome {
+        Outcome::Coordinator(true) => Ok(ExitCode::SUCCESS),
+        Outcome::Coordinator(false) => {
+            let log = children
+                .iter()
+                .find(|c| c.coordinator)
+                .map(|c| c.log.clone())
+                .unwrap_or_default();
+            bail!(
+                "the coordinator failed; its log ({}):\n{}",
+                log.display(),
+                tail(&log, 20)
+            )
+        }
+        Outcome::Died(name, status, log) => bail!(
+            "{name} stopped ({status}) before the run finished; everything was stopped. Its log ({}):\n{}",
+            log.display(),
+            tail(&log, 20)
+        ),
+        Outcome::Interrupted => {
+            eprintln!("graspopt launch: interrupted, every process stopped");
+            Ok(ExitCode::from(130))
+        }
+    }
+}
+
+enum Outcome {
+    Coordinator(bool),
+    Died(String, String, PathBuf),
+    Interrupted,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn deploy(name: &str) -> (LaunchFile, PathBuf) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../deploy")
+            .join(name);
+        let text = std::fs::read_to_string(&path).unwrap();
+        (LaunchFile::parse(&text, &path).unwrap(), path)
+    }
+
+    #[test]
+    fn local_file_runs_everything_here_with_three_hands() {
+        let (file, path) = deploy("local.toml");
+        let plan = file.plan("any-host", path.parent().unwrap()).unwrap();
+        let names: Vec<&str> = plan.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "router",
+                "perception",
+                "planner",
+                "metric",
+                "hand-1",
+                "hand-2",
+                "hand-3",
+                "coordinator"
+            ]
+        );
+        assert_eq!(plan[0].wait_port, Some(7447));
+        assert_eq!(plan.iter().filter(|p| p.coordinator).count(), 1);
+        for p in &plan[1..] {
+            assert!(
+                p.args
+                    .windows(2)
+                    .any(|w| w[0] == "--connect" && w[1] == file.endpoint)
+            );
+        }
+    }
+
+    #[test]
+    fn two_machine_file_splits_the_agents_by_host() {
+        let (file, path) = deploy("two-machines.toml");
+        let base = path.parent().unwrap();
+        let lab: Vec<String> = file
+            .plan("lab-pc", base)
+            .unwrap()
+            .into_iter()
+            .map(|p| p.name)
+            .collect();
+        let robot: Vec<String> = file
+            .plan("robot-pc", base)
+            .unwrap()
+            .into_iter()
+            .map(|p| p.name)
+            .collect();
+        assert!(lab.contains(&"router".to_string()) && lab.contains(&"coordinator".to_string()));
+        assert!(
+            robot
+                .iter()
+                .all(|n| n.starts_with("robot-hand") || n == "metric-robot")
+        );
+        assert!(!robot.is_empty());
+        assert!(file.plan("elsewhere", base).unwrap().is_empty());
+        // Every Zenoh configuration the file names exists and is read by the bus.
+        for p in file
+            .plan("lab-pc", base)
+            .unwrap()
+            .iter()
+            .chain(&file.plan("robot-pc", base).unwrap())
+        {
+            if let Some(w) = p.args.windows(2).find(|w| w[0] == "--zenoh-config") {
+                let bus = graspopt_bus::BusArgs {
+                    zenoh_config: Some(PathBuf::from(&w[1])),
+                    ..Default::default()
+                };
+                bus.zenoh_config()
+                    .unwrap_or_else(|e| panic!("{}: {e}", w[1]));
+            }
+        }
+    }
+
+    #[test]
+    fn bad_launch_files_name_the_problem() {
+        let origin = Path::new("x.toml");
+        let err = |t: &str| format!("{:#}", LaunchFile::parse(t, origin).unwrap_err());
+        assert!(err("run = \"a b\"\nendpoint = \"tcp/h:1\"").contains("run"));
+        assert!(err("run = \"r\"\nendpoint = \"h:1\"").contains("no protocol"));
+        let e = err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"gripper\"");
+        assert!(e.contains("gripper"), "{e}");
+        let e = err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\ncolour = 1");
+        assert!(e.contains("colour"), "{e}");
+        let two = "run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\n[[agent]]\nkind = \"hand\"";
+        let f = LaunchFile::parse(two, origin).unwrap();
+        assert!(format!("{:#}", f.plan("h", Path::new(".")).unwrap_err()).contains("two agents"));
+    }
+}

@@ -1,0 +1,326 @@
+//! Faults a distributed run must survive: a hand worker killed in the middle of a trial, a
+//! worker that hangs past its lease, and bad input on every topic.
+
+use std::time::{Duration, Instant};
+
+use graspopt_bus::{Bus, BusArgs, BusMode, CongestionControl};
+use graspopt_e2e::{Cluster, check_journal, signal};
+use graspopt_journal::{Journal, TrialState};
+use graspopt_protocol::{
+    CloudPoint, ContactClouds, Encoding, FingerCloud, Pose, RunId, TrialResult, encode,
+};
+
+/// Polls the journal until `pred` holds for some trial; returns that trial's id.
+fn wait_for_trial(
+    path: &std::path::Path,
+    run: &str,
+    timeout: Duration,
+    pred: impl Fn(&graspopt_journal::TrialRow) -> bool,
+) -> u64 {
+    let start = Instant::now();
+    loop {
+        if path.exists()
+            && let Ok(j) = Journal::open(path)
+            && let Ok(trials) = j.trials(run)
+            && let Some(t) = trials.iter().find(|t| pred(t))
+        {
+            return t.trial_id;
+        }
+        assert!(start.elapsed() < timeout, "no such trial after {timeout:?}");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn final_status(
+    c: &Cluster,
+    coordinator: graspopt_e2e::Proc,
+    timeout: Duration,
+) -> serde_json::Value {
+    let (status, stdout) = coordinator.wait_output(timeout);
+    assert!(
+        status.success(),
+        "coordinator failed: {stdout}\n{}",
+        c.log("coordinator")
+    );
+    serde_json::from_str(stdout.trim()).unwrap()
+}
+
+/// A hand worker SIGKILLed while it holds a trial: the coordinator sees its liveliness token
+/// vanish and gives the trial to the other worker long before the lease (two minutes) runs
+/// out; every trial completes exactly once.
+#[test]
+fn a_trial_survives_its_killed_worker() {
+    let c = Cluster::start("killed", "killed");
+    let journal = c.dir.join("journal.sqlite");
+    let _perception = c.agent("perception", &["perception", "--object", "cuboid"]);
+    let _planner = c.agent("planner", &["planner"]);
+    let _metric = c.agent("metric", &["metric"]);
+    let mut hand1 = c.agent(
+        "hand-1",
+        &["hand", "--id", "hand-1", "--trial-cost-ms", "400"],
+    );
+    let _hand2 = c.agent(
+        "hand-2",
+        &["hand", "--id", "hand-2", "--trial-cost-ms", "400"],
+    );
+    let coordinator = c.agent(
+        "coordinator",
+        &[
+            "coordinator",
+            "--object",
+            "cuboid",
+            "--trials",
+            "8",
+            "--seed",
+            "3",
+            "--lease-ms",
+            "120000",
+            "--journal",
+            journal.to_str().unwrap(),
+        ],
+    );
+    // hand-1 has completed a trial and holds another one: kill it.
+    wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
+        t.worker == "hand-1" && t.state == TrialState::Completed
+    });
+    let held = wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
+        t.worker == "hand-1" && t.state == TrialState::Running
+    });
+    let killed_at = Instant::now();
+    hand1.kill();
+    // Well within the lease: the re-issue came from the lost liveliness token.
+    let status = final_status(&c, coordinator, Duration::from_secs(60));
+    assert!(killed_at.elapsed() < Duration::from_secs(60));
+    assert_eq!(status["completed"], 8);
+    assert!(
+        status["errors"]["reissued"].as_u64().unwrap() >= 1,
+        "{status}"
+    );
+    let trials = check_journal(&journal, "killed", 8);
+    let t = &trials[held as usize - 1];
+    assert_eq!(t.attempts, 2, "trial {held} was issued again");
+    assert_eq!(
+        t.worker, "hand-2",
+        "trial {held} was completed by the survivor"
+    );
+    assert_eq!(t.result_attempt, Some(2));
+}
+
+/// A worker that stops answering (SIGSTOP) keeps its liveliness token for a while; its lease
+/// expires and the trial goes to the other worker. When it wakes up (SIGCONT) its late result
+/// is a duplicate: counted, and the completed trial is not changed.
+#[test]
+fn a_hung_worker_loses_its_trial_when_the_lease_expires() {
+    let c = Cluster::start("hung", "hung");
+    let journal = c.dir.join("journal.sqlite");
+    let _perception = c.agent("perception", &["perception", "--object", "sphere"]);
+    let _planner = c.agent("planner", &["planner"]);
+    let _metric = c.agent("metric", &["metric"]);
+    let hand1 = c.agent(
+        "hand-1",
+        &["hand", "--id", "hand-1", "--trial-cost-ms", "300"],
+    );
+    let _hand2 = c.agent(
+        "hand-2",
+        &["hand", "--id", "hand-2", "--trial-cost-ms", "300"],
+    );
+    let coordinator = c.agent(
+        "coordinator",
+        &[
+            "coordinator",
+            "--object",
+            "sphere",
+            "--trials",
+            "14",
+            "--seed",
+            "1",
+            "--lease-ms",
+            "1500",
+            "--journal",
+            journal.to_str().unwrap(),
+        ],
+    );
+    let held = wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
+        t.worker == "hand-1" && t.state == TrialState::Running
+    });
+    signal(&hand1, "STOP");
+    // The lease (1.5 s) expires; hand-2 completes the trial.
+    wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
+        t.trial_id == held && t.state == TrialState::Completed
+    });
+    signal(&hand1, "CONT");
+    let status = final_status(&c, coordinator, Duration::from_secs(120));
+    assert_eq!(status["completed"], 14);
+    assert!(
+        status["errors"]["reissued"].as_u64().unwrap() >= 1,
+        "{status}"
+    );
+    let trials = check_journal(&journal, "hung", 14);
+    let t = &trials[held as usize - 1];
+    assert!(t.attempts >= 2, "trial {held} was issued again");
+    assert_eq!(t.worker, "hand-2");
+    // The late result of attempt 1 came after the re-issued attempt's and changed nothing.
+    assert!(t.result_attempt.unwrap() >= 2, "{t:?}");
+    assert!(
+        status["errors"]["duplicates"].as_u64().unwrap() >= 1,
+        "{status}"
+    );
+}
+
+/// A ContactClouds message with a NaN in one point.
+fn nan_clouds(run: &RunId) -> ContactClouds {
+    ContactClouds {
+        run_id: run.clone(),
+        trial_id: 1,
+        attempt: 1,
+        worker: "hand-1".into(),
+        hand: "barrett".into(),
+        palm_pose: Pose::IDENTITY,
+        fingers: vec![FingerCloud {
+            finger: Some(0),
+            links: vec!["f0".into()],
+            points: vec![CloudPoint {
+                p: [0.0, f64::NAN, 0.0],
+                n: [1.0, 0.0, 0.0],
+            }],
+        }],
+        min_gap: None,
+        error: None,
+        executed_ms: 0,
+    }
+}
+
+/// Garbage, a wrong wire version, NaN values, a result for an unknown trial and a duplicate
+/// result, on every topic: each is logged and counted, the run goes on, and the journal holds
+/// exactly the trials the real agents produced.
+#[test]
+fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
+    let c = Cluster::start("badinput", "bad");
+    let journal = c.dir.join("journal.sqlite");
+    let _perception = c.agent("perception", &["perception", "--object", "cylinder"]);
+    let _planner = c.agent("planner", &["planner"]);
+    let _metric = c.agent("metric", &["metric"]);
+    let _hands: Vec<_> = (1..=2)
+        .map(|i| {
+            let id = format!("hand-{i}");
+            c.agent(&id, &["hand", "--id", &id, "--trial-cost-ms", "300"])
+        })
+        .collect();
+    let coordinator = c.agent(
+        "coordinator",
+        &[
+            "coordinator",
+            "--object",
+            "cylinder",
+            "--trials",
+            "10",
+            "--seed",
+            "6",
+            "--journal",
+            journal.to_str().unwrap(),
+        ],
+    );
+    let run = RunId::new("bad").unwrap();
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let first: TrialResult = runtime.block_on(async {
+        let bus = Bus::open(&BusArgs {
+            connect: vec![c.endpoint.clone()],
+            mode: Some(BusMode::Client),
+            no_multicast_scouting: true,
+            no_shm: true,
+            ..Default::default()
+        })
+        .await
+        .unwrap();
+        let results = bus
+            .subscribe::<TrialResult>(&run.result_key())
+            .await
+            .unwrap();
+        let first = tokio::time::timeout(Duration::from_secs(60), results.recv())
+            .await
+            .expect("a first result")
+            .unwrap()
+            .message
+            .unwrap();
+        let garbage = b"\x01\x00 not bincode at all \xff\xff\xff".to_vec();
+        let mut wrong_version = encode(&first, Encoding::Bincode).unwrap();
+        wrong_version[0] = 99;
+        let mut nan_score = first.clone();
+        nan_score.score = f64::NAN;
+        let mut unknown = first.clone();
+        unknown.trial_id = 9_999;
+        let mut duplicate = first.clone();
+        duplicate.score = 1.0e6;
+        let put_raw = |key: String, bytes: Vec<u8>, encoding: Encoding| {
+            let bus = &bus;
+            async move {
+                bus.put_bytes(&key, bytes, encoding, CongestionControl::Block)
+                    .await
+                    .unwrap()
+            }
+        };
+        // Results: three undecodable (garbage, wrong version, NaN), one unknown trial, one
+        // duplicate with a better score than any real trial.
+        put_raw(run.result_key(), garbage.clone(), Encoding::Bincode).await;
+        put_raw(run.result_key(), wrong_version, Encoding::Bincode).await;
+        put_raw(
+            run.result_key(),
+            encode(&nan_score, Encoding::Bincode).unwrap(),
+            Encoding::Bincode,
+        )
+        .await;
+        bus.put(&run.result_key(), &unknown, Encoding::Bincode)
+            .await
+            .unwrap();
+        bus.put(&run.result_key(), &duplicate, Encoding::Json)
+            .await
+            .unwrap();
+        // Object estimate (coordinator, metric and hands listen), clouds (metric), a command
+        // (hand-1), each garbage or NaN.
+        put_raw(run.object_key(), garbage.clone(), Encoding::Bincode).await;
+        put_raw(
+            run.clouds_key(),
+            encode(&nan_clouds(&run), Encoding::Bincode).unwrap(),
+            Encoding::Bincode,
+        )
+        .await;
+        put_raw(
+            run.command_key("hand-1"),
+            b"{\"wire\": 1}".to_vec(),
+            Encoding::Json,
+        )
+        .await;
+        let _ = bus.close().await;
+        first
+    });
+    let status = final_status(&c, coordinator, Duration::from_secs(120));
+    assert_eq!(status["completed"], 10, "{status}");
+    assert_eq!(status["errors"]["bad_messages"], 4, "{status}");
+    assert_eq!(status["errors"]["unknown_trial"], 1, "{status}");
+    assert_eq!(status["errors"]["duplicates"], 1, "{status}");
+    // The journal: exactly the ten real trials, the first with its real score, no trace of
+    // the injected messages (no trial 9999, no duplicate event, no 1e6 score).
+    let trials = check_journal(&journal, "bad", 10);
+    let t = &trials[first.trial_id as usize - 1];
+    assert_eq!(t.score, Some(first.score));
+    assert!(trials.iter().all(|t| t.score.unwrap() < 1.0e6));
+    let j = Journal::open(&journal).unwrap();
+    let events = j.events("bad").unwrap();
+    assert!(
+        events
+            .iter()
+            .all(|e| e.trial_id <= 10 && e.kind != "duplicate")
+    );
+    // The other agents logged what they rejected, with a count.
+    let metric = c.log("metric");
+    assert!(
+        metric.contains("bad clouds") && metric.contains("fingers[0].points[0].p"),
+        "{metric}"
+    );
+    assert!(metric.contains("bad object estimate"), "{metric}");
+    let hand = c.log("hand-1");
+    assert!(
+        hand.contains("bad command") && hand.contains("bad messages"),
+        "{hand}"
+    );
+}
