@@ -41,6 +41,8 @@ enum Command {
     Router(commands::router::RouterArgs),
     /// Start the agents a launch file places on this machine, each its own process.
     Launch(commands::launch::LaunchArgs),
+    /// Watch the bus: list topics, echo messages, measure rate and bandwidth.
+    Topic(commands::topic::TopicArgs),
     /// A run's trials from its journal, as CSV or JSON.
     Export(commands::export::ExportArgs),
     /// Figures of the distributed pipeline (throughput, overhead, cloud latency).
@@ -69,6 +71,7 @@ fn main() -> ExitCode {
         Command::Agent(args) => commands::agent::run(args),
         Command::Router(args) => commands::router::run(args),
         Command::Launch(args) => commands::launch::run(args),
+        Command::Topic(args) => commands::topic::run(args),
         Command::Export(args) => commands::export::run(args),
         Command::Bench(args) => commands::bench::run(args),
     };

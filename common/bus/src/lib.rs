@@ -22,7 +22,9 @@ pub use alive::{AliveEvent, AliveWatch};
 pub use args::{BusArgs, BusMode};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
 pub use error::BusError;
-pub use session::{Bus, Incoming, Received, Server, Subscription, host_name};
+pub use session::{
+    Bus, Incoming, RawSample, RawSubscription, Received, Server, Subscription, host_name,
+};
 /// Whether a put waits (`Block`) or drops (`Drop`) under congestion.
 pub use zenoh::qos::CongestionControl;
 

@@ -174,6 +174,23 @@ impl Bus {
         })
     }
 
+    /// Subscribes to every sample under `key` (a key expression), undecoded, through a ring
+    /// buffer of `capacity` samples: for tools that watch topics. A slow reader loses the
+    /// oldest samples and never slows the publishers.
+    pub async fn subscribe_raw(
+        &self,
+        key: &str,
+        capacity: usize,
+    ) -> Result<RawSubscription, BusError> {
+        let sub = self
+            .session
+            .declare_subscriber(key)
+            .with(RingChannel::new(capacity.max(1)))
+            .await
+            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))?;
+        Ok(RawSubscription { sub })
+    }
+
     /// Sends a query and decodes the first reply.
     pub async fn query<Q: Message, R: Message>(
         &self,
@@ -259,6 +276,31 @@ impl<T: Message> Subscription<T> {
             Inner::Ring(s) => s.recv_async().await.ok()?,
         };
         Some(decode_sample(&sample))
+    }
+}
+
+/// A sample as it came: key, declared encoding, bytes.
+#[derive(Debug, Clone)]
+pub struct RawSample {
+    pub key: String,
+    pub encoding: Encoding,
+    pub bytes: Vec<u8>,
+}
+
+/// An undecoded subscription (see [`Bus::subscribe_raw`]).
+pub struct RawSubscription {
+    sub: Subscriber<RingChannelHandler<Sample>>,
+}
+
+impl RawSubscription {
+    /// The next sample; `None` when the session closed.
+    pub async fn recv(&self) -> Option<RawSample> {
+        let sample = self.sub.recv_async().await.ok()?;
+        Some(RawSample {
+            key: sample.key_expr().as_str().to_string(),
+            encoding: protocol_encoding(sample.encoding()),
+            bytes: sample.payload().to_bytes().into_owned(),
+        })
     }
 }
 

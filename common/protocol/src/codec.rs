@@ -194,3 +194,29 @@ pub fn decode<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<T, DecodeE
     })?;
     Ok(msg)
 }
+
+/// Decodes (and validates) the message a topic carries, as JSON for display: what
+/// `graspopt topic echo` prints. The JSON is the message's fields, without the wire version.
+pub fn decode_topic(
+    topic: crate::Topic,
+    bytes: &[u8],
+    encoding: Encoding,
+) -> Result<Value, DecodeError> {
+    use crate::Topic;
+    use crate::messages::{ContactClouds, ObjectEstimate, RunStatus, TrialCommand, TrialResult};
+    fn json<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<Value, DecodeError> {
+        let msg = decode::<T>(bytes, encoding)?;
+        serde_json::to_value(&msg).map_err(|e| DecodeError::Malformed {
+            message_type: T::TYPE,
+            format: "json",
+            detail: e.to_string(),
+        })
+    }
+    match topic {
+        Topic::Object => json::<ObjectEstimate>(bytes, encoding),
+        Topic::Command => json::<TrialCommand>(bytes, encoding),
+        Topic::Clouds => json::<ContactClouds>(bytes, encoding),
+        Topic::Result => json::<TrialResult>(bytes, encoding),
+        Topic::Status => json::<RunStatus>(bytes, encoding),
+    }
+}

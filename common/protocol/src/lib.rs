@@ -15,7 +15,7 @@ pub mod codec;
 pub mod keys;
 pub mod messages;
 
-pub use codec::{DecodeError, Encoding, decode, encode};
+pub use codec::{DecodeError, Encoding, decode, decode_topic, encode};
 pub use keys::{AgentKind, RunId, Topic};
 pub use messages::*;
 

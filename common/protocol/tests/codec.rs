@@ -213,3 +213,18 @@ fn invalid_content_is_refused_naming_the_field() {
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
 }
+
+#[test]
+fn a_topic_decodes_to_its_message_fields() {
+    let msg = result();
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        let bytes = encode(&msg, enc).unwrap();
+        let v = decode_topic(Topic::Result, &bytes, enc).unwrap();
+        assert_eq!(v["trial_id"], msg.trial_id);
+        assert_eq!(v["score"], msg.score);
+        assert_eq!(v["worker"], msg.worker.as_str());
+        assert!(v.get("wire").is_none());
+        // Another topic's type does not decode from these bytes.
+        assert!(decode_topic(Topic::Object, &bytes, enc).is_err());
+    }
+}

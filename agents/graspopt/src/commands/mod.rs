@@ -12,4 +12,5 @@ pub mod run;
 pub mod scan;
 pub mod setup;
 pub mod svg;
+pub mod topic;
 pub mod trial;
