@@ -43,6 +43,8 @@ enum Command {
     Launch(commands::launch::LaunchArgs),
     /// Watch the bus: list topics, echo messages, measure rate and bandwidth.
     Topic(commands::topic::TopicArgs),
+    /// A live dashboard of the runs on the bus.
+    Monitor(commands::monitor::MonitorArgs),
     /// A run's trials from its journal, as CSV or JSON.
     Export(commands::export::ExportArgs),
     /// Figures of the distributed pipeline (throughput, overhead, cloud latency).
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         Command::Router(args) => commands::router::run(args),
         Command::Launch(args) => commands::launch::run(args),
         Command::Topic(args) => commands::topic::run(args),
+        Command::Monitor(args) => commands::monitor::run(args),
         Command::Export(args) => commands::export::run(args),
         Command::Bench(args) => commands::bench::run(args),
     };

@@ -207,22 +207,19 @@ impl Bus {
             .timeout(timeout)
             .await
             .map_err(|e| BusError::zenoh(format!("query on {key}"), e))?;
-        match replies.recv_async().await {
-            Ok(reply) => match reply.result() {
-                Ok(sample) => {
-                    let enc = protocol_encoding(sample.encoding());
-                    Ok(decode::<R>(&sample.payload().to_bytes(), enc)?)
-                }
-                Err(err) => Err(BusError::ReplyError {
-                    key: key.to_string(),
-                    detail: String::from_utf8_lossy(&err.payload().to_bytes()).into_owned(),
-                }),
-            },
-            Err(_) => Err(BusError::NoReply {
-                key: key.to_string(),
-                timeout_ms: timeout.as_millis() as u64,
-            }),
-        }
+        first_reply(key, &replies, timeout).await
+    }
+
+    /// Sends a query without a payload (the coordinator's state, say) and decodes the first
+    /// reply.
+    pub async fn get<R: Message>(&self, key: &str, timeout: Duration) -> Result<R, BusError> {
+        let replies = self
+            .session
+            .get(key)
+            .timeout(timeout)
+            .await
+            .map_err(|e| BusError::zenoh(format!("query on {key}"), e))?;
+        first_reply(key, &replies, timeout).await
     }
 
     /// Answers queries on `key`.
@@ -276,6 +273,29 @@ impl<T: Message> Subscription<T> {
             Inner::Ring(s) => s.recv_async().await.ok()?,
         };
         Some(decode_sample(&sample))
+    }
+}
+
+async fn first_reply<R: Message>(
+    key: &str,
+    replies: &FifoChannelHandler<zenoh::query::Reply>,
+    timeout: Duration,
+) -> Result<R, BusError> {
+    match replies.recv_async().await {
+        Ok(reply) => match reply.result() {
+            Ok(sample) => {
+                let enc = protocol_encoding(sample.encoding());
+                Ok(decode::<R>(&sample.payload().to_bytes(), enc)?)
+            }
+            Err(err) => Err(BusError::ReplyError {
+                key: key.to_string(),
+                detail: String::from_utf8_lossy(&err.payload().to_bytes()).into_owned(),
+            }),
+        },
+        Err(_) => Err(BusError::NoReply {
+            key: key.to_string(),
+            timeout_ms: timeout.as_millis() as u64,
+        }),
     }
 }
 

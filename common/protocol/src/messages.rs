@@ -197,12 +197,18 @@ impl Message for ContactClouds {
         }
         for (f, finger) in self.fingers.iter().enumerate() {
             for (i, pt) in finger.points.iter().enumerate() {
-                finite(&format!("fingers[{f}].points[{i}].p"), &pt.p)?;
-                finite(&format!("fingers[{f}].points[{i}].n"), &pt.n)?;
-                let n = pt.n.iter().map(|v| v * v).sum::<f64>().sqrt();
-                if (n - 1.0).abs() > 1e-3 {
+                // Field names are formatted only for the error: this runs on every point.
+                let ok = pt.p.iter().chain(&pt.n).all(|v| v.is_finite());
+                if !ok {
+                    finite(&format!("fingers[{f}].points[{i}].p"), &pt.p)?;
+                    finite(&format!("fingers[{f}].points[{i}].n"), &pt.n)?;
+                }
+                let n2 = pt.n.iter().map(|v| v * v).sum::<f64>();
+                // |n| within 1e-3 of 1 (compared squared, without a square root).
+                if !((1.0 - 1e-3) * (1.0 - 1e-3)..=(1.0 + 1e-3) * (1.0 + 1e-3)).contains(&n2) {
                     return Err(format!(
-                        "fingers[{f}].points[{i}].n is not a unit normal (norm {n})"
+                        "fingers[{f}].points[{i}].n is not a unit normal (norm {})",
+                        n2.sqrt()
                     ));
                 }
             }

@@ -42,6 +42,9 @@ pub enum What {
         /// Trials of the overhead run.
         #[arg(long, default_value_t = 100)]
         overhead_trials: u64,
+        /// How the throughput runs propose trials.
+        #[arg(long, value_enum, default_value_t = Method::Random)]
+        method: Method,
     },
     /// Contact-cloud latency, shared memory versus Zenoh.
     Clouds {
@@ -62,11 +65,13 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
             trials_per_worker,
             workers,
             overhead_trials,
+            method,
         } => runtime.block_on(pipeline(
             *trial_cost_ms,
             *trials_per_worker,
             workers,
             *overhead_trials,
+            *method,
         ))?,
         What::Clouds { points, messages } => runtime.block_on(clouds(*points, *messages))?,
     }
@@ -144,15 +149,16 @@ async fn pipeline(
     per_worker: u64,
     workers: &[usize],
     overhead_trials: u64,
+    method: Method,
 ) -> Result<()> {
-    println!("## Throughput: simulated trial cost {cost} ms, cylinder, 2D, random proposals");
+    println!("## Throughput: simulated trial cost {cost} ms, cylinder, 2D, {method:?} proposals");
     println!();
     println!("| workers | trials | seconds | trials/s | speed-up | speed-up / workers |");
     println!("|---|---|---|---|---|---|");
     let mut base: Option<f64> = None;
     for &w in workers {
         let trials = per_worker * w as u64;
-        let e = embedded(&format!("tp{w}"), w, trials, cost, Method::Random)?;
+        let e = embedded(&format!("tp{w}"), w, trials, cost, method)?;
         timed_run(&e).await?;
         // From the first trial's issue to the last trial's result, by the journal's clock:
         // every trial counts, start-up (agents joining) does not.
@@ -280,14 +286,36 @@ async fn clouds(points: usize, messages: usize) -> Result<()> {
         )?
         .len()
     );
+    // What both paths share: encoding on the hand's side, decoding (with validation) on the
+    // metric's.
+    let msg = cloud_message(&RunId::new("bench-clouds")?, 0, points);
+    let (mut enc, mut dec) = (Vec::new(), Vec::new());
+    for _ in 0..messages {
+        let t = Instant::now();
+        let bytes = graspopt_protocol::encode(&msg, graspopt_protocol::Encoding::Bincode)?;
+        enc.push(t.elapsed().as_secs_f64() * 1e6);
+        let t = Instant::now();
+        let back: ContactClouds =
+            graspopt_protocol::decode(&bytes, graspopt_protocol::Encoding::Bincode)?;
+        dec.push(t.elapsed().as_secs_f64() * 1e6);
+        anyhow::ensure!(back.point_count() == points, "decode lost points");
+    }
+    let (enc, dec) = (median(&mut enc), median(&mut dec));
+    let codec = enc + dec;
     println!();
-    println!("| path | median (µs) | p90 (µs) |");
-    println!("|---|---|---|");
+    println!("Encoding (bincode) median {enc:.0} µs, decoding with validation median {dec:.0} µs.");
+    println!();
+    println!("| path | median (µs) | p90 (µs) | median minus encode + decode ({codec:.0} µs) |");
+    println!("|---|---|---|---|");
     for shm in [true, false] {
         let (path, mut lat) = cloud_latency(shm, points, messages).await?;
         let med = median(&mut lat);
         let p90 = lat[(lat.len() * 9 / 10).min(lat.len() - 1)];
-        println!("| {} | {med:.0} | {p90:.0} |", path.as_str());
+        println!(
+            "| {} | {med:.0} | {p90:.0} | {:.0} |",
+            path.as_str(),
+            med - codec
+        );
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod experiment;
 pub mod export;
 pub mod launch;
+pub mod monitor;
 pub mod optimize_function;
 pub mod quality;
 pub mod router;
