@@ -242,6 +242,8 @@ struct Ctx<'a> {
     state: RunState,
     space: Option<(TrialSpace, Vec<[f64; 2]>)>,
     request_id: u64,
+    /// The encoding each worker asked for in its liveliness token (bincode by default).
+    encodings: std::collections::HashMap<String, Encoding>,
 }
 
 impl Ctx<'_> {
@@ -283,8 +285,13 @@ impl Ctx<'_> {
                 lease_ms: self.config.lease_ms,
                 issued_ms: now,
             };
+            let encoding = self
+                .encodings
+                .get(&worker)
+                .copied()
+                .unwrap_or(Encoding::Bincode);
             self.bus
-                .put(&self.run.command_key(&worker), &command, Encoding::Bincode)
+                .put(&self.run.command_key(&worker), &command, encoding)
                 .await?;
         }
         Ok(())
@@ -405,6 +412,7 @@ pub async fn run(
         state,
         space: None,
         request_id: 0,
+        encodings: Default::default(),
     };
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
@@ -462,6 +470,7 @@ pub async fn run(
             Some(ev) = hands.recv() => {
                 if ev.agent.run == *run {
                     if ev.alive {
+                        ctx.encodings.insert(ev.agent.id.clone(), ev.agent.encoding);
                         ctx.state.worker_up(&ev.agent.id, &ev.agent.host);
                     } else if let Some(t) = ctx.state.worker_down(&ev.agent.id) {
                         tracing::warn!("coordinator: worker {} lost with trial {t}: re-issuing", ev.agent.id);

@@ -29,6 +29,8 @@ enum Command {
     Trial(commands::trial::TrialArgs),
     /// Grid-scan a metric over one or two trial parameters (CSV and SVG).
     Scan(commands::scan::ScanArgs),
+    /// Record a grid of simulated grasps' contact clouds (for `agent hand --replay`).
+    Record(commands::record::RecordArgs),
     /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15).
     Experiment(commands::experiment::ExperimentArgs),
     /// Run the BO engine (or random search) on a standard test function.
@@ -65,6 +67,7 @@ fn main() -> ExitCode {
         Command::Quality(args) => commands::quality::run(args),
         Command::Trial(args) => commands::trial::run(args),
         Command::Scan(args) => commands::scan::run(args),
+        Command::Record(args) => commands::record::run(args),
         Command::Experiment(args) => commands::experiment::run(args),
         Command::OptimizeFunction(args) => {
             commands::optimize_function::run(args).map(|()| ExitCode::SUCCESS)

@@ -7,8 +7,13 @@
 //! pads each trial to at least that long, to model a real robot's cycle time. A real hand is
 //! another implementation of the same conversation (see `docs/protocol.md`).
 //!
+//! With `replay` set, the hand answers from recorded contact data instead ([`replay`]): each
+//! trial gets the recorded grasp nearest to its parameters.
+//!
 //! [`SimulatedHand::execute`] is the logic (no network); [`run`] wires it to the bus.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod replay;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -34,6 +39,8 @@ pub struct HandConfig {
     pub mesh: Option<PathBuf>,
     /// Minimum duration of a trial (milliseconds), to model a robot's cycle time.
     pub trial_cost_ms: u64,
+    /// Answer trials from this recording (JSON lines, see [`replay`]) instead of simulating.
+    pub replay: Option<PathBuf>,
 }
 
 impl Default for HandConfig {
@@ -44,6 +51,7 @@ impl Default for HandConfig {
             object: None,
             mesh: None,
             trial_cost_ms: 0,
+            replay: None,
         }
     }
 }
@@ -128,6 +136,10 @@ pub fn world_object(config: &HandConfig, estimate: Option<&ObjectEstimate>) -> O
 
 /// Serves trial commands until the task is cancelled.
 pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
+    if let Some(path) = &config.replay {
+        let recording = replay::Recording::load(path)?;
+        return run_replay(bus, run, config, recording).await;
+    }
     let hand = Arc::new(SimulatedHand::new(&config.hand)?);
     let commands = bus
         .subscribe::<TrialCommand>(&run.command_key(&config.id))
@@ -200,4 +212,65 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
             else => return Ok(()),
         }
     }
+}
+
+/// Serves trial commands from a recording until the task is cancelled.
+async fn run_replay(
+    bus: &Bus,
+    run: &RunId,
+    config: &HandConfig,
+    recording: replay::Recording,
+) -> anyhow::Result<()> {
+    let commands = bus
+        .subscribe::<TrialCommand>(&run.command_key(&config.id))
+        .await?;
+    let sender = CloudSender::open(bus, run);
+    let _token = bus.declare_alive(run, AgentKind::Hand, &config.id).await?;
+    tracing::info!(
+        "hand {}: answering from {} ({} grasps)",
+        config.id,
+        recording.path.display(),
+        recording.trials.len()
+    );
+    let mut bad = 0u64;
+    while let Some(r) = commands.recv().await {
+        let command = match r.message {
+            Ok(c) if c.run_id == *run && c.worker == config.id => c,
+            Ok(c) => {
+                bad += 1;
+                tracing::warn!(
+                    "hand {}: command for {}/{} ignored",
+                    config.id,
+                    c.run_id,
+                    c.worker
+                );
+                continue;
+            }
+            Err(e) => {
+                bad += 1;
+                tracing::warn!(
+                    "hand {}: bad command on {} ({bad} bad messages): {e}",
+                    config.id,
+                    r.key
+                );
+                continue;
+            }
+        };
+        let started = Instant::now();
+        let mut clouds = recording.answer(&command, &config.id);
+        if let Some(rest) =
+            Duration::from_millis(config.trial_cost_ms).checked_sub(started.elapsed())
+        {
+            tokio::time::sleep(rest).await;
+        }
+        clouds.executed_ms = now_ms();
+        if let Err(e) = sender.send(&clouds).await {
+            tracing::warn!(
+                "hand {}: cannot send the clouds of trial {}: {e}",
+                config.id,
+                clouds.trial_id
+            );
+        }
+    }
+    Ok(())
 }

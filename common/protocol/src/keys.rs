@@ -25,6 +25,8 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+use crate::codec::Encoding;
+
 /// The first chunk of every key.
 pub const ROOT: &str = "graspopt";
 
@@ -233,20 +235,31 @@ pub struct AliveKey {
     pub kind: AgentKind,
     pub host: String,
     pub id: String,
+    /// The encoding this agent wants its messages in: a token ending in `/json`
+    /// (`graspopt/<run>/alive/hand/<host>/<id>/json`) asks for JSON, so an agent written
+    /// without bincode (a Python hand) gets its trial commands as JSON.
+    pub encoding: Encoding,
 }
 
-/// Parses `graspopt/<run>/alive/<kind>/<host>/<id>`.
+/// Parses `graspopt/<run>/alive/<kind>/<host>/<id>` and
+/// `graspopt/<run>/alive/<kind>/<host>/<id>/json`.
 pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
     let parts: Vec<&str> = key.split('/').collect();
-    match parts.as_slice() {
-        [root, run, "alive", kind, host, id] if *root == ROOT => Some(AliveKey {
-            run: RunId::new(run).ok()?,
-            kind: AgentKind::parse(kind)?,
-            host: (*host).to_string(),
-            id: (*id).to_string(),
-        }),
-        _ => None,
+    let (root, run, kind, host, id, encoding) = match parts.as_slice() {
+        [root, run, "alive", kind, host, id] => (root, run, kind, host, id, Encoding::Bincode),
+        [root, run, "alive", kind, host, id, "json"] => (root, run, kind, host, id, Encoding::Json),
+        _ => return None,
+    };
+    if *root != ROOT {
+        return None;
     }
+    Some(AliveKey {
+        run: RunId::new(run).ok()?,
+        kind: AgentKind::parse(kind)?,
+        host: (*host).to_string(),
+        id: (*id).to_string(),
+        encoding,
+    })
 }
 
 /// The published topics, for tools that list and decode them.
@@ -353,7 +366,15 @@ mod tests {
         assert_eq!(parsed.kind, AgentKind::Hand);
         assert_eq!(parsed.host, "host-a");
         assert_eq!(parsed.id, "hand-1");
+        assert_eq!(parsed.encoding, Encoding::Bincode);
         assert!(parse_alive_key("graspopt/r1/alive/robot/h/i").is_none());
+        // A JSON-speaking agent's token.
+        let parsed = parse_alive_key(&format!("{key}/json")).unwrap();
+        assert_eq!(
+            (parsed.id.as_str(), parsed.encoding),
+            ("hand-1", Encoding::Json)
+        );
+        assert!(parse_alive_key(&format!("{key}/xml")).is_none());
     }
 
     #[test]

@@ -65,6 +65,10 @@ pub enum Kind {
         /// Minimum trial duration (milliseconds).
         #[arg(long)]
         trial_cost_ms: Option<u64>,
+        /// Answer trials from recorded contact data (JSON lines, `graspopt record` writes
+        /// them) instead of simulating.
+        #[arg(long, value_name = "FILE")]
+        replay: Option<PathBuf>,
     },
     /// Scores contact clouds.
     Metric {
@@ -175,6 +179,7 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
             common,
             hand,
             trial_cost_ms,
+            replay,
         } => {
             let mut c: graspopt_hand::HandConfig = load(common.config.as_deref())?;
             if let Some(v) = &common.id {
@@ -184,6 +189,9 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 c.hand = v.clone();
             }
             c.trial_cost_ms = trial_cost_ms.unwrap_or(c.trial_cost_ms);
+            if replay.is_some() {
+                c.replay = replay.clone();
+            }
             let (bus, run) = join(common).await?;
             until_signal(graspopt_hand::run(&bus, &run, &c)).await
         }

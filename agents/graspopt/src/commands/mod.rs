@@ -8,6 +8,7 @@ pub mod launch;
 pub mod monitor;
 pub mod optimize_function;
 pub mod quality;
+pub mod record;
 pub mod router;
 pub mod run;
 pub mod scan;

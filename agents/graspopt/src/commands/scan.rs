@@ -33,14 +33,21 @@ pub struct ScanArgs {
     pub threads: usize,
 }
 
-pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
-    let kinds = args
-        .axes
+/// A grid of trials: the evaluator, the parameters, points per axis and the axes' values.
+pub struct Grid {
+    pub ev: graspopt_trial::Evaluator,
+    pub kinds: Vec<graspopt_sim::ParamKind>,
+    pub steps: Vec<usize>,
+    pub axes: Vec<Vec<f64>>,
+}
+
+/// The grid of `--axes` and `--steps` (shared with `graspopt record`).
+pub fn grid(sim: &SimArgs, axes: &str, steps: &str) -> Result<Grid> {
+    let kinds = axes
         .split(',')
         .map(param_kind)
         .collect::<Result<Vec<_>>>()?;
-    let steps: Vec<usize> = args
-        .steps
+    let steps: Vec<usize> = steps
         .split(',')
         .map(|s| {
             s.trim()
@@ -55,7 +62,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         n if n == kinds.len() => steps,
         n => bail!("--steps has {n} values for {} axes", kinds.len()),
     };
-    let ev = args.sim.evaluator(&kinds)?;
+    let ev = sim.evaluator(&kinds)?;
     let axes: Vec<Vec<f64>> = ev
         .space
         .bounds()
@@ -63,6 +70,21 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         .zip(&steps)
         .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
         .collect();
+    Ok(Grid {
+        ev,
+        kinds,
+        steps,
+        axes,
+    })
+}
+
+pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
+    let Grid {
+        ev,
+        kinds,
+        steps,
+        axes,
+    } = grid(&args.sim, &args.axes, &args.steps)?;
     let total: usize = steps.iter().product();
     let bar = ProgressBar::new(total as u64);
     bar.set_style(

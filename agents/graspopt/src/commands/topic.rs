@@ -580,6 +580,7 @@ mod tests {
             kind,
             host: "h".into(),
             id: id.into(),
+            encoding: graspopt_protocol::Encoding::Bincode,
         };
         let rows = topic_rows(&[
             a(AgentKind::Metric, "metric"),

@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""A graspopt hand agent in Python, speaking the documented protocol (docs/protocol.md) in JSON.
+
+It stands where a real robot's driver would: it declares itself alive, receives trial commands,
+"executes" each one and publishes the contact clouds its fingertip sensors measured. Here the
+measurements come from a recording (JSON lines, as written by `graspopt record`): each command is
+answered with the recorded grasp nearest to its parameters. Replace `measure()` with your robot.
+
+    pip install eclipse-zenoh~=1.10.0
+    python3 hand_agent.py --connect tcp/127.0.0.1:7447 --run mug --id py-hand-1 \
+        --recording mug.jsonl
+
+Only the Python standard library and eclipse-zenoh are needed.
+"""
+
+import argparse
+import json
+import math
+import socket
+import sys
+import time
+
+import zenoh
+
+WIRE_VERSION = 1  # every payload carries it; a mismatch is refused
+
+
+def load_recording(path):
+    """The recorded grasps: dicts with params, hand, palm_pose, fingers, min_gap."""
+    grasps = []
+    with open(path, encoding="utf-8") as f:
+        for n, line in enumerate(f, 1):
+            if line.strip():
+                try:
+                    grasps.append(json.loads(line))
+                except json.JSONDecodeError as e:
+                    sys.exit(f"recording {path}, line {n}: {e}")
+    if not grasps:
+        sys.exit(f"recording {path} holds no grasps")
+    return grasps
+
+
+def measure(grasps, command):
+    """What the fingers touched when the hand executed `command`: the nearest recorded grasp."""
+    params = command["params"]
+    candidates = [g for g in grasps if len(g["params"]) == len(params)]
+    if not candidates:
+        return None, f"the recording has no grasp with {len(params)} parameters"
+    best = min(candidates, key=lambda g: math.dist(g["params"], params))
+    if best["hand"] != command["hand"]:
+        return None, f"recorded with a {best['hand']} hand, the trial asks for {command['hand']}"
+    return best, None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--connect", required=True, help="router or peer endpoint, e.g. tcp/10.0.0.5:7447")
+    ap.add_argument("--run", required=True, help="the run to join")
+    ap.add_argument("--id", default="py-hand-1", help="this worker's id (unique in the run)")
+    ap.add_argument("--recording", required=True, help="JSON lines of recorded grasps")
+    ap.add_argument("--trial-cost-ms", type=int, default=0, help="minimum duration of a trial")
+    args = ap.parse_args()
+
+    grasps = load_recording(args.recording)
+    conf = zenoh.Config()
+    conf.insert_json5("mode", '"peer"')
+    conf.insert_json5("connect/endpoints", json.dumps([args.connect]))
+    conf.insert_json5("scouting/multicast/enabled", "false")
+    session = zenoh.open(conf)
+
+    prefix = f"graspopt/{args.run}"
+    host = "".join(c if c.isalnum() or c in "-_." else "_" for c in socket.gethostname()) or "host"
+    commands = queue_of(session, f"{prefix}/hand/{args.id}/command")
+    # The trailing /json asks the coordinator for JSON commands.
+    token = session.liveliness().declare_token(f"{prefix}/alive/hand/{host}/{args.id}/json")
+    print(f"{args.id}: {len(grasps)} recorded grasps, waiting for trials on {args.connect}",
+          file=sys.stderr, flush=True)
+
+    bad = 0
+    try:
+        while True:
+            sample = commands.recv()
+            started = time.monotonic()
+            try:
+                command = json.loads(sample.payload.to_bytes())
+                if command.get("wire") != WIRE_VERSION:
+                    raise ValueError(f"wire version {command.get('wire')}, expected {WIRE_VERSION}")
+                if command["worker"] != args.id:
+                    raise ValueError(f"command for worker {command['worker']}")
+            except (ValueError, KeyError, TypeError) as e:
+                bad += 1
+                print(f"{args.id}: bad command ({bad} bad messages): {e}", file=sys.stderr, flush=True)
+                continue
+            grasp, error = measure(grasps, command)
+            clouds = {
+                "wire": WIRE_VERSION,
+                "run_id": command["run_id"],
+                "trial_id": command["trial_id"],
+                "attempt": command["attempt"],
+                "worker": args.id,
+                "hand": command["hand"],
+                "palm_pose": grasp["palm_pose"] if grasp else command["palm_pose"],
+                "fingers": grasp["fingers"] if grasp else [],
+                "min_gap": grasp.get("min_gap") if grasp else None,
+                "error": error,
+                "executed_ms": int(time.time() * 1000),
+            }
+            rest = args.trial_cost_ms / 1000 - (time.monotonic() - started)
+            if rest > 0:
+                time.sleep(rest)
+            session.put(f"{prefix}/clouds", json.dumps(clouds).encode(),
+                        encoding=zenoh.Encoding.APPLICATION_JSON,
+                        congestion_control=zenoh.CongestionControl.BLOCK)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        token.undeclare()
+        session.close()
+
+
+def queue_of(session, key):
+    """A subscriber whose samples are read one at a time with .recv()."""
+    return session.declare_subscriber(key, zenoh.handlers.FifoChannel(256))
+
+
+if __name__ == "__main__":
+    main()
