@@ -202,6 +202,63 @@ impl Cluster {
         Proc::start(name, &v, &self.dir)
     }
 
+    /// Perception (publishing `object` at its true pose), a planner and a metric agent: what
+    /// every run needs besides its hands and coordinator.
+    pub fn support(&self, object: &str) -> Vec<Proc> {
+        vec![
+            self.agent("perception", &["perception", "--object", object]),
+            self.agent("planner", &["planner"]),
+            self.agent("metric", &["metric"]),
+        ]
+    }
+
+    /// Hands `hand-1` ... `hand-<n>`, each with `extra` flags.
+    pub fn hands(&self, n: usize, extra: &[&str]) -> Vec<Proc> {
+        (1..=n)
+            .map(|i| {
+                let id = format!("hand-{i}");
+                let mut args = vec!["hand", "--id", &id];
+                args.extend_from_slice(extra);
+                self.agent(&id, &args)
+            })
+            .collect()
+    }
+
+    /// This cluster's journal: `<dir>/journal.sqlite`.
+    pub fn journal(&self) -> PathBuf {
+        self.dir.join("journal.sqlite")
+    }
+
+    /// The coordinator of a run of `trials` trials on `object` with `seed`, journal
+    /// [`Cluster::journal`], and `extra` flags.
+    pub fn coordinator(&self, object: &str, trials: &str, seed: &str, extra: &[&str]) -> Proc {
+        let journal = self.journal();
+        let mut args = vec![
+            "coordinator",
+            "--object",
+            object,
+            "--trials",
+            trials,
+            "--seed",
+            seed,
+            "--journal",
+            journal.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        self.agent("coordinator", &args)
+    }
+
+    /// Waits for the coordinator to finish successfully; returns the final status it printed.
+    pub fn final_status(&self, coordinator: Proc, timeout: Duration) -> serde_json::Value {
+        let (status, stdout) = coordinator.wait_output(timeout);
+        assert!(
+            status.success(),
+            "coordinator failed: {stdout}\n{}",
+            self.log("coordinator")
+        );
+        serde_json::from_str(stdout.trim()).unwrap()
+    }
+
     /// The log of one of this cluster's processes.
     pub fn log(&self, name: &str) -> String {
         log(&self.dir, name)
@@ -271,4 +328,41 @@ pub fn signal(p: &Proc, name: &str) {
         .unwrap()
         .success();
     assert!(ok, "kill -{name} {}", p.name);
+}
+
+/// An embedded run of `run_id` on `object` that lasts (1000 random trials of 40 ms on two
+/// workers), listening on `endpoint` for tools to attach; results in `<dir>/results`.
+pub fn long_run(dir: &Path, run_id: &str, object: &str, endpoint: &str) -> Proc {
+    let out = dir.join("results");
+    let shm = format!("gpe2e_{run_id}_{}_", std::process::id());
+    let p = Proc::start(
+        "run",
+        &[
+            "run",
+            "--run",
+            run_id,
+            "--object",
+            object,
+            "--workers",
+            "2",
+            "--trials",
+            "1000",
+            "--method",
+            "random",
+            "--trial-cost-ms",
+            "40",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--listen",
+            endpoint,
+            "--no-multicast-scouting",
+            "--shm-prefix",
+            &shm,
+        ],
+        dir,
+    );
+    let port: u16 = endpoint.rsplit(':').next().unwrap().parse().unwrap();
+    wait_for_port(port, Duration::from_secs(30));
+    p
 }

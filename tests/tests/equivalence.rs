@@ -85,7 +85,7 @@ fn one_worker_gives_the_same_trials_embedded_multi_process_and_over_either_cloud
     assert!(shm.iter().any(|t| t.metrics.is_some()));
 
     let c = Cluster::start("equivalence-mp", "run");
-    let journal = c.dir.join("journal.sqlite");
+    let journal = c.journal();
     let _perception = c.agent(
         "perception",
         &["perception", "--object", "mug", "--seed", SEED],
@@ -93,26 +93,8 @@ fn one_worker_gives_the_same_trials_embedded_multi_process_and_over_either_cloud
     let _planner = c.agent("planner", &["planner"]);
     let _metric = c.agent("metric", &["metric"]);
     let _hand = c.agent("hand-1", &["hand", "--id", "hand-1"]);
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "mug",
-            "--trials",
-            "8",
-            "--seed",
-            SEED,
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
-    let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
-    assert!(
-        status.success(),
-        "coordinator failed: {stdout}\n{}",
-        c.log("coordinator")
-    );
+    let coordinator = c.coordinator("mug", "8", SEED, &[]);
+    c.final_status(coordinator, Duration::from_secs(120));
     let multi = check_journal(&journal, "run", TRIALS);
     assert_same_trials(&shm, &multi, "embedded vs multi-process");
 }

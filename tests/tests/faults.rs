@@ -31,54 +31,16 @@ fn wait_for_trial(
     }
 }
 
-fn final_status(
-    c: &Cluster,
-    coordinator: graspopt_e2e::Proc,
-    timeout: Duration,
-) -> serde_json::Value {
-    let (status, stdout) = coordinator.wait_output(timeout);
-    assert!(
-        status.success(),
-        "coordinator failed: {stdout}\n{}",
-        c.log("coordinator")
-    );
-    serde_json::from_str(stdout.trim()).unwrap()
-}
-
 /// A hand worker SIGKILLed while it holds a trial: the coordinator sees its liveliness token
 /// vanish and gives the trial to the other worker long before the lease (two minutes) runs
 /// out; every trial completes exactly once.
 #[test]
 fn a_trial_survives_its_killed_worker() {
     let c = Cluster::start("killed", "killed");
-    let journal = c.dir.join("journal.sqlite");
-    let _perception = c.agent("perception", &["perception", "--object", "cuboid"]);
-    let _planner = c.agent("planner", &["planner"]);
-    let _metric = c.agent("metric", &["metric"]);
-    let mut hand1 = c.agent(
-        "hand-1",
-        &["hand", "--id", "hand-1", "--trial-cost-ms", "400"],
-    );
-    let _hand2 = c.agent(
-        "hand-2",
-        &["hand", "--id", "hand-2", "--trial-cost-ms", "400"],
-    );
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "cuboid",
-            "--trials",
-            "8",
-            "--seed",
-            "3",
-            "--lease-ms",
-            "120000",
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
+    let journal = c.journal();
+    let _support = c.support("cuboid");
+    let mut hands = c.hands(2, &["--trial-cost-ms", "400"]);
+    let coordinator = c.coordinator("cuboid", "8", "3", &["--lease-ms", "120000"]);
     // hand-1 has completed a trial and holds another one: kill it.
     wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
         t.worker == "hand-1" && t.state == TrialState::Completed
@@ -87,9 +49,9 @@ fn a_trial_survives_its_killed_worker() {
         t.worker == "hand-1" && t.state == TrialState::Running
     });
     let killed_at = Instant::now();
-    hand1.kill();
+    hands[0].kill();
     // Well within the lease: the re-issue came from the lost liveliness token.
-    let status = final_status(&c, coordinator, Duration::from_secs(60));
+    let status = c.final_status(coordinator, Duration::from_secs(60));
     assert!(killed_at.elapsed() < Duration::from_secs(60));
     assert_eq!(status["completed"], 8);
     assert!(
@@ -112,44 +74,20 @@ fn a_trial_survives_its_killed_worker() {
 #[test]
 fn a_hung_worker_loses_its_trial_when_the_lease_expires() {
     let c = Cluster::start("hung", "hung");
-    let journal = c.dir.join("journal.sqlite");
-    let _perception = c.agent("perception", &["perception", "--object", "sphere"]);
-    let _planner = c.agent("planner", &["planner"]);
-    let _metric = c.agent("metric", &["metric"]);
-    let hand1 = c.agent(
-        "hand-1",
-        &["hand", "--id", "hand-1", "--trial-cost-ms", "300"],
-    );
-    let _hand2 = c.agent(
-        "hand-2",
-        &["hand", "--id", "hand-2", "--trial-cost-ms", "300"],
-    );
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "sphere",
-            "--trials",
-            "14",
-            "--seed",
-            "1",
-            "--lease-ms",
-            "1500",
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
+    let journal = c.journal();
+    let _support = c.support("sphere");
+    let hands = c.hands(2, &["--trial-cost-ms", "300"]);
+    let coordinator = c.coordinator("sphere", "14", "1", &["--lease-ms", "1500"]);
     let held = wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
         t.worker == "hand-1" && t.state == TrialState::Running
     });
-    signal(&hand1, "STOP");
+    signal(&hands[0], "STOP");
     // The lease (1.5 s) expires; hand-2 completes the trial.
     wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
         t.trial_id == held && t.state == TrialState::Completed
     });
-    signal(&hand1, "CONT");
-    let status = final_status(&c, coordinator, Duration::from_secs(120));
+    signal(&hands[0], "CONT");
+    let status = c.final_status(coordinator, Duration::from_secs(120));
     assert_eq!(status["completed"], 14);
     assert!(
         status["errors"]["reissued"].as_u64().unwrap() >= 1,
@@ -196,30 +134,10 @@ fn nan_clouds(run: &RunId) -> ContactClouds {
 #[test]
 fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     let c = Cluster::start("badinput", "bad");
-    let journal = c.dir.join("journal.sqlite");
-    let _perception = c.agent("perception", &["perception", "--object", "cylinder"]);
-    let _planner = c.agent("planner", &["planner"]);
-    let _metric = c.agent("metric", &["metric"]);
-    let _hands: Vec<_> = (1..=2)
-        .map(|i| {
-            let id = format!("hand-{i}");
-            c.agent(&id, &["hand", "--id", &id, "--trial-cost-ms", "300"])
-        })
-        .collect();
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "cylinder",
-            "--trials",
-            "10",
-            "--seed",
-            "6",
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
+    let journal = c.journal();
+    let _support = c.support("cylinder");
+    let _hands = c.hands(2, &["--trial-cost-ms", "300"]);
+    let coordinator = c.coordinator("cylinder", "10", "6", &[]);
     let run = RunId::new("bad").unwrap();
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let first: TrialResult = runtime.block_on(async {
@@ -293,7 +211,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         let _ = bus.close().await;
         first
     });
-    let status = final_status(&c, coordinator, Duration::from_secs(120));
+    let status = c.final_status(coordinator, Duration::from_secs(120));
     assert_eq!(status["completed"], 10, "{status}");
     assert_eq!(status["errors"]["bad_messages"], 4, "{status}");
     assert_eq!(status["errors"]["unknown_trial"], 1, "{status}");
@@ -323,4 +241,28 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         hand.contains("bad command") && hand.contains("bad messages"),
         "{hand}"
     );
+}
+
+/// A metric agent that starts late: trials wait for it (clouds published with nobody
+/// listening would be lost and the trial would wait for its lease), so the run completes
+/// promptly once it is up.
+#[test]
+fn trials_wait_for_a_metric_agent() {
+    let c = Cluster::start("latemetric", "late");
+    let _perception = c.agent("perception", &["perception", "--object", "cuboid"]);
+    let _planner = c.agent("planner", &["planner"]);
+    let _hands = c.hands(1, &[]);
+    let coordinator = c.coordinator("cuboid", "6", "2", &[]);
+    std::thread::sleep(Duration::from_secs(2));
+    let j = c.journal();
+    let issued = Journal::open(&j)
+        .map(|j| j.trials("late").map(|t| t.len()).unwrap_or(0))
+        .unwrap_or(0);
+    assert_eq!(issued, 0, "no trial before a metric agent is alive");
+    let _metric = c.agent("metric", &["metric"]);
+    // Well within the 30 s lease: nothing was lost.
+    let status = c.final_status(coordinator, Duration::from_secs(25));
+    assert_eq!(status["completed"], 6);
+    assert_eq!(status["errors"]["reissued"], 0, "{status}");
+    check_journal(&j, "late", 6);
 }

@@ -6,7 +6,7 @@ use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use graspopt_e2e::{Proc, free_port, graspopt, graspopt_bin, tempdir, wait_for_port};
+use graspopt_e2e::{free_port, graspopt, graspopt_bin, long_run, tempdir};
 use graspopt_journal::Journal;
 
 const ROWS: u16 = 32;
@@ -31,34 +31,7 @@ fn monitor_attaches_to_a_running_run_and_shows_it() {
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let out = dir.join("results");
-    let _run = Proc::start(
-        "run",
-        &[
-            "run",
-            "--run",
-            "tp",
-            "--object",
-            "cuboid",
-            "--workers",
-            "2",
-            "--trials",
-            "1000",
-            "--method",
-            "random",
-            "--trial-cost-ms",
-            "40",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-            "--listen",
-            &endpoint,
-            "--no-multicast-scouting",
-            "--shm-prefix",
-            &format!("gpe2e_mon_{}_", std::process::id()),
-        ],
-        &dir,
-    );
-    wait_for_port(port, Duration::from_secs(30));
+    let _run = long_run(&dir, "tp", "cuboid", &endpoint);
     // The run is well under way before the monitor starts.
     let journal = out.join("journal.sqlite");
     let start = Instant::now();

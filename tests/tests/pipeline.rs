@@ -89,37 +89,11 @@ fn embedded_run_completes_every_trial_and_reports_the_journal_best() {
 #[test]
 fn multi_process_run_over_a_router_completes_40_trials() {
     let c = Cluster::start("multiprocess", "mp");
-    let journal = c.dir.join("journal.sqlite");
-    let _perception = c.agent("perception", &["perception", "--object", "cylinder"]);
-    let _planner = c.agent("planner", &["planner"]);
-    let _metric = c.agent("metric", &["metric"]);
-    let _hands: Vec<_> = (1..=3)
-        .map(|i| {
-            let id = format!("hand-{i}");
-            c.agent(&id, &["hand", "--id", &id])
-        })
-        .collect();
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "cylinder",
-            "--trials",
-            "40",
-            "--seed",
-            "2",
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
-    let (status, stdout) = coordinator.wait_output(Duration::from_secs(240));
-    assert!(
-        status.success(),
-        "coordinator failed: {stdout}\n{}",
-        c.log("coordinator")
-    );
-    let final_status: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let journal = c.journal();
+    let _support = c.support("cylinder");
+    let _hands = c.hands(3, &[]);
+    let coordinator = c.coordinator("cylinder", "40", "2", &[]);
+    let final_status = c.final_status(coordinator, Duration::from_secs(240));
     assert_eq!(final_status["completed"], 40);
     assert_eq!(final_status["phase"], "finished");
     let trials = check_journal(&journal, "mp", 40);

@@ -45,24 +45,9 @@ fn record(dir: &Path) -> (PathBuf, Vec<(Vec<f64>, f64)>) {
 /// Runs `TRIALS` trials on the cuboid with `hand` as the only worker; checks every score is
 /// the nearest recorded grasp's and that `worker` did them.
 fn optimize_with(c: &Cluster, hand: Proc, worker: &str, grasps: &[(Vec<f64>, f64)]) {
-    let journal = c.dir.join("journal.sqlite");
-    let _perception = c.agent("perception", &["perception", "--object", "cuboid"]);
-    let _planner = c.agent("planner", &["planner"]);
-    let _metric = c.agent("metric", &["metric"]);
-    let coordinator = c.agent(
-        "coordinator",
-        &[
-            "coordinator",
-            "--object",
-            "cuboid",
-            "--trials",
-            &TRIALS.to_string(),
-            "--seed",
-            "3",
-            "--journal",
-            journal.to_str().unwrap(),
-        ],
-    );
+    let journal = c.journal();
+    let _support = c.support("cuboid");
+    let coordinator = c.coordinator("cuboid", &TRIALS.to_string(), "3", &[]);
     let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
     assert!(
         status.success(),

@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use graspopt_e2e::{Proc, free_port, graspopt, tempdir, wait_for_port};
+use graspopt_e2e::{free_port, graspopt, long_run, tempdir};
 use graspopt_journal::Journal;
 
 fn topic(endpoint: &str, args: &[&str]) -> String {
@@ -35,34 +35,7 @@ fn topic_tools_list_echo_and_time_a_running_pipeline() {
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let out = dir.join("results");
-    let _run = Proc::start(
-        "run",
-        &[
-            "run",
-            "--run",
-            "tp",
-            "--object",
-            "cylinder",
-            "--workers",
-            "2",
-            "--trials",
-            "1000",
-            "--method",
-            "random",
-            "--trial-cost-ms",
-            "40",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-            "--listen",
-            &endpoint,
-            "--no-multicast-scouting",
-            "--shm-prefix",
-            &format!("gpe2e_topic_{}_", std::process::id()),
-        ],
-        &dir,
-    );
-    wait_for_port(port, Duration::from_secs(30));
+    let _run = long_run(&dir, "tp", "cylinder", &endpoint);
 
     // list: the live agents' topics, types and publishers.
     let start = Instant::now();

@@ -244,6 +244,8 @@ struct Ctx<'a> {
     request_id: u64,
     /// The encoding each worker asked for in its liveliness token (bincode by default).
     encodings: std::collections::HashMap<String, Encoding>,
+    /// Live metric agents (`host/id`).
+    scorers: std::collections::HashSet<String>,
 }
 
 impl Ctx<'_> {
@@ -397,6 +399,10 @@ pub async fn run(
     let hands = bus
         .watch_alive(&run.alive_kind_key(AgentKind::Hand))
         .await?;
+    // Trials wait for a metric agent: clouds published before one listens would be lost.
+    let metrics = bus
+        .watch_alive(&run.alive_kind_key(AgentKind::Metric))
+        .await?;
     let state_server = bus
         .serve::<graspopt_protocol::RunStatus>(&run.state_key())
         .await?;
@@ -413,6 +419,7 @@ pub async fn run(
         space: None,
         request_id: 0,
         encodings: Default::default(),
+        scorers: Default::default(),
     };
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
@@ -422,7 +429,7 @@ pub async fn run(
         if ctx.state.finished() {
             break;
         }
-        if ctx.space.is_some() {
+        if ctx.space.is_some() && !ctx.scorers.is_empty() {
             ctx.issue_queued().await?;
             if tokio::time::Instant::now() >= planner_retry_at {
                 if ctx.plan().await? {
@@ -477,12 +484,25 @@ pub async fn run(
                     }
                 }
             },
+            Some(ev) = metrics.recv() => {
+                if ev.agent.run == *run {
+                    let key = format!("{}/{}", ev.agent.host, ev.agent.id);
+                    if ev.alive {
+                        ctx.scorers.insert(key);
+                    } else {
+                        ctx.scorers.remove(&key);
+                        if ctx.scorers.is_empty() {
+                            tracing::warn!("coordinator: no metric agent left: trials wait for one");
+                        }
+                    }
+                }
+            },
             Some(q) = state_server.recv() => {
                 let s = status(run, &spec, &ctx.state, if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting });
                 let _ = q.reply(&s).await;
             },
             _ = lease_tick.tick() => {
-                for t in ctx.state.expire_leases(now_ms()) {
+                for t in ctx.state.expire_leases(now_ms(), config.lease_ms as i64) {
                     tracing::warn!("coordinator: lease of trial {t} expired: re-issuing");
                 }
             },

@@ -41,6 +41,9 @@ pub struct Worker {
     pub host: String,
     /// The trial it holds (it is busy until a result for it arrives).
     pub trial: Option<u64>,
+    /// Set when the lease of its trial expired: if it has not answered by then, it is
+    /// freed (its command or its result was lost) and may take trials again.
+    pub release_at_ms: Option<i64>,
 }
 
 /// What a result did.
@@ -84,6 +87,7 @@ impl RunState {
             .or_insert_with(|| Worker {
                 host: host.to_string(),
                 trial: None,
+                release_at_ms: None,
             });
     }
 
@@ -162,12 +166,15 @@ impl RunState {
             lease_until_ms,
         };
         w.trial = Some(trial_id);
+        w.release_at_ms = None;
         Some(t.attempts)
     }
 
     /// Re-queues trials whose lease expired. The worker stays busy (it may be slow, not
-    /// dead) until it answers. Returns the re-queued trials.
-    pub fn expire_leases(&mut self, now_ms: i64) -> Vec<u64> {
+    /// dead) for `grace_ms` more; if it has not answered by then it is freed, since a live
+    /// worker that never answers has lost its command or its result (with one worker, keeping
+    /// it busy forever would stall the run). Returns the re-queued trials.
+    pub fn expire_leases(&mut self, now_ms: i64, grace_ms: i64) -> Vec<u64> {
         let mut out = Vec::new();
         for (id, t) in self.trials.iter_mut() {
             if let TrialPhase::Running {
@@ -176,10 +183,21 @@ impl RunState {
             } = &t.phase
                 && *lease_until_ms < now_ms
             {
+                if let Some(w) = self.workers.get_mut(worker)
+                    && w.trial == Some(*id)
+                {
+                    w.release_at_ms = Some(now_ms + grace_ms);
+                }
                 t.phase = TrialPhase::Queued {
                     reason: Some(format!("lease of worker {worker} expired")),
                 };
                 out.push(*id);
+            }
+        }
+        for w in self.workers.values_mut() {
+            if w.release_at_ms.is_some_and(|at| at <= now_ms) {
+                w.trial = None;
+                w.release_at_ms = None;
             }
         }
         self.errors.reissued += out.len() as u64;
@@ -192,6 +210,7 @@ impl RunState {
             && w.trial == Some(result.trial_id)
         {
             w.trial = None;
+            w.release_at_ms = None;
         }
         let Some(t) = self.trials.get_mut(&result.trial_id) else {
             self.errors.unknown_trial += 1;
@@ -350,14 +369,32 @@ mod tests {
         s.worker_up("a", "h");
         let t = s.add_trial(vec![0.0]);
         s.assign(t, "a", 1000);
-        assert!(s.expire_leases(999).is_empty());
-        assert_eq!(s.expire_leases(1001), vec![t]);
+        assert!(s.expire_leases(999, 500).is_empty());
+        assert_eq!(s.expire_leases(1001, 500), vec![t]);
         assert!(s.idle_workers().is_empty());
         // The slow worker's late result still completes the trial.
         assert_eq!(s.on_result(&result(t, "a", 1.0)), Disposition::Completed);
         assert!(s.finished());
         assert_eq!(s.on_result(&result(42, "a", 1.0)), Disposition::Unknown);
         assert_eq!(s.errors.unknown_trial, 1);
+    }
+
+    #[test]
+    fn a_silent_worker_is_freed_after_the_grace_and_gets_the_trial_again() {
+        let mut s = RunState::new(1);
+        s.worker_up("only", "h");
+        let t = s.add_trial(vec![0.0]);
+        assert_eq!(s.assign(t, "only", 1000), Some(1));
+        assert_eq!(s.expire_leases(1001, 500), vec![t]);
+        // Still busy during the grace...
+        assert!(s.expire_leases(1400, 500).is_empty());
+        assert!(s.idle_workers().is_empty());
+        // ...then free: the lone worker takes its trial again (attempt 2).
+        assert!(s.expire_leases(1502, 500).is_empty());
+        assert_eq!(s.idle_workers(), ["only"]);
+        assert_eq!(s.assign(t, "only", 3000), Some(2));
+        assert_eq!(s.on_result(&result(t, "only", 0.5)), Disposition::Completed);
+        assert!(s.finished());
     }
 
     #[test]

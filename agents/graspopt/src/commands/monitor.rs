@@ -142,12 +142,7 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
     ));
     match &s.best {
         Some(b) => {
-            let params: Vec<String> = s
-                .param_names
-                .iter()
-                .zip(&b.params)
-                .map(|(n, v)| format!("{n}={v:.5}"))
-                .collect();
+            let params = super::run::named_params(&s.param_names, &b.params, ", ");
             let fc = match b.force_closure {
                 Some(true) => ", force closure",
                 Some(false) => ", no force closure",
@@ -155,9 +150,7 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
             };
             out.push(format!(
                 "best: trial {} score {:.5} at {}{fc}",
-                b.trial_id,
-                b.score,
-                params.join(", ")
+                b.trial_id, b.score, params
             ));
         }
         None => out.push("best: none yet".into()),

@@ -295,21 +295,25 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         status.run_id, status.completed, status.failed
     );
     if let Some(b) = &status.best {
-        let params: Vec<String> = status
-            .param_names
-            .iter()
-            .zip(&b.params)
-            .map(|(n, v)| format!("{n}={v:.5}"))
-            .collect();
         println!(
             "best: trial {} score {} at {}",
             b.trial_id,
             b.score,
-            params.join(",")
+            named_params(&status.param_names, &b.params, ",")
         );
     }
     println!("results: {}", e.out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// `name=value` for each parameter (5 decimals), joined by `sep`.
+pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
+    let parts: Vec<String> = names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| format!("{n}={v:.5}"))
+        .collect();
+    parts.join(sep)
 }
 
 /// The status before the coordinator's first one.
