@@ -69,7 +69,9 @@ def main():
     session = zenoh.open(conf)
 
     prefix = f"graspopt/{args.run}"
-    host = "".join(c if c.isalnum() or c in "-_." else "_" for c in socket.gethostname()) or "host"
+    # A key chunk: ASCII letters, digits, '-', '_', '.', at most 64, not starting with '.'.
+    host = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_"
+                   for c in socket.gethostname())[:64].lstrip(".") or "host"
     commands = queue_of(session, f"{prefix}/hand/{args.id}/command")
     # The trailing /json asks the coordinator for JSON commands.
     token = session.liveliness().declare_token(f"{prefix}/alive/hand/{host}/{args.id}/json")
@@ -83,6 +85,8 @@ def main():
             started = time.monotonic()
             try:
                 command = json.loads(sample.payload.to_bytes())
+                if not isinstance(command, dict):
+                    raise ValueError("not a JSON object")
                 if command.get("wire") != WIRE_VERSION:
                     raise ValueError(f"wire version {command.get('wire')}, expected {WIRE_VERSION}")
                 if command["worker"] != args.id:

@@ -9,7 +9,7 @@
 //! | `graspopt/<run>/status`               | [`RunStatus`]      | coordinator         |
 //! | `graspopt/<run>/planner/suggest`      | [`SuggestRequest`] -> [`SuggestReply`] (query) | planner answers |
 //! | `graspopt/<run>/coordinator/state`    | [`RunStatus`] (query) | coordinator answers |
-//! | `graspopt/<run>/alive/<kind>/<host>/<id>` | liveliness token | every agent       |
+//! | `graspopt/<run>/alive/<kind>/<host>/<id>[/json]` | liveliness token (`/json`: send me JSON) | every agent |
 //!
 //! Run ids, hosts and agent ids are single key chunks: ASCII letters, digits, `-`, `_` and `.`.
 //!

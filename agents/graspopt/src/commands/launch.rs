@@ -106,8 +106,8 @@ pub struct Planned {
     pub coordinator: bool,
     /// Arguments of `graspopt`.
     pub args: Vec<String>,
-    /// For the router: the port to wait for.
-    pub wait_port: Option<u16>,
+    /// For the router: the `host:port` to wait for (loopback for a wildcard listener).
+    pub wait_addr: Option<String>,
 }
 
 impl LaunchFile {
@@ -139,6 +139,23 @@ impl LaunchFile {
                     origin.display(),
                     a.kind
                 );
+            }
+        }
+        let mut names = std::collections::HashSet::new();
+        for a in &file.agents {
+            let id = a.id.clone().unwrap_or_else(|| a.kind.clone());
+            for i in 1..=a.count {
+                let name = if a.count > 1 {
+                    format!("{id}-{i}")
+                } else {
+                    id.clone()
+                };
+                if !names.insert(name.clone()) {
+                    bail!(
+                        "launch file {}: two agents named {name:?} (ids are unique in a run, across hosts)",
+                        origin.display()
+                    );
+                }
             }
         }
         if file
@@ -177,10 +194,9 @@ impl LaunchFile {
                 name: "router".into(),
                 coordinator: false,
                 args,
-                wait_port: loopback_port(&listen),
+                wait_addr: reachable_addr(&listen),
             });
         }
-        let mut names = std::collections::HashSet::new();
         for a in self.agents.iter().filter(|a| here(&a.host)) {
             let id = a.id.clone().unwrap_or_else(|| a.kind.clone());
             for i in 1..=a.count {
@@ -189,9 +205,6 @@ impl LaunchFile {
                 } else {
                     id.clone()
                 };
-                if !names.insert(name.clone()) {
-                    bail!("launch file: two agents named {name:?} on host {host}");
-                }
                 let mut args = vec![
                     "agent".to_string(),
                     a.kind.clone(),
@@ -216,7 +229,7 @@ impl LaunchFile {
                     name,
                     coordinator: a.kind == "coordinator",
                     args,
-                    wait_port: None,
+                    wait_addr: None,
                 });
             }
         }
@@ -224,12 +237,17 @@ impl LaunchFile {
     }
 }
 
-/// The port of a `tcp/<address>:<port>` endpoint this machine can connect to (a wildcard
-/// address is reached on loopback).
-fn loopback_port(endpoint: &str) -> Option<u16> {
+/// Where this machine reaches a router listening on `tcp/<address>:<port>`: that address,
+/// or loopback for a wildcard one. `None` for other protocols.
+fn reachable_addr(endpoint: &str) -> Option<String> {
     let rest = endpoint.strip_prefix("tcp/")?;
-    let (_, port) = rest.rsplit_once(':')?;
-    port.parse().ok()
+    let (host, port) = rest.rsplit_once(':')?;
+    let port: u16 = port.parse().ok()?;
+    let host = match host {
+        "0.0.0.0" | "[::]" | "" => "127.0.0.1",
+        h => h,
+    };
+    Some(format!("{host}:{port}"))
 }
 
 struct Running {
@@ -237,6 +255,15 @@ struct Running {
     coordinator: bool,
     child: Child,
     log: PathBuf,
+}
+
+/// The processes launch started: stopped when dropped, so an early return leaves none behind.
+struct Children(Vec<Running>);
+
+impl Drop for Children {
+    fn drop(&mut self) {
+        terminate(&mut self.0);
+    }
 }
 
 fn terminate(children: &mut [Running]) {
@@ -302,7 +329,7 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     std::fs::create_dir_all(&logs)
         .with_context(|| format!("cannot create the log folder {}", logs.display()))?;
     let exe = std::env::current_exe().context("cannot find the graspopt executable")?;
-    let mut children: Vec<Running> = Vec::new();
+    let mut children = Children(Vec::new());
     for p in &plan {
         let log = logs.join(format!("{}.log", p.name));
         let err = std::fs::File::create(&log)
@@ -312,30 +339,23 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
             .stdin(Stdio::null())
             .stderr(err)
             .spawn();
-        let child = match child {
-            Ok(c) => c,
-            Err(e) => {
-                terminate(&mut children);
-                bail!("cannot start {}: {e}", p.name);
-            }
-        };
+        let child = child.with_context(|| format!("cannot start {}", p.name))?;
         eprintln!(
             "graspopt launch: started {} (log {})",
             p.name,
             log.display()
         );
-        children.push(Running {
+        children.0.push(Running {
             name: p.name.clone(),
             coordinator: p.coordinator,
             child,
             log,
         });
-        if let Some(port) = p.wait_port {
+        if let Some(addr) = &p.wait_addr {
             let start = Instant::now();
-            while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            while std::net::TcpStream::connect(addr.as_str()).is_err() {
                 if start.elapsed() > Duration::from_secs(20) {
-                    terminate(&mut children);
-                    bail!("the router does not accept connections on port {port} after 20 s");
+                    bail!("the router does not accept connections on {addr} after 20 s");
                 }
                 std::thread::sleep(Duration::from_millis(20));
             }
@@ -348,14 +368,15 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
         tokio::pin!(signal);
         loop {
             tokio::select! {
+                biased;
                 _ = &mut signal => return Outcome::Interrupted,
                 _ = poll.tick() => {}
             }
             let mut all_done = true;
-            for c in children.iter_mut() {
+            for c in children.0.iter_mut() {
                 match c.child.try_wait() {
                     Ok(Some(status)) if c.coordinator => {
-                        return Outcome::Coordinator(status.success());
+                        return Outcome::Coordinator(status.code());
                     }
                     Ok(Some(status)) => {
                         return Outcome::Died(c.name.clone(), status.to_string(), c.log.clone());
@@ -365,24 +386,28 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
                 }
             }
             if all_done {
-                return Outcome::Coordinator(true);
+                return Outcome::Coordinator(Some(0));
             }
         }
     });
-    terminate(&mut children);
+    terminate(&mut children.0);
     match outcome {
-        Outcome::Coordinator(true) => Ok(ExitCode::SUCCESS),
-        Outcome::Coordinator(false) => {
+        Outcome::Coordinator(Some(0)) => Ok(ExitCode::SUCCESS),
+        Outcome::Coordinator(code) => {
             let log = children
+                .0
                 .iter()
                 .find(|c| c.coordinator)
                 .map(|c| c.log.clone())
                 .unwrap_or_default();
-            bail!(
-                "the coordinator failed; its log ({}):\n{}",
+            eprintln!(
+                "graspopt launch: the coordinator failed; its log ({}):\n{}",
                 log.display(),
                 tail(&log, 20)
-            )
+            );
+            // Its exit status is launch's (1 if it was killed by a signal).
+            let code = code.and_then(|c| u8::try_from(c).ok()).unwrap_or(1);
+            Ok(ExitCode::from(code))
         }
         Outcome::Died(name, status, log) => bail!(
             "{name} stopped ({status}) before the run finished; everything was stopped. Its log ({}):\n{}",
@@ -397,7 +422,8 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
 }
 
 enum Outcome {
-    Coordinator(bool),
+    /// The coordinator's exit code (`None`: killed by a signal).
+    Coordinator(Option<i32>),
     Died(String, String, PathBuf),
     Interrupted,
 }
@@ -432,7 +458,7 @@ mod tests {
                 "coordinator"
             ]
         );
-        assert_eq!(plan[0].wait_port, Some(7447));
+        assert_eq!(plan[0].wait_addr.as_deref(), Some("127.0.0.1:7447"));
         assert_eq!(plan.iter().filter(|p| p.coordinator).count(), 1);
         for p in &plan[1..] {
             assert!(
@@ -495,8 +521,11 @@ mod tests {
         assert!(e.contains("gripper"), "{e}");
         let e = err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\ncolour = 1");
         assert!(e.contains("colour"), "{e}");
-        let two = "run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\n[[agent]]\nkind = \"hand\"";
-        let f = LaunchFile::parse(two, origin).unwrap();
-        assert!(format!("{:#}", f.plan("h", Path::new(".")).unwrap_err()).contains("two agents"));
+        let two = "run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\nhost = \"a\"\n[[agent]]\nkind = \"hand\"\nhost = \"b\"";
+        assert!(
+            err(two).contains("two agents named \"hand\""),
+            "{}",
+            err(two)
+        );
     }
 }

@@ -385,13 +385,15 @@ async fn dashboard(bus: &Bus, only: Option<&RunId>) -> Result<()> {
     // Keys are read on their own thread (crossterm's read blocks).
     let (keys_tx, mut keys) = mpsc::unbounded_channel();
     std::thread::spawn(move || {
-        use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind};
+        use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
         while let Ok(ev) = event::read() {
             if let Event::Key(k) = ev
                 && k.kind == KeyEventKind::Press
             {
                 let key = match k.code {
                     KeyCode::Char('q') | KeyCode::Esc => Key::Quit,
+                    // Raw mode delivers Ctrl-C as a key, not a signal.
+                    KeyCode::Char('c') if k.modifiers.contains(KeyModifiers::CONTROL) => Key::Quit,
                     KeyCode::Tab | KeyCode::Right | KeyCode::Down => Key::Next,
                     _ => continue,
                 };
@@ -402,7 +404,16 @@ async fn dashboard(bus: &Bus, only: Option<&RunId>) -> Result<()> {
             }
         }
     });
-    let mut terminal = ratatui::try_init()?;
+    let mut terminal = match ratatui::try_init() {
+        Ok(t) => t,
+        Err(e) => {
+            // Raw mode may be on already: give the shell its terminal back.
+            ratatui::restore();
+            return Err(anyhow::anyhow!(
+                "cannot use this terminal for the dashboard: {e} (try --once)"
+            ));
+        }
+    };
     let mut m = Monitor::default();
     let mut alive_runs: Vec<String> = Vec::new();
     let mut redraw = tokio::time::interval(Duration::from_millis(250));

@@ -14,6 +14,7 @@
 //! one host) are not on Zenoh and so are not seen here.
 
 use std::collections::{BTreeMap, VecDeque};
+use std::io::Write;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -404,9 +405,11 @@ fn deadline(watch: &Watch) -> Result<Option<tokio::time::Instant>> {
         Some(s) if !(s.is_finite() && s > 0.0) => {
             bail!("--duration must be a positive number of seconds, got {s}")
         }
-        Some(s) => Ok(Some(
-            tokio::time::Instant::now() + Duration::from_secs_f64(s),
-        )),
+        Some(s) => {
+            let d = Duration::try_from_secs_f64(s)
+                .map_err(|_| anyhow::anyhow!("--duration {s} is too long"))?;
+            Ok(Some(tokio::time::Instant::now() + d))
+        }
         None => Ok(None),
     }
 }
@@ -450,7 +453,9 @@ async fn echo(bus: &Bus, watch: &Watch, format: Format, count: Option<u64>) -> R
                         json!({"key": sample.key, "type": type_name, "bytes": sample.bytes.len(), "error": e})
                     }
                 };
-                println!("{v}");
+                if writeln!(std::io::stdout(), "{v}").is_err() {
+                    break; // the reader went away (a pipe closed)
+                }
             }
             Format::Text => {
                 let mut out = format!(
@@ -463,7 +468,9 @@ async fn echo(bus: &Bus, watch: &Watch, format: Format, count: Option<u64>) -> R
                     Ok(m) => render_text(&m, 1, &mut out),
                     Err(e) => out.push_str(&format!("  cannot decode: {e}\n")),
                 }
-                print!("{out}");
+                if write!(std::io::stdout(), "{out}").is_err() {
+                    break;
+                }
             }
         }
     }
@@ -505,12 +512,14 @@ async fn rate(bus: &Bus, watch: &Watch, window: usize, bandwidth: bool) -> Resul
                 Some(s) => w.push(start.elapsed().as_secs_f64(), s.bytes.len()),
                 None => break,
             },
-            _ = report.tick() => println!("{}", line(&w)),
+            _ = report.tick() => if writeln!(std::io::stdout(), "{}", line(&w)).is_err() {
+                return Ok(());
+            },
             _ = &mut stop => break,
             _ = &mut signal => break,
         }
     }
-    println!("{}", line(&w));
+    let _ = writeln!(std::io::stdout(), "{}", line(&w));
     Ok(())
 }
 
