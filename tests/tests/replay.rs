@@ -112,7 +112,7 @@ fn replay_hand_answers_trials_from_a_recording() {
 }
 
 /// Needs Python with eclipse-zenoh: `.ci/run` makes a venv and runs this with
-/// `GRASPOPT_PYTHON` set (`cargo test -p graspopt-e2e --test replay -- --ignored`).
+/// `GRASPOPT_PYTHON` set (`cargo test --workspace --test replay -- --ignored`).
 #[test]
 #[ignore = "needs Python with eclipse-zenoh (GRASPOPT_PYTHON); .ci/run runs it"]
 fn python_hand_agent_is_the_only_worker_of_an_optimization() {
