@@ -162,14 +162,8 @@ impl Bus {
         key: &str,
         capacity: usize,
     ) -> Result<Subscription<T>, BusError> {
-        let sub = self
-            .session
-            .declare_subscriber(key)
-            .with(RingChannel::new(capacity.max(1)))
-            .await
-            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))?;
         Ok(Subscription {
-            inner: Inner::Ring(sub),
+            inner: Inner::Ring(self.ring_subscriber(key, capacity).await?),
             _t: PhantomData,
         })
     }
@@ -182,13 +176,21 @@ impl Bus {
         key: &str,
         capacity: usize,
     ) -> Result<RawSubscription, BusError> {
-        let sub = self
-            .session
+        Ok(RawSubscription {
+            sub: self.ring_subscriber(key, capacity).await?,
+        })
+    }
+
+    async fn ring_subscriber(
+        &self,
+        key: &str,
+        capacity: usize,
+    ) -> Result<Subscriber<RingChannelHandler<Sample>>, BusError> {
+        self.session
             .declare_subscriber(key)
             .with(RingChannel::new(capacity.max(1)))
             .await
-            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))?;
-        Ok(RawSubscription { sub })
+            .map_err(|e| BusError::zenoh(format!("subscribing to {key}"), e))
     }
 
     /// Sends a query and decodes the first reply.

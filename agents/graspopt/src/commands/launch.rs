@@ -96,6 +96,19 @@ fn one() -> u32 {
     1
 }
 
+impl AgentEntry {
+    /// The ids of this entry's processes: the id (default: the kind), or `<id>-1` ...
+    /// `<id>-<count>` for several.
+    fn names(&self) -> Vec<String> {
+        let id = self.id.clone().unwrap_or_else(|| self.kind.clone());
+        if self.count > 1 {
+            (1..=self.count).map(|i| format!("{id}-{i}")).collect()
+        } else {
+            vec![id]
+        }
+    }
+}
+
 const KINDS: [&str; 5] = ["perception", "hand", "metric", "planner", "coordinator"];
 
 /// One process to start.
@@ -143,13 +156,7 @@ impl LaunchFile {
         }
         let mut names = std::collections::HashSet::new();
         for a in &file.agents {
-            let id = a.id.clone().unwrap_or_else(|| a.kind.clone());
-            for i in 1..=a.count {
-                let name = if a.count > 1 {
-                    format!("{id}-{i}")
-                } else {
-                    id.clone()
-                };
+            for name in a.names() {
                 if !names.insert(name.clone()) {
                     bail!(
                         "launch file {}: two agents named {name:?} (ids are unique in a run, across hosts)",
@@ -198,13 +205,7 @@ impl LaunchFile {
             });
         }
         for a in self.agents.iter().filter(|a| here(&a.host)) {
-            let id = a.id.clone().unwrap_or_else(|| a.kind.clone());
-            for i in 1..=a.count {
-                let name = if a.count > 1 {
-                    format!("{id}-{i}")
-                } else {
-                    id.clone()
-                };
+            for name in a.names() {
                 let mut args = vec![
                     "agent".to_string(),
                     a.kind.clone(),
