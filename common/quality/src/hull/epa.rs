@@ -93,6 +93,12 @@ fn expand<const D: usize>(
         .map(|f| Reverse((Key(poly.facets[f as usize].offset), f)))
         .collect();
     let mut iterations = 0;
+    // The least support value seen. The inscribed radius is at most the support value
+    // along any unit direction, so while that bound is positive a facet farther than it
+    // is never the answer and is not queued. (A polytope that does not contain the
+    // origin has a facet at offset <= 0, which stays queued, so the result is then
+    // still a non-positive certificate. A bound <= 0 prunes nothing.)
+    let mut upper = f64::INFINITY;
     let mut used = vec![false; points.len()];
     for &i in simplex {
         used[i] = true;
@@ -112,6 +118,7 @@ fn expand<const D: usize>(
         if height - offset <= tolerance {
             return Ok(InnerDistance { offset, iterations });
         }
+        upper = upper.min(height);
         // A point is added at most once; asked for again, the polytope has gone
         // non-convex in rounding: give up on it (the caller falls back to the full hull).
         if std::mem::replace(&mut used[best], true) {
@@ -120,7 +127,10 @@ fn expand<const D: usize>(
         let new = poly.add_point(best, f)?;
         iterations += 1;
         for g in new {
-            heap.push(Reverse((Key(poly.facets[g as usize].offset), g)));
+            let offset = poly.facets[g as usize].offset;
+            if upper <= 0.0 || offset <= upper + tolerance {
+                heap.push(Reverse((Key(offset), g)));
+            }
         }
     }
     Err(Degenerate)
@@ -147,6 +157,78 @@ mod tests {
         // Shifted by 0.5 along x: the nearest facet, x = -0.5, is at distance 0.5.
         let r = inner_distance(&cube).unwrap();
         assert!((r.offset - 0.5).abs() < 1e-12);
+    }
+
+    /// A fixed-seed generator for the random sets below.
+    fn uniform(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+
+    #[test]
+    fn six_dimensional_cross_polytope_and_cube() {
+        let mut cross = Vec::new();
+        for i in 0..6 {
+            for s in [1.0, -1.0] {
+                let mut p = SVector::<f64, 6>::zeros();
+                p[i] = s;
+                cross.push(p);
+            }
+        }
+        let r = inner_distance(&cross).unwrap();
+        assert!((r.offset - 1.0 / 6.0f64.sqrt()).abs() < 1e-12, "{r:?}");
+        // 64 vertices, 32 on each facet: heavily coplanar.
+        let cube: Vec<SVector<f64, 6>> = (0..64u32)
+            .map(|i| SVector::from_fn(|k, _| if i >> k & 1 == 1 { 1.0 } else { -1.0 }))
+            .collect();
+        let r = inner_distance(&cube).unwrap();
+        assert!((r.offset - 1.0).abs() < 1e-12, "{r:?}");
+    }
+
+    #[test]
+    fn agrees_with_the_full_hull_on_random_sets() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for (n, grid) in [(20, 0.0), (48, 0.0), (48, 0.25), (120, 0.0), (200, 0.5)] {
+            for _ in 0..5 {
+                // Points in a box around the origin; with a grid, rounded to it, which
+                // makes many of them coplanar.
+                let points: Vec<SVector<f64, 6>> = (0..n)
+                    .map(|_| {
+                        SVector::from_fn(|_, _| {
+                            let x = 2.0 * uniform(&mut state) + 0.1;
+                            if grid > 0.0 {
+                                (x / grid).round() * grid
+                            } else {
+                                x
+                            }
+                        })
+                    })
+                    .collect();
+                let hull = quickhull::Hull::new(&points).unwrap();
+                let r = inner_distance(&points).unwrap();
+                assert!(
+                    (r.offset - hull.min_offset()).abs() < 1e-9,
+                    "n {n} grid {grid}: {r:?} vs {}",
+                    hull.min_offset()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn origin_outside_random_sets_give_non_positive_certificates() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for shift in [0.6, 1.0, 3.0] {
+            let points: Vec<SVector<f64, 6>> = (0..48)
+                .map(|_| {
+                    SVector::from_fn(|k, _| uniform(&mut state) + if k == 0 { shift } else { 0.0 })
+                })
+                .collect();
+            let r = inner_distance(&points).unwrap();
+            assert!(r.offset <= 1e-12, "shift {shift}: {r:?}");
+        }
     }
 
     #[test]

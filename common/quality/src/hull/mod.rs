@@ -7,7 +7,8 @@
 //! - [`qp`]: the same distance as a second-order cone program solved by Clarabel, kept
 //!   as the reference solver.
 //! - [`polytope`]: a simplicial polytope grown one point at a time (beneath-beyond),
-//!   shared by the two algorithms below.
+//!   shared by the two algorithms below; [`ridges`] matches its new facets along their
+//!   shared ridges.
 //! - [`epa`]: the expanding-polytope algorithm: the distance from an interior origin to
 //!   the hull boundary (Largest Sphere), growing only the facets nearest the origin.
 //! - [`quickhull`]: the full hull, for its volume and facets.
@@ -20,6 +21,7 @@ pub mod min_norm;
 pub mod polytope;
 pub mod qp;
 pub mod quickhull;
+pub mod ridges;
 
 use nalgebra::SVector;
 

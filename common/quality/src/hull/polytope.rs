@@ -11,7 +11,11 @@
 //! (a cube's 32 vertices per facet, duplicated contacts) yields a consistent
 //! triangulation rather than slivers.
 
+use std::hint::select_unpredictable;
+
 use nalgebra::SVector;
+
+use super::ridges::{MAX_FACETS, RidgeTable, vertex_keys};
 
 /// Index of a facet in [`Polytope::facets`].
 pub type FacetId = u32;
@@ -49,10 +53,12 @@ pub struct Polytope<'a, const D: usize> {
     pub eps: f64,
     stamp: Vec<u32>,
     epoch: u32,
-    slot_of: Vec<u32>,
     visible: Vec<FacetId>,
-    horizon: Vec<(FacetId, usize)>,
-    cone: Vec<[FacetId; D]>,
+    /// Horizon ridges of the current step: (visible facet, slot of the hidden neighbour).
+    horizon: Vec<(FacetId, u32)>,
+    ridges: RidgeTable,
+    /// The ridge-hashing key words of every point.
+    keys: Vec<[u64; 2]>,
 }
 
 /// Failure to build or grow the polytope (degenerate geometry in floating point).
@@ -73,15 +79,15 @@ impl<'a, const D: usize> Polytope<'a, D> {
         let interior = simplex.iter().map(|&i| points[i]).sum::<SVector<f64, D>>() / (D + 1) as f64;
         let mut poly = Self {
             points,
-            facets: Vec::with_capacity(64 * D * D),
+            facets: Vec::with_capacity(128 * D * D),
             interior,
             eps,
             stamp: Vec::new(),
             epoch: 0,
-            slot_of: Vec::new(),
             visible: Vec::new(),
             horizon: Vec::new(),
-            cone: Vec::new(),
+            ridges: RidgeTable::default(),
+            keys: (0..points.len() as u32).map(vertex_keys).collect(),
         };
         // Facet f omits simplex[f]; across the ridge opposite vertex simplex[g] lies facet g.
         for f in 0..=D {
@@ -101,8 +107,8 @@ impl<'a, const D: usize> Polytope<'a, D> {
                 alive: true,
             });
         }
-        poly.stamp = vec![0; poly.facets.len()];
-        poly.slot_of = vec![0; poly.facets.len()];
+        poly.stamp = Vec::with_capacity(poly.facets.capacity());
+        poly.stamp.resize(poly.facets.len(), 0);
         Ok(poly)
     }
 
@@ -157,6 +163,11 @@ impl<'a, const D: usize> Polytope<'a, D> {
 
     /// Adds point `p`, which must lie beyond facet `seed` (by more than `eps`). Returns
     /// the range of the new facets' ids; the removed ones are in [`Self::last_visible`].
+    ///
+    /// The loops avoid data-dependent branches where they can (appends advance a length
+    /// by a 0/1 flag): whether a neighbour is visible, whether a ridge is on the horizon
+    /// and whether a ridge's partner has been seen are coin flips that a branch
+    /// predictor cannot learn, and mispredictions were a third of the time.
     pub fn add_point(
         &mut self,
         p: usize,
@@ -169,123 +180,114 @@ impl<'a, const D: usize> Polytope<'a, D> {
             self.epoch = 1;
         }
         let epoch = self.epoch;
-        // Visible set by breadth-first search from the seed; `slot_of` holds each
-        // visible facet's position in the list.
+        // Visible set by breadth-first search from the seed. Stamps never exceed the
+        // current epoch, so `max` marks a facet exactly when it is taken.
         self.visible.clear();
-        self.horizon.clear();
         self.visible.push(seed);
         self.stamp[seed as usize] = epoch;
-        self.slot_of[seed as usize] = 0;
+        let mut len = 1;
         let mut head = 0;
-        while head < self.visible.len() {
+        while head < len {
             let f = self.visible[head] as usize;
             head += 1;
-            for slot in 0..D {
-                let g = self.facets[f].neighbors[slot] as usize;
-                if self.stamp[g] == epoch {
-                    continue;
-                }
-                if self.facets[g].distance(&point) > self.eps {
-                    self.stamp[g] = epoch;
-                    self.slot_of[g] = self.visible.len() as u32;
-                    self.visible.push(g as FacetId);
-                }
+            if self.visible.len() < len + D {
+                self.visible.resize(2 * (len + D), 0);
+            }
+            for g in self.facets[f].neighbors {
+                let fresh = self.stamp[g as usize] != epoch;
+                let beyond = self.facets[g as usize].distance(&point) > self.eps;
+                let take = fresh & beyond;
+                self.visible[len] = g;
+                len += take as usize;
+                let stamp = &mut self.stamp[g as usize];
+                *stamp = (*stamp).max(epoch * take as u32);
             }
         }
-        // Cone each horizon ridge to the new point; `cone[i][slot]` is the new facet on
-        // the ridge opposite `slot` of the i-th visible facet.
+        self.visible.truncate(len);
+        // The horizon: ridges between a visible and a hidden facet.
+        self.horizon.clear();
+        self.horizon.resize(len * D, (0, 0));
+        let mut ridges = 0;
+        for &f in &self.visible {
+            for (slot, &g) in self.facets[f as usize].neighbors.iter().enumerate() {
+                self.horizon[ridges] = (f, slot as u32);
+                ridges += (self.stamp[g as usize] != epoch) as usize;
+            }
+        }
+        self.horizon.truncate(ridges);
+        // Cone each horizon ridge to the new point.
         let first = self.facets.len() as FacetId;
-        self.cone.clear();
-        self.cone.resize(self.visible.len(), [FacetId::MAX; D]);
-        for i in 0..self.visible.len() {
-            let f = self.visible[i];
-            for slot in 0..D {
-                let outer = self.facets[f as usize].neighbors[slot];
-                if self.stamp[outer as usize] == epoch {
-                    continue;
-                }
-                let id = self.facets.len() as FacetId;
-                let mut verts = self.facets[f as usize].verts;
-                // The apex already on the horizon: rounding made the polytope non-convex
-                // there; a facet with a repeated vertex would break the topology.
-                if verts.contains(&(p as u32)) {
-                    return Err(Degenerate);
-                }
-                verts[slot] = p as u32;
-                let (normal, offset) = self.cone_hyperplane(f, outer, &point, &verts)?;
-                let mut neighbors = [FacetId::MAX; D];
-                neighbors[slot] = outer;
-                let outer_facet = &mut self.facets[outer as usize];
-                let k = outer_facet
-                    .neighbors
-                    .iter()
-                    .position(|&n| n == f)
-                    .ok_or(Degenerate)?;
-                outer_facet.neighbors[k] = id;
-                self.facets.push(Facet {
-                    verts,
-                    neighbors,
-                    normal,
-                    offset,
-                    alive: true,
-                });
-                self.stamp.push(0);
-                self.slot_of.push(0);
-                self.cone[i][slot] = id;
-                self.horizon.push((f, slot));
+        for i in 0..ridges {
+            let (f, slot) = self.horizon[i];
+            let slot = slot as usize;
+            let outer = self.facets[f as usize].neighbors[slot];
+            let id = self.facets.len() as FacetId;
+            let mut verts = self.facets[f as usize].verts;
+            // The apex already on the horizon: rounding made the polytope non-convex
+            // there; a facet with a repeated vertex would break the topology.
+            if verts.contains(&(p as u32)) {
+                return Err(Degenerate);
             }
+            verts[slot] = p as u32;
+            let (normal, offset) = self.cone_hyperplane(f, outer, &point, &verts)?;
+            let mut neighbors = [FacetId::MAX; D];
+            neighbors[slot] = outer;
+            let outer_facet = &mut self.facets[outer as usize];
+            let back = position(&outer_facet.neighbors, f).ok_or(Degenerate)?;
+            outer_facet.neighbors[back] = id;
+            self.facets.push(Facet {
+                verts,
+                neighbors,
+                normal,
+                offset,
+                alive: true,
+            });
+            self.stamp.push(0);
         }
-        // Link the new facets with each other. The new facet on horizon ridge (F, s)
-        // meets, across its ridge opposite F.verts[t], the new facet found by turning
-        // around the (D-3)-face sigma = F.verts minus {F.verts[s], F.verts[t]} through
-        // visible facets until the horizon is reached again.
-        for h in 0..self.horizon.len() {
-            let (f, s) = self.horizon[h];
-            let g = self.cone[self.slot_of[f as usize] as usize][s];
-            for t in 0..D {
-                if t == s || self.facets[g as usize].neighbors[t] != FacetId::MAX {
-                    continue;
-                }
-                let mut cur = f;
-                let mut a = self.facets[f as usize].verts[s];
-                let mut b = self.facets[f as usize].verts[t];
-                let mut steps = 0;
-                let (other, other_slot) = loop {
-                    steps += 1;
-                    if steps > 4 * self.visible.len() + 8 {
-                        return Err(Degenerate);
-                    }
-                    let cf = &self.facets[cur as usize];
-                    let slot_b = cf.verts.iter().position(|&v| v == b).ok_or(Degenerate)?;
-                    let next = cf.neighbors[slot_b];
-                    if self.stamp[next as usize] != epoch || next >= first {
-                        // (cur, slot_b) is a horizon ridge: its cone facet holds
-                        // sigma + {a, p}, and meets ours across the ridge opposite a.
-                        let slot_a = cf.verts.iter().position(|&v| v == a).ok_or(Degenerate)?;
-                        let other = self.cone[self.slot_of[cur as usize] as usize][slot_b];
-                        break (other, slot_a);
-                    }
-                    let nf = &self.facets[next as usize];
-                    let back = nf
-                        .neighbors
-                        .iter()
-                        .position(|&n| n == cur)
-                        .ok_or(Degenerate)?;
-                    b = a;
-                    a = nf.verts[back];
-                    cur = next;
-                };
-                if other == FacetId::MAX || other == g {
-                    return Err(Degenerate);
-                }
-                self.facets[g as usize].neighbors[t] = other;
-                self.facets[other as usize].neighbors[other_slot] = g;
-            }
-        }
+        self.link_new_facets(first)?;
         for &f in &self.visible {
             self.facets[f as usize].alive = false;
         }
         Ok(first..self.facets.len() as FacetId)
+    }
+
+    /// Links the new facets `first..` (the cones from the added point over the horizon,
+    /// in the order of `self.horizon`) with each other: two of them are neighbours
+    /// across a ridge through the apex, matched by the ridge's vertex set in a hash
+    /// table. Unmatched offers write `FacetId::MAX` over `FacetId::MAX`, so the loop has
+    /// no branch on the outcome.
+    fn link_new_facets(&mut self, first: FacetId) -> Result<(), Degenerate> {
+        let end = self.facets.len() as FacetId;
+        if end >= MAX_FACETS {
+            return Err(Degenerate);
+        }
+        self.ridges.begin((end - first) as usize * (D - 1));
+        for (g, &(_, apex_slot)) in (first..end).zip(&self.horizon) {
+            let verts = self.facets[g as usize].verts;
+            let keys = verts.map(|v| self.keys[v as usize]);
+            let sum = keys.iter().fold([0u64; 2], |a, k| {
+                [a[0].wrapping_add(k[0]), a[1].wrapping_add(k[1])]
+            });
+            for j in 0..D - 1 {
+                // Every slot but the apex's (that ridge is the horizon ridge).
+                let t = j + (j >= apex_slot as usize) as usize;
+                let ridge = [
+                    sum[0].wrapping_sub(keys[t][0]),
+                    sum[1].wrapping_sub(keys[t][1]),
+                ];
+                let (h, u) = self.ridges.offer(ridge, g, t as u32);
+                let matched = h != FacetId::MAX;
+                self.facets[g as usize].neighbors[t] = h;
+                let (target, slot, value) =
+                    select_unpredictable(matched, (h, u, g), (g, t as u32, FacetId::MAX));
+                self.facets[target as usize].neighbors[slot as usize] = value;
+            }
+        }
+        if self.ridges.complete() {
+            Ok(())
+        } else {
+            Err(Degenerate)
+        }
     }
 
     /// The hyperplane of the new facet `verts` on the horizon ridge between the visible
@@ -308,7 +310,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
         let mut normal = f2.normal * d1 - f1.normal * d2;
         let norm = normal.norm();
         if norm > 0.0 && norm.is_finite() {
-            normal /= norm;
+            normal *= norm.recip();
             let offset = normal.dot(apex);
             let tolerance = RESIDUAL_TOLERANCE * self.eps;
             let fits = normal.dot(&self.interior) < offset
@@ -340,6 +342,13 @@ impl<'a, const D: usize> Polytope<'a, D> {
         }
         total / factorial
     }
+}
+
+/// The slot holding `id`, without a data-dependent branch.
+#[inline]
+fn position<const D: usize>(ids: &[FacetId; D], id: FacetId) -> Option<usize> {
+    let slot = (0..D).fold(D, |found, k| if ids[k] == id { k } else { found });
+    (slot < D).then_some(slot)
 }
 
 /// Determinant by Gaussian elimination with partial pivoting.
@@ -405,6 +414,52 @@ mod tests {
             for &g in &poly.facets[f as usize].neighbors {
                 assert!(poly.facets[g as usize].alive);
                 assert!(poly.facets[g as usize].neighbors.contains(&f));
+            }
+        }
+    }
+
+    #[test]
+    fn growth_keeps_the_topology_consistent() {
+        // Random points on and inside a sphere in 5D, added in order: after every step
+        // each live facet's neighbours are live, point back, and share all vertices
+        // but one with it; every input point ends up inside.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let pts: Vec<SVector<f64, 5>> = (0..80)
+            .map(|i| {
+                let p = SVector::<f64, 5>::from_fn(|_, _| uniform());
+                if i % 3 == 0 { p } else { p / p.norm() }
+            })
+            .collect();
+        let basis = super::super::affine::affine_basis(&pts);
+        let mut poly = Polytope::simplex(&pts, &basis.indices, 1e-12).unwrap();
+        for (i, p) in pts.iter().enumerate() {
+            let Some(seed) = poly
+                .live_facets()
+                .find(|&f| poly.facets[f as usize].distance(p) > 1e-12)
+            else {
+                continue;
+            };
+            poly.add_point(i, seed).unwrap();
+            for f in poly.live_facets() {
+                let facet = &poly.facets[f as usize];
+                for (slot, &g) in facet.neighbors.iter().enumerate() {
+                    let other = &poly.facets[g as usize];
+                    assert!(other.alive && other.neighbors.contains(&f));
+                    let shared = facet.verts.iter().filter(|v| other.verts.contains(v));
+                    assert_eq!(shared.count(), 4);
+                    assert!(!other.verts.contains(&facet.verts[slot]));
+                }
+            }
+        }
+        for f in poly.live_facets() {
+            for p in &pts {
+                assert!(poly.facets[f as usize].distance(p) <= 1e-9);
             }
         }
     }
