@@ -8,6 +8,14 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+/// The repository's root folder.
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ is inside the repository")
+        .to_path_buf()
+}
+
 /// The `graspopt` binary of this build (`cargo test --workspace` builds it before any test
 /// runs; `cargo build -p graspopt` does too).
 pub fn graspopt_bin() -> PathBuf {
@@ -160,14 +168,25 @@ pub struct Cluster {
 impl Cluster {
     /// Starts the router and waits until it listens.
     pub fn start(name: &str, run: &str) -> Cluster {
+        Cluster::start_with(name, run, |_| Vec::new())
+    }
+
+    /// As [`Cluster::start`], with more router flags, made from the scratch folder (a
+    /// configuration file written there, say).
+    pub fn start_with(
+        name: &str,
+        run: &str,
+        router_flags: impl FnOnce(&Path) -> Vec<String>,
+    ) -> Cluster {
         let dir = tempdir(name);
         let port = free_port();
         let endpoint = format!("tcp/127.0.0.1:{port}");
-        let router = Proc::start(
-            "router",
-            &["router", "--listen", &endpoint, "--no-multicast-scouting"],
-            &dir,
-        );
+        let mut args: Vec<String> = ["router", "--listen", &endpoint, "--no-multicast-scouting"]
+            .map(String::from)
+            .to_vec();
+        args.extend(router_flags(&dir));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let router = Proc::start("router", &args, &dir);
         wait_for_port(port, Duration::from_secs(20));
         // Short: the prefix is at most 32 characters.
         let tag: String = name
@@ -232,6 +251,18 @@ impl Cluster {
     /// The coordinator of a run of `trials` trials on `object` with `seed`, journal
     /// [`Cluster::journal`], and `extra` flags.
     pub fn coordinator(&self, object: &str, trials: &str, seed: &str, extra: &[&str]) -> Proc {
+        self.coordinator_as("coordinator", object, trials, seed, extra)
+    }
+
+    /// As [`Cluster::coordinator`], logging to `<dir>/<name>.log` (a restarted coordinator).
+    pub fn coordinator_as(
+        &self,
+        name: &str,
+        object: &str,
+        trials: &str,
+        seed: &str,
+        extra: &[&str],
+    ) -> Proc {
         let journal = self.journal();
         let mut args = vec![
             "coordinator",
@@ -245,16 +276,17 @@ impl Cluster {
             journal.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
-        self.agent("coordinator", &args)
+        self.agent(name, &args)
     }
 
     /// Waits for the coordinator to finish successfully; returns the final status it printed.
     pub fn final_status(&self, coordinator: Proc, timeout: Duration) -> serde_json::Value {
+        let name = coordinator.name.clone();
         let (status, stdout) = coordinator.wait_output(timeout);
         assert!(
             status.success(),
-            "coordinator failed: {stdout}\n{}",
-            self.log("coordinator")
+            "{name} failed: {stdout}\n{}",
+            self.log(&name)
         );
         serde_json::from_str(stdout.trim()).unwrap()
     }
@@ -264,9 +296,30 @@ impl Cluster {
         log(&self.dir, name)
     }
 
-    /// The router process (to check it survived).
+    /// The router process (to check it survived, or to kill it).
     pub fn router(&mut self) -> &mut Proc {
         &mut self.router
+    }
+
+    /// Starts the router again on the same endpoint (after [`Proc::kill`] on it).
+    pub fn restart_router(&mut self) {
+        let port: u16 = self
+            .endpoint
+            .rsplit(':')
+            .next()
+            .and_then(|p| p.parse().ok())
+            .unwrap();
+        self.router = Proc::start(
+            "router-restarted",
+            &[
+                "router",
+                "--listen",
+                &self.endpoint,
+                "--no-multicast-scouting",
+            ],
+            &self.dir,
+        );
+        wait_for_port(port, Duration::from_secs(20));
     }
 }
 
@@ -365,4 +418,66 @@ pub fn long_run(dir: &Path, run_id: &str, object: &str, endpoint: &str) -> Proc 
     let port: u16 = endpoint.rsplit(':').next().unwrap().parse().unwrap();
     wait_for_port(port, Duration::from_secs(30));
     p
+}
+
+/// Completed trials in the journal right now (0 while it does not exist yet).
+pub fn completed_now(path: &Path, run: &str) -> usize {
+    if !path.exists() {
+        return 0;
+    }
+    graspopt_journal::Journal::open(path)
+        .and_then(|j| j.counts(run))
+        .map(|c| c.completed)
+        .unwrap_or(0)
+}
+
+/// Waits until `pred` holds, polling every 20 ms; panics with `what` after `timeout`.
+pub fn wait_until(what: &str, timeout: Duration, mut pred: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !pred() {
+        assert!(start.elapsed() < timeout, "{what}: not after {timeout:?}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Records one test's figures: printed, and appended as a JSON line to
+/// `target/<profile>/reliability.jsonl` (`.ci/run` prints that file; docs/reliability.md
+/// quotes it).
+pub fn report(figures: serde_json::Value) {
+    use std::io::Write;
+    println!("reliability: {figures}");
+    let bin = graspopt_bin();
+    let path = bin
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join("reliability.jsonl");
+    if let Ok(mut f) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+    {
+        let _ = writeln!(f, "{figures}");
+    }
+}
+
+/// What a finished run of `n` trials lost and recorded twice, from its journal: trials of
+/// `1..=n` not completed, and trials with more than one accepted result in the event log.
+pub fn lost_and_recorded_twice(path: &Path, run: &str, n: u64) -> (u64, u64) {
+    let journal = graspopt_journal::Journal::open(path).unwrap();
+    let completed: std::collections::BTreeSet<u64> = journal
+        .trials(run)
+        .unwrap()
+        .iter()
+        .filter(|t| t.state == graspopt_journal::TrialState::Completed)
+        .map(|t| t.trial_id)
+        .collect();
+    let lost = (1..=n).filter(|id| !completed.contains(id)).count() as u64;
+    let mut results: std::collections::BTreeMap<u64, u64> = Default::default();
+    for e in journal.events(run).unwrap() {
+        if e.kind == graspopt_journal::event_kind::RESULT {
+            *results.entry(e.trial_id).or_default() += 1;
+        }
+    }
+    let twice = results.values().filter(|&&c| c > 1).count() as u64;
+    (lost, twice)
 }

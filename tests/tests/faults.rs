@@ -4,11 +4,12 @@
 use std::time::{Duration, Instant};
 
 use graspopt_bus::{Bus, BusArgs, BusMode, CongestionControl};
-use graspopt_e2e::{Cluster, check_journal, signal};
+use graspopt_e2e::{Cluster, check_journal, lost_and_recorded_twice, report, signal};
 use graspopt_journal::{Journal, TrialState};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Pose, RunId, TrialResult, encode,
 };
+use serde_json::json;
 
 /// Polls the journal until `pred` holds for some trial; returns that trial's id.
 fn wait_for_trial(
@@ -66,6 +67,14 @@ fn a_trial_survives_its_killed_worker() {
         "trial {held} was completed by the survivor"
     );
     assert_eq!(t.result_attempt, Some(2));
+    let (lost, twice) = lost_and_recorded_twice(&journal, "killed", 8);
+    assert_eq!((lost, twice), (0, 0));
+    report(json!({
+        "test": "hand worker killed (SIGKILL) holding a trial",
+        "faults": 1, "trials": 8, "lost": lost, "recorded_twice": twice,
+        "reissued": status["errors"]["reissued"],
+        "run_completed_after_kill_ms": killed_at.elapsed().as_millis(),
+    }));
 }
 
 /// A worker that stops answering (SIGSTOP) keeps its liveliness token for a while; its lease
@@ -103,15 +112,24 @@ fn a_hung_worker_loses_its_trial_when_the_lease_expires() {
         status["errors"]["duplicates"].as_u64().unwrap() >= 1,
         "{status}"
     );
+    let (lost, twice) = lost_and_recorded_twice(&journal, "hung", 14);
+    assert_eq!((lost, twice), (0, 0));
+    report(json!({
+        "test": "hand worker hung (SIGSTOP) past its lease",
+        "faults": 1, "trials": 14, "lost": lost, "recorded_twice": twice,
+        "late_results_counted_as_duplicates": status["errors"]["duplicates"],
+    }));
 }
 
-/// A ContactClouds message with a NaN in one point.
+/// A ContactClouds message with a NaN in one point, naming trial 1 as if from a worker the
+/// run does not have: the metric agent fails that attempt with the reason, and the
+/// coordinator, which never issued it, counts the failure as "not issued".
 fn nan_clouds(run: &RunId) -> ContactClouds {
     ContactClouds {
         run_id: run.clone(),
         trial_id: 1,
         attempt: 1,
-        worker: "hand-1".into(),
+        worker: "hand-9".into(),
         hand: "barrett".into(),
         palm_pose: Pose::IDENTITY,
         fingers: vec![FingerCloud {
@@ -215,6 +233,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     assert_eq!(status["completed"], 10, "{status}");
     assert_eq!(status["errors"]["bad_messages"], 4, "{status}");
     assert_eq!(status["errors"]["unknown_trial"], 1, "{status}");
+    assert_eq!(status["errors"]["not_issued"], 1, "{status}");
     assert_eq!(status["errors"]["duplicates"], 1, "{status}");
     // The journal: exactly the ten real trials, the first with its real score, no trace of
     // the injected messages (no trial 9999, no duplicate event, no 1e6 score).
@@ -241,6 +260,16 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         hand.contains("bad command") && hand.contains("bad messages"),
         "{hand}"
     );
+    let e = &status["errors"];
+    let counted: u64 = ["bad_messages", "unknown_trial", "not_issued", "duplicates"]
+        .iter()
+        .map(|k| e[k].as_u64().unwrap())
+        .sum();
+    let (lost, _) = lost_and_recorded_twice(&journal, "bad", 10);
+    report(json!({
+        "test": "one bad message of each kind on every topic",
+        "sent": 8, "counted_by_coordinator": counted, "trials": 10, "lost": lost,
+    }));
 }
 
 /// A metric agent that starts late: trials wait for it (clouds published with nobody

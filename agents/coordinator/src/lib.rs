@@ -11,6 +11,7 @@
 
 pub mod state;
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -18,7 +19,7 @@ use anyhow::{Context, bail};
 use graspopt_bus::{Bus, now_ms};
 use graspopt_journal::{
     Journal, MetricValues as JournalMetrics, ResultOutcome, RunRecord, RunStatus as JournalStatus,
-    TrialIssue, TrialResultRecord, TrialState,
+    TrialIssue, TrialResultRecord, TrialState, event_kind,
 };
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, PlannerMethod, RunId, RunPhase, RunStatus, SuggestReply,
@@ -154,6 +155,17 @@ pub fn open_run(
     };
     let mut state = RunState::new(spec.trials);
     let mut rows = journal.trials(run.as_str())?;
+    // Who each attempt went to, so that late results of attempts issued before a restart
+    // are still accepted.
+    let mut issued: BTreeMap<u64, BTreeMap<u32, String>> = BTreeMap::new();
+    for e in journal.events(run.as_str())? {
+        if e.kind == event_kind::ISSUED || e.kind == event_kind::REISSUED {
+            issued
+                .entry(e.trial_id)
+                .or_default()
+                .insert(e.attempt, e.worker.clone());
+        }
+    }
     // Observations in completion order (as the planner first saw them).
     rows.sort_by_key(|r| (r.completed_ms.unwrap_or(i64::MAX), r.trial_id));
     for row in &rows {
@@ -173,6 +185,7 @@ pub fn open_run(
             state::Trial {
                 params: row.params.clone(),
                 attempts: row.attempts,
+                issued_to: issued.remove(&row.trial_id).unwrap_or_default(),
                 phase,
             },
         );
@@ -246,6 +259,8 @@ struct Ctx<'a> {
     encodings: std::collections::HashMap<String, Encoding>,
     /// Live metric agents (`host/id`).
     scorers: std::collections::HashSet<String>,
+    /// Trials running when the last metric agent vanished.
+    orphaned: Vec<u64>,
 }
 
 impl Ctx<'_> {
@@ -349,8 +364,10 @@ impl Ctx<'_> {
 
     fn on_result(&mut self, result: &TrialResult) -> anyhow::Result<Disposition> {
         let now = now_ms();
-        let known = self.state.trials.contains_key(&result.trial_id);
-        if !known {
+        // A result must name an attempt issued to the worker it names: anything else (a
+        // forged or corrupted message, a trial never proposed) is counted and never
+        // reaches the journal.
+        if !self.state.was_issued(result) {
             return Ok(self.state.on_result(result));
         }
         let already = matches!(
@@ -420,6 +437,7 @@ pub async fn run(
         request_id: 0,
         encodings: Default::default(),
         scorers: Default::default(),
+        orphaned: Vec::new(),
     };
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
@@ -445,6 +463,7 @@ pub async fn run(
                     match ctx.on_result(&result)? {
                         Disposition::Unknown => tracing::warn!("coordinator: result for unknown trial {}", result.trial_id),
                         Disposition::Duplicate => tracing::info!("coordinator: duplicate result for trial {}", result.trial_id),
+                        Disposition::NotIssued => tracing::warn!("coordinator: result for trial {} attempt {} from {}, which was never issued that attempt", result.trial_id, result.attempt, result.worker),
                         _ => {}
                     }
                     let s = status(run, &spec, &ctx.state, RunPhase::Running);
@@ -488,10 +507,18 @@ pub async fn run(
                 if ev.agent.run == *run {
                     let key = format!("{}/{}", ev.agent.host, ev.agent.id);
                     if ev.alive {
+                        let was_empty = ctx.scorers.is_empty();
                         ctx.scorers.insert(key);
+                        if was_empty {
+                            let orphaned = std::mem::take(&mut ctx.orphaned);
+                            for t in ctx.state.requeue_orphaned(&orphaned) {
+                                tracing::warn!("coordinator: trial {t} ran while no metric agent was alive: re-issuing");
+                            }
+                        }
                     } else {
                         ctx.scorers.remove(&key);
                         if ctx.scorers.is_empty() {
+                            ctx.orphaned = ctx.state.running_trials();
                             tracing::warn!("coordinator: no metric agent left: trials wait for one");
                         }
                     }

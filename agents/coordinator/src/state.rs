@@ -32,6 +32,8 @@ pub struct Trial {
     pub params: Vec<f64>,
     /// Attempts issued so far.
     pub attempts: u32,
+    /// The worker each attempt was issued to: a result is accepted only from one of them.
+    pub issued_to: BTreeMap<u32, String>,
     pub phase: TrialPhase,
 }
 
@@ -57,6 +59,9 @@ pub enum Disposition {
     Duplicate,
     /// No such trial in this run: ignored.
     Unknown,
+    /// The trial exists, but no attempt of it was issued to the worker the result names:
+    /// ignored (a forged or corrupted result must not complete a trial).
+    NotIssued,
 }
 
 /// The state of one run.
@@ -144,6 +149,7 @@ impl RunState {
             Trial {
                 params,
                 attempts: 0,
+                issued_to: BTreeMap::new(),
                 phase: TrialPhase::Queued { reason: None },
             },
         );
@@ -161,6 +167,7 @@ impl RunState {
             return None;
         }
         t.attempts += 1;
+        t.issued_to.insert(t.attempts, worker.to_string());
         t.phase = TrialPhase::Running {
             worker: worker.to_string(),
             lease_until_ms,
@@ -168,6 +175,43 @@ impl RunState {
         w.trial = Some(trial_id);
         w.release_at_ms = None;
         Some(t.attempts)
+    }
+
+    /// Trials running now (their results depend on a metric agent being there).
+    pub fn running_trials(&self) -> Vec<u64> {
+        self.trials
+            .iter()
+            .filter(|(_, t)| matches!(t.phase, TrialPhase::Running { .. }))
+            .map(|(id, _)| *id)
+            .collect()
+    }
+
+    /// A metric agent is back after none was alive: of `orphaned` (the trials that were
+    /// running when the last one vanished), those still running had their clouds sent to
+    /// nobody. They are queued again and their workers freed at once, rather than at the
+    /// end of their leases. A result that still arrives for the old attempt is accepted
+    /// (or counted as a duplicate) as usual. Returns the re-queued trials.
+    pub fn requeue_orphaned(&mut self, orphaned: &[u64]) -> Vec<u64> {
+        let mut out = Vec::new();
+        for id in orphaned {
+            let Some(t) = self.trials.get_mut(id) else {
+                continue;
+            };
+            if let TrialPhase::Running { worker, .. } = &t.phase {
+                if let Some(w) = self.workers.get_mut(worker)
+                    && w.trial == Some(*id)
+                {
+                    w.trial = None;
+                    w.release_at_ms = None;
+                }
+                t.phase = TrialPhase::Queued {
+                    reason: Some(format!("no metric agent scored the clouds of {worker}")),
+                };
+                out.push(*id);
+            }
+        }
+        self.errors.reissued += out.len() as u64;
+        out
     }
 
     /// Re-queues trials whose lease expired. The worker stays busy (it may be slow, not
@@ -206,6 +250,14 @@ impl RunState {
 
     /// Applies a result (already accepted by the journal when `Completed`/`Failed`).
     pub fn on_result(&mut self, result: &TrialResult) -> Disposition {
+        if !self.was_issued(result) {
+            if self.trials.contains_key(&result.trial_id) {
+                self.errors.not_issued += 1;
+                return Disposition::NotIssued;
+            }
+            self.errors.unknown_trial += 1;
+            return Disposition::Unknown;
+        }
         if let Some(w) = self.workers.get_mut(&result.worker)
             && w.trial == Some(result.trial_id)
         {
@@ -239,6 +291,16 @@ impl RunState {
             result.metrics.map(|m| m.force_closure),
         );
         Disposition::Completed
+    }
+
+    /// Whether the trial the result names exists and the attempt it names was issued to the
+    /// worker it names.
+    pub fn was_issued(&self, result: &TrialResult) -> bool {
+        self.trials.get(&result.trial_id).is_some_and(|t| {
+            t.issued_to
+                .get(&result.attempt)
+                .is_some_and(|w| *w == result.worker)
+        })
     }
 
     /// Records a completed trial's observation and the best so far.
@@ -353,8 +415,11 @@ mod tests {
         assert_eq!(s.on_result(&result(2, "b", 0.5)), Disposition::Completed);
         assert_eq!(s.idle_workers(), vec!["b".to_string()]);
         assert_eq!(s.assign(1, "b", 200), Some(2));
-        assert_eq!(s.on_result(&result(1, "b", 0.7)), Disposition::Completed);
-        assert_eq!(s.on_result(&result(1, "b", 0.9)), Disposition::Duplicate);
+        let mut r = result(1, "b", 0.7);
+        r.attempt = 2;
+        assert_eq!(s.on_result(&r), Disposition::Completed);
+        r.score = 0.9;
+        assert_eq!(s.on_result(&r), Disposition::Duplicate);
         assert!(s.finished());
         assert_eq!(s.completed(), 2);
         assert_eq!(s.errors.duplicates, 1);
@@ -395,6 +460,47 @@ mod tests {
         assert_eq!(s.assign(t, "only", 3000), Some(2));
         assert_eq!(s.on_result(&result(t, "only", 0.5)), Disposition::Completed);
         assert!(s.finished());
+    }
+
+    #[test]
+    fn a_result_is_accepted_only_from_the_worker_and_attempt_issued() {
+        let mut s = RunState::new(1);
+        s.worker_up("a", "h");
+        s.worker_up("b", "h");
+        let t = s.add_trial(vec![0.0]);
+        assert_eq!(s.assign(t, "a", 1000), Some(1));
+        // Another worker, an attempt never issued, a trial never proposed.
+        assert_eq!(s.on_result(&result(t, "b", 9.0)), Disposition::NotIssued);
+        let mut r = result(t, "a", 9.0);
+        r.attempt = 2;
+        assert_eq!(s.on_result(&r), Disposition::NotIssued);
+        assert_eq!(s.on_result(&result(7, "a", 9.0)), Disposition::Unknown);
+        assert_eq!((s.errors.not_issued, s.errors.unknown_trial), (2, 1));
+        // Worker a still holds its trial; its own result completes it.
+        assert!(s.idle_workers() == ["b"]);
+        assert_eq!(s.on_result(&result(t, "a", 0.5)), Disposition::Completed);
+        assert_eq!(s.best.as_ref().unwrap().score, 0.5);
+    }
+
+    #[test]
+    fn trials_orphaned_by_the_metric_agent_are_requeued_when_it_is_back() {
+        let mut s = RunState::new(3);
+        s.worker_up("a", "h");
+        s.worker_up("b", "h");
+        let t1 = s.add_trial(vec![0.1]);
+        let t2 = s.add_trial(vec![0.2]);
+        s.assign(t1, "a", 10_000);
+        s.assign(t2, "b", 10_000);
+        let orphaned = s.running_trials();
+        assert_eq!(orphaned, [t1, t2]);
+        // Trial 2's result made it before the metric agent went away.
+        assert_eq!(s.on_result(&result(t2, "b", 0.5)), Disposition::Completed);
+        assert_eq!(s.requeue_orphaned(&orphaned), [t1]);
+        assert_eq!(s.idle_workers(), ["a", "b"]);
+        assert_eq!(s.assign(t1, "b", 20_000), Some(2));
+        // The first attempt's result, late, still counts.
+        assert_eq!(s.on_result(&result(t1, "a", 0.7)), Disposition::Completed);
+        assert_eq!(s.errors.reissued, 1);
     }
 
     #[test]

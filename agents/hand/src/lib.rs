@@ -154,6 +154,10 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
     loop {
         tokio::select! {
             Some(r) = objects.recv() => match r.message {
+                Ok(e) if e.run_id != *run => {
+                    bad += 1;
+                    tracing::warn!("hand {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
+                }
                 Ok(e) if config.object.is_none() && config.mesh.is_none() && world_name.as_deref() != Some(&e.object) => {
                     world = world_object(config, Some(&e)).map(Arc::new);
                     world_name = Some(e.object.clone());
@@ -169,7 +173,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
                     Ok(c) if c.run_id == *run && c.worker == config.id => c,
                     Ok(c) => {
                         bad += 1;
-                        tracing::warn!("hand {}: command for {}/{} ignored", config.id, c.run_id, c.worker);
+                        tracing::warn!("hand {}: command for {}/{} ignored ({bad} bad messages)", config.id, c.run_id, c.worker);
                         continue;
                     }
                     Err(e) => {
@@ -239,7 +243,7 @@ async fn run_replay(
             Ok(c) => {
                 bad += 1;
                 tracing::warn!(
-                    "hand {}: command for {}/{} ignored",
+                    "hand {}: command for {}/{} ignored ({bad} bad messages)",
                     config.id,
                     c.run_id,
                     c.worker

@@ -14,7 +14,9 @@ use std::sync::Arc;
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudReceiver};
 use graspopt_convert::{measured_from_clouds, metric_values, object_from_estimate};
-use graspopt_protocol::{AgentKind, ContactClouds, Encoding, ObjectEstimate, RunId, TrialResult};
+use graspopt_protocol::{
+    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, ObjectEstimate, RunId, TrialResult,
+};
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
 use graspopt_trial::measured::score_measured;
@@ -74,6 +76,30 @@ pub fn score_clouds(clouds: &ContactClouds, object: &Object, config: &MetricConf
     result
 }
 
+/// The failed result of an attempt whose clouds were invalid (a NaN, a normal that is not
+/// unit length): the error names the field.
+pub fn invalid_clouds_result(
+    about: &AttemptRef,
+    detail: &str,
+    scorer: &str,
+    transport: &str,
+) -> TrialResult {
+    TrialResult {
+        run_id: about.run_id.clone(),
+        trial_id: about.trial_id,
+        attempt: about.attempt,
+        worker: about.worker.clone(),
+        scorer: scorer.to_string(),
+        score: 0.0,
+        metrics: None,
+        contacts: 0,
+        fingers_in_contact: 0,
+        cloud_points: 0,
+        cloud_transport: transport.to_string(),
+        error: Some(format!("invalid contact clouds: {detail}")),
+    }
+}
+
 /// Scores clouds until the task is cancelled.
 pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Result<()> {
     config
@@ -105,7 +131,10 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                         }
                     }
                 }
-                Ok(_) => bad += 1,
+                Ok(e) => {
+                    bad += 1;
+                    tracing::warn!("metric {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
+                }
                 Err(e) => {
                     bad += 1;
                     tracing::warn!("metric {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
@@ -115,11 +144,22 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                 Ok(c) if c.run_id == *run => waiting.push_back((c, r.path.as_str())),
                 Ok(c) => {
                     bad += 1;
-                    tracing::warn!("metric {}: clouds of run {} ignored", config.id, c.run_id);
+                    tracing::warn!("metric {}: clouds of run {} ignored ({bad} bad messages)", config.id, c.run_id);
                 }
                 Err(e) => {
                     bad += 1;
                     tracing::warn!("metric {}: bad clouds via {} ({bad} bad messages): {e}", config.id, r.path.as_str());
+                    // Clouds that name an attempt of this run fail it with the reason, so
+                    // the trial does not wait for its lease (the coordinator accepts it only
+                    // from the worker the attempt was issued to).
+                    if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
+                        && a.run_id == *run
+                    {
+                        let failed = invalid_clouds_result(a, detail, &config.id, r.path.as_str());
+                        if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
+                            tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
+                        }
+                    }
                 }
             },
             else => return Ok(()),

@@ -138,6 +138,11 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
             Ok(r) if r.run_id == *run => r.clone(),
             Ok(r) => {
                 bad += 1;
+                tracing::warn!(
+                    "planner {}: request of run {} refused ({bad} bad messages)",
+                    config.id,
+                    r.run_id
+                );
                 let _ = incoming
                     .reply_error(&format!("this planner serves run {run}, not {}", r.run_id))
                     .await;

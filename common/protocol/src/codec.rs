@@ -75,6 +75,8 @@ pub enum DecodeError {
     Invalid {
         message_type: &'static str,
         detail: String,
+        /// The attempt the message reports on, when it names one.
+        about: Option<Box<crate::messages::AttemptRef>>,
     },
 }
 
@@ -191,6 +193,7 @@ pub fn decode<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<T, DecodeE
     msg.validate().map_err(|detail| DecodeError::Invalid {
         message_type,
         detail,
+        about: msg.attempt_ref().map(Box::new),
     })?;
     Ok(msg)
 }

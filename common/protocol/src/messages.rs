@@ -17,6 +17,21 @@ pub trait Message: Serialize + for<'de> Deserialize<'de> {
     fn run_id(&self) -> &RunId;
     /// Checks the content; the error names the field.
     fn validate(&self) -> Result<(), String>;
+    /// The trial attempt this message reports on, for messages that report on one (a hand's
+    /// clouds): an invalid one can then fail that attempt with the reason instead of
+    /// leaving it to its lease.
+    fn attempt_ref(&self) -> Option<AttemptRef> {
+        None
+    }
+}
+
+/// One attempt of one trial, as named by a message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AttemptRef {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    pub attempt: u32,
+    pub worker: String,
 }
 
 fn finite(field: &str, values: &[f64]) -> Result<(), String> {
@@ -187,6 +202,14 @@ impl Message for ContactClouds {
     const TYPE: &'static str = "ContactClouds";
     fn run_id(&self) -> &RunId {
         &self.run_id
+    }
+    fn attempt_ref(&self) -> Option<AttemptRef> {
+        Some(AttemptRef {
+            run_id: self.run_id.clone(),
+            trial_id: self.trial_id,
+            attempt: self.attempt,
+            worker: self.worker.clone(),
+        })
     }
     fn validate(&self) -> Result<(), String> {
         self.palm_pose.validate("palm_pose")?;
@@ -408,6 +431,8 @@ pub struct ErrorCounts {
     pub unknown_trial: u64,
     /// Second and later results for a completed trial.
     pub duplicates: u64,
+    /// Results naming a trial of this run with an attempt or worker it was never issued to.
+    pub not_issued: u64,
     /// Trials re-issued after a lost worker or an expired lease.
     pub reissued: u64,
     /// Trials that failed.

@@ -165,8 +165,8 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
     }
     let e = &s.errors;
     out.push(format!(
-        "errors: {} bad messages, {} unknown trials, {} duplicates, {} re-issued, {} failed",
-        e.bad_messages, e.unknown_trial, e.duplicates, e.reissued, e.failed
+        "errors: {} bad messages, {} unknown trials, {} not issued, {} duplicates, {} re-issued, {} failed",
+        e.bad_messages, e.unknown_trial, e.not_issued, e.duplicates, e.reissued, e.failed
     ));
     out
 }
