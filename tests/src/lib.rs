@@ -425,10 +425,14 @@ pub fn completed_now(path: &Path, run: &str) -> usize {
     if !path.exists() {
         return 0;
     }
-    graspopt_journal::Journal::open(path)
-        .and_then(|j| j.counts(run))
-        .map(|c| c.completed)
-        .unwrap_or(0)
+    let journal = graspopt_journal::Journal::open(path)
+        .unwrap_or_else(|e| panic!("journal {}: {e}", path.display()));
+    match journal.run(run) {
+        Ok(Some(_)) => journal.counts(run).map(|c| c.completed),
+        Ok(None) => Ok(0),
+        Err(e) => Err(e),
+    }
+    .unwrap_or_else(|e| panic!("journal {}: {e}", path.display()))
 }
 
 /// Waits until `pred` holds, polling every 20 ms; panics with `what` after `timeout`.

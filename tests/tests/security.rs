@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use graspopt_bus::{Bus, BusArgs, BusMode};
-use graspopt_e2e::{Cluster, check_journal, repo_root, report};
-use graspopt_protocol::{Encoding, RunId, TrialResult};
+use graspopt_e2e::{Cluster, check_journal, cloud_transport, repo_root, report};
+use graspopt_protocol::{AgentKind, Encoding, RunId, TrialResult};
 use serde_json::json;
 
 const TRIALS: u64 = 8;
@@ -64,10 +64,11 @@ fn forged(id: u64) -> TrialResult {
 fn only_authenticated_agents_in_their_roles_reach_the_journal() {
     let c = Cluster::start_with("secure", "sec", router_config);
     let role = |r: &str| secure(&format!("{r}.json5"));
+    // Clouds over Zenoh too (no shared memory), as between two hosts: the ACL sees them.
     let agent = |name: &str, r: &str, args: &[&str]| {
         let config = role(r);
         let mut v = args.to_vec();
-        v.extend_from_slice(&["--zenoh-config", config.to_str().unwrap()]);
+        v.extend_from_slice(&["--zenoh-config", config.to_str().unwrap(), "--no-shm"]);
         c.agent(name, &v)
     };
     let _perception = agent(
@@ -87,11 +88,11 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
         "cuboid",
         &TRIALS.to_string(),
         "4",
-        &["--zenoh-config", config.to_str().unwrap()],
+        &["--zenoh-config", config.to_str().unwrap(), "--no-shm"],
     );
     let run = RunId::new("sec").unwrap();
     let runtime = tokio::runtime::Runtime::new().unwrap();
-    let (refused, forged_sent, observed) = runtime.block_on(async {
+    let (refused, forged_sent, observed, posing) = runtime.block_on(async {
         // No credentials, and a wrong password: refused when connecting.
         let anonymous = Bus::open(&client(&c, None)).await;
         let wrong = c.dir.join("wrong.json5");
@@ -115,6 +116,11 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
             .subscribe::<TrialResult>(&run.result_key())
             .await
             .unwrap();
+        // A hand posing as a metric agent (the coordinator would issue trials to nobody).
+        let _posing = hand
+            .declare_alive(&run, AgentKind::Metric, "posing-metric")
+            .await
+            .unwrap();
         let mut sent = 0u64;
         let mut observed = 0u64;
         while observed < TRIALS {
@@ -136,7 +142,20 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
             }
             assert!(sent < 200_000, "the run does not progress");
         }
-        (refused, sent, observed)
+        let metrics: Vec<String> = watcher
+            .alive_now(&run.alive_kind_key(AgentKind::Metric))
+            .await
+            .unwrap()
+            .into_iter()
+            .map(|a| a.id)
+            .collect();
+        assert_eq!(
+            metrics,
+            ["metric"],
+            "metric agents the router lets others see"
+        );
+        let posing = metrics.iter().filter(|m| *m != "metric").count();
+        (refused, sent, observed, posing)
     });
     assert_eq!(
         refused,
@@ -157,9 +176,11 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
     );
     let trials = check_journal(&c.journal(), "sec", TRIALS as usize);
     assert!(trials.iter().all(|t| t.score.unwrap() < 1.0e6));
+    assert!(trials.iter().all(|t| cloud_transport(t) == "zenoh"));
     report(json!({
         "test": "security: user/password authentication and access control",
-        "refused_connections": 2, "forged_results_sent": forged_sent,
+        "refused_connections": refused.iter().filter(|r| **r).count(),
+        "forged_results_sent": forged_sent, "posing_liveliness_tokens_seen": posing,
         "forged_results_reaching_the_coordinator": reached, "real_results_seen_by_observer": observed,
         "trials": TRIALS,
     }));

@@ -274,7 +274,7 @@ impl Ctx<'_> {
             let Some(worker) = idle.next() else { break };
             let now = now_ms();
             let lease_until = now + self.config.lease_ms as i64;
-            let Some(attempt) = self.state.assign(trial_id, &worker, lease_until) else {
+            let Some(attempt) = self.state.assign(trial_id, &worker, now, lease_until) else {
                 continue;
             };
             let params = self.state.trials[&trial_id].params.clone();
@@ -367,8 +367,8 @@ impl Ctx<'_> {
         // A result must name an attempt issued to the worker it names: anything else (a
         // forged or corrupted message, a trial never proposed) is counted and never
         // reaches the journal.
-        if !self.state.was_issued(result) {
-            return Ok(self.state.on_result(result));
+        if !self.state.was_issued(result) || self.state.stale_failure(result) {
+            return Ok(self.state.on_result(result, now));
         }
         let already = matches!(
             self.state.trials[&result.trial_id].phase,
@@ -394,7 +394,7 @@ impl Ctx<'_> {
             }
         }
         // A duplicate is counted in the run's status and leaves the journal as it is.
-        Ok(self.state.on_result(result))
+        Ok(self.state.on_result(result, now))
     }
 }
 
@@ -410,7 +410,8 @@ pub async fn run(
 ) -> anyhow::Result<RunStatus> {
     let mut journal = Journal::open(&config.journal)
         .with_context(|| format!("cannot open the journal {}", config.journal.display()))?;
-    let (spec, state) = open_run(&mut journal, run, spec, resume)?;
+    let (spec, mut state) = open_run(&mut journal, run, spec, resume)?;
+    state.grace_ms = config.lease_ms as i64;
     let results = bus.subscribe::<TrialResult>(&run.result_key()).await?;
     let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
     let hands = bus
@@ -464,6 +465,7 @@ pub async fn run(
                         Disposition::Unknown => tracing::warn!("coordinator: result for unknown trial {}", result.trial_id),
                         Disposition::Duplicate => tracing::info!("coordinator: duplicate result for trial {}", result.trial_id),
                         Disposition::NotIssued => tracing::warn!("coordinator: result for trial {} attempt {} from {}, which was never issued that attempt", result.trial_id, result.attempt, result.worker),
+                        Disposition::StaleFailure => tracing::warn!("coordinator: attempt {} of trial {} failed, a later attempt is running: ignored", result.attempt, result.trial_id),
                         _ => {}
                     }
                     let s = status(run, &spec, &ctx.state, RunPhase::Running);
@@ -511,7 +513,7 @@ pub async fn run(
                         ctx.scorers.insert(key);
                         if was_empty {
                             let orphaned = std::mem::take(&mut ctx.orphaned);
-                            for t in ctx.state.requeue_orphaned(&orphaned) {
+                            for t in ctx.state.requeue_orphaned(&orphaned, now_ms()) {
                                 tracing::warn!("coordinator: trial {t} ran while no metric agent was alive: re-issuing");
                             }
                         }
@@ -549,4 +551,60 @@ pub async fn run(
         let _ = p.send(s.clone());
     }
     Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A coordinator restarted with `--resume` still accepts the late result of an attempt
+    /// issued before the restart (who got each attempt comes back from the journal's events).
+    #[test]
+    fn a_resumed_run_accepts_results_of_attempts_issued_before_the_restart() {
+        let mut journal = Journal::open_in_memory().unwrap();
+        let run = RunId::new("r").unwrap();
+        let spec = RunSpec {
+            object: "sphere".into(),
+            hand: "barrett".into(),
+            params: vec![ParamKind::Approach],
+            bounds: None,
+            trials: 2,
+            seed: 1,
+            method: PlannerMethod::Random,
+            initial: None,
+        };
+        open_run(&mut journal, &run, &spec, false).unwrap();
+        for (attempt, worker) in [(1, "a"), (2, "b")] {
+            journal
+                .record_issue(&TrialIssue {
+                    run_id: "r".into(),
+                    trial_id: 1,
+                    attempt,
+                    params: vec![0.01],
+                    worker: worker.into(),
+                    at_ms: 10 * attempt as i64,
+                    lease_until_ms: 1000,
+                    reason: None,
+                })
+                .unwrap();
+        }
+        let (_, mut state) = open_run(&mut journal, &run, &spec, true).unwrap();
+        let result = |attempt: u32, worker: &str| TrialResult {
+            run_id: run.clone(),
+            trial_id: 1,
+            attempt,
+            worker: worker.into(),
+            scorer: "m".into(),
+            score: 0.5,
+            metrics: None,
+            contacts: 1,
+            fingers_in_contact: 1,
+            cloud_points: 1,
+            cloud_transport: String::new(),
+            error: None,
+        };
+        assert!(!state.was_issued(&result(1, "b")));
+        assert!(state.was_issued(&result(2, "b")));
+        assert_eq!(state.on_result(&result(1, "a"), 0), Disposition::Completed);
+    }
 }

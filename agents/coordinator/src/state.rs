@@ -16,6 +16,7 @@ pub enum TrialPhase {
     /// Leased to a worker.
     Running {
         worker: String,
+        issued_ms: i64,
         lease_until_ms: i64,
     },
     Completed {
@@ -35,6 +36,13 @@ pub struct Trial {
     /// The worker each attempt was issued to: a result is accepted only from one of them.
     pub issued_to: BTreeMap<u32, String>,
     pub phase: TrialPhase,
+}
+
+/// The median of `values` (`None` when empty).
+fn median(values: &[i64]) -> Option<i64> {
+    let mut v = values.to_vec();
+    v.sort_unstable();
+    v.get(v.len() / 2).copied()
 }
 
 /// A live hand worker.
@@ -60,8 +68,11 @@ pub enum Disposition {
     /// No such trial in this run: ignored.
     Unknown,
     /// The trial exists, but no attempt of it was issued to the worker the result names:
-    /// ignored (a forged or corrupted result must not complete a trial).
+    /// ignored (a corrupted or stray result must not complete a trial).
     NotIssued,
+    /// A failure reported by an earlier attempt while a later one is still running: ignored
+    /// (the later attempt may well succeed).
+    StaleFailure,
 }
 
 /// The state of one run.
@@ -75,6 +86,11 @@ pub struct RunState {
     pub best: Option<BestTrial>,
     pub best_history: Vec<f64>,
     pub errors: ErrorCounts,
+    /// How long a worker that may still be executing a trial stays busy after the trial no
+    /// longer needs it (re-issued elsewhere, or completed by another attempt).
+    pub grace_ms: i64,
+    /// How long completed attempts took, issue to result (milliseconds).
+    pub trial_ms: Vec<i64>,
 }
 
 impl RunState {
@@ -156,8 +172,14 @@ impl RunState {
         id
     }
 
-    /// Leases a queued trial to an idle worker; returns the attempt number.
-    pub fn assign(&mut self, trial_id: u64, worker: &str, lease_until_ms: i64) -> Option<u32> {
+    /// Leases a queued trial to an idle worker at `now_ms`; returns the attempt number.
+    pub fn assign(
+        &mut self,
+        trial_id: u64,
+        worker: &str,
+        now_ms: i64,
+        lease_until_ms: i64,
+    ) -> Option<u32> {
         let w = self.workers.get_mut(worker)?;
         if w.trial.is_some() {
             return None;
@@ -170,6 +192,7 @@ impl RunState {
         t.issued_to.insert(t.attempts, worker.to_string());
         t.phase = TrialPhase::Running {
             worker: worker.to_string(),
+            issued_ms: now_ms,
             lease_until_ms,
         };
         w.trial = Some(trial_id);
@@ -186,32 +209,62 @@ impl RunState {
             .collect()
     }
 
-    /// A metric agent is back after none was alive: of `orphaned` (the trials that were
-    /// running when the last one vanished), those still running had their clouds sent to
-    /// nobody. They are queued again and their workers freed at once, rather than at the
-    /// end of their leases. A result that still arrives for the old attempt is accepted
-    /// (or counted as a duplicate) as usual. Returns the re-queued trials.
-    pub fn requeue_orphaned(&mut self, orphaned: &[u64]) -> Vec<u64> {
+    /// A metric agent is back after none was alive. The trials in `orphaned` (running when
+    /// the last one vanished) that are still running may have had their clouds sent to
+    /// nobody. Each worker is taken to be done with its trial twice a typical trial's
+    /// duration after it was issued (the median of the completed ones; the lease when none
+    /// has completed yet): a trial whose worker is done by now is queued again at once and
+    /// the worker freed; otherwise its lease is cut to that moment (and the worker freed
+    /// then), so a worker still executing it can still deliver it to the agent that is back.
+    /// Returns the trials queued again now.
+    pub fn requeue_orphaned(&mut self, orphaned: &[u64], now_ms: i64) -> Vec<u64> {
+        let typical = median(&self.trial_ms);
         let mut out = Vec::new();
         for id in orphaned {
             let Some(t) = self.trials.get_mut(id) else {
                 continue;
             };
-            if let TrialPhase::Running { worker, .. } = &t.phase {
-                if let Some(w) = self.workers.get_mut(worker)
-                    && w.trial == Some(*id)
-                {
+            let TrialPhase::Running {
+                worker,
+                issued_ms,
+                lease_until_ms,
+            } = &mut t.phase
+            else {
+                continue;
+            };
+            let done_by = typical.map_or(*lease_until_ms, |d| {
+                (*issued_ms + 2 * d).min(*lease_until_ms)
+            });
+            if let Some(w) = self.workers.get_mut(worker.as_str())
+                && w.trial == Some(*id)
+            {
+                w.release_at_ms = Some(done_by);
+                if done_by <= now_ms {
                     w.trial = None;
                     w.release_at_ms = None;
                 }
+            }
+            if done_by <= now_ms {
                 t.phase = TrialPhase::Queued {
                     reason: Some(format!("no metric agent scored the clouds of {worker}")),
                 };
                 out.push(*id);
+            } else {
+                *lease_until_ms = done_by;
             }
         }
         self.errors.reissued += out.len() as u64;
         out
+    }
+
+    /// Every worker but `except` still holding `trial` is freed after the grace (unless it
+    /// answers first).
+    fn release_holders(&mut self, trial: u64, except: Option<&str>, now_ms: i64) {
+        for (id, w) in self.workers.iter_mut() {
+            if w.trial == Some(trial) && except != Some(id.as_str()) && w.release_at_ms.is_none() {
+                w.release_at_ms = Some(now_ms + self.grace_ms);
+            }
+        }
     }
 
     /// Re-queues trials whose lease expired. The worker stays busy (it may be slow, not
@@ -224,13 +277,16 @@ impl RunState {
             if let TrialPhase::Running {
                 worker,
                 lease_until_ms,
+                ..
             } = &t.phase
                 && *lease_until_ms < now_ms
             {
                 if let Some(w) = self.workers.get_mut(worker)
                     && w.trial == Some(*id)
                 {
-                    w.release_at_ms = Some(now_ms + grace_ms);
+                    // An earlier release (an orphaned trial) stands.
+                    let at = now_ms + grace_ms;
+                    w.release_at_ms = Some(w.release_at_ms.map_or(at, |r| r.min(at)));
                 }
                 t.phase = TrialPhase::Queued {
                     reason: Some(format!("lease of worker {worker} expired")),
@@ -248,8 +304,9 @@ impl RunState {
         out
     }
 
-    /// Applies a result (already accepted by the journal when `Completed`/`Failed`).
-    pub fn on_result(&mut self, result: &TrialResult) -> Disposition {
+    /// Applies a result (already accepted by the journal when `Completed`/`Failed`) at
+    /// `now_ms`.
+    pub fn on_result(&mut self, result: &TrialResult, now_ms: i64) -> Disposition {
         if !self.was_issued(result) {
             if self.trials.contains_key(&result.trial_id) {
                 self.errors.not_issued += 1;
@@ -264,6 +321,12 @@ impl RunState {
             w.trial = None;
             w.release_at_ms = None;
         }
+        if self.stale_failure(result) {
+            return Disposition::StaleFailure;
+        }
+        // Other workers still on this trial (an earlier or later attempt) are freed after
+        // the grace: their result can only be a duplicate now.
+        self.release_holders(result.trial_id, Some(&result.worker), now_ms);
         let Some(t) = self.trials.get_mut(&result.trial_id) else {
             self.errors.unknown_trial += 1;
             return Disposition::Unknown;
@@ -280,6 +343,11 @@ impl RunState {
             self.errors.failed += 1;
             return Disposition::Failed;
         }
+        if let TrialPhase::Running { issued_ms, .. } = t.phase
+            && result.attempt == t.attempts
+        {
+            self.trial_ms.push(now_ms - issued_ms);
+        }
         t.phase = TrialPhase::Completed {
             score: result.score,
         };
@@ -291,6 +359,19 @@ impl RunState {
             result.metrics.map(|m| m.force_closure),
         );
         Disposition::Completed
+    }
+
+    /// Whether `result` is a failure of an earlier attempt of a trial whose later attempt is
+    /// issued and still open.
+    pub fn stale_failure(&self, result: &TrialResult) -> bool {
+        result.error.is_some()
+            && self.trials.get(&result.trial_id).is_some_and(|t| {
+                result.attempt < t.attempts
+                    && matches!(
+                        t.phase,
+                        TrialPhase::Running { .. } | TrialPhase::Queued { .. }
+                    )
+            })
     }
 
     /// Whether the trial the result names exists and the attempt it names was issued to the
@@ -406,20 +487,20 @@ mod tests {
         let t1 = s.add_trial(vec![0.1]);
         let t2 = s.add_trial(vec![0.2]);
         assert_eq!((t1, t2), (1, 2));
-        assert_eq!(s.assign(t1, "a", 100), Some(1));
-        assert_eq!(s.assign(t2, "b", 100), Some(1));
+        assert_eq!(s.assign(t1, "a", 0, 100), Some(1));
+        assert_eq!(s.assign(t2, "b", 0, 100), Some(1));
         assert_eq!(s.proposals_needed(), 0);
         // Worker a dies holding trial 1.
         assert_eq!(s.worker_down("a"), Some(1));
         assert_eq!(s.queued().len(), 1);
-        assert_eq!(s.on_result(&result(2, "b", 0.5)), Disposition::Completed);
+        assert_eq!(s.on_result(&result(2, "b", 0.5), 0), Disposition::Completed);
         assert_eq!(s.idle_workers(), vec!["b".to_string()]);
-        assert_eq!(s.assign(1, "b", 200), Some(2));
+        assert_eq!(s.assign(1, "b", 0, 200), Some(2));
         let mut r = result(1, "b", 0.7);
         r.attempt = 2;
-        assert_eq!(s.on_result(&r), Disposition::Completed);
+        assert_eq!(s.on_result(&r, 0), Disposition::Completed);
         r.score = 0.9;
-        assert_eq!(s.on_result(&r), Disposition::Duplicate);
+        assert_eq!(s.on_result(&r, 0), Disposition::Duplicate);
         assert!(s.finished());
         assert_eq!(s.completed(), 2);
         assert_eq!(s.errors.duplicates, 1);
@@ -433,14 +514,14 @@ mod tests {
         let mut s = RunState::new(1);
         s.worker_up("a", "h");
         let t = s.add_trial(vec![0.0]);
-        s.assign(t, "a", 1000);
+        s.assign(t, "a", 0, 1000);
         assert!(s.expire_leases(999, 500).is_empty());
         assert_eq!(s.expire_leases(1001, 500), vec![t]);
         assert!(s.idle_workers().is_empty());
         // The slow worker's late result still completes the trial.
-        assert_eq!(s.on_result(&result(t, "a", 1.0)), Disposition::Completed);
+        assert_eq!(s.on_result(&result(t, "a", 1.0), 0), Disposition::Completed);
         assert!(s.finished());
-        assert_eq!(s.on_result(&result(42, "a", 1.0)), Disposition::Unknown);
+        assert_eq!(s.on_result(&result(42, "a", 1.0), 0), Disposition::Unknown);
         assert_eq!(s.errors.unknown_trial, 1);
     }
 
@@ -449,7 +530,7 @@ mod tests {
         let mut s = RunState::new(1);
         s.worker_up("only", "h");
         let t = s.add_trial(vec![0.0]);
-        assert_eq!(s.assign(t, "only", 1000), Some(1));
+        assert_eq!(s.assign(t, "only", 0, 1000), Some(1));
         assert_eq!(s.expire_leases(1001, 500), vec![t]);
         // Still busy during the grace...
         assert!(s.expire_leases(1400, 500).is_empty());
@@ -457,8 +538,11 @@ mod tests {
         // ...then free: the lone worker takes its trial again (attempt 2).
         assert!(s.expire_leases(1502, 500).is_empty());
         assert_eq!(s.idle_workers(), ["only"]);
-        assert_eq!(s.assign(t, "only", 3000), Some(2));
-        assert_eq!(s.on_result(&result(t, "only", 0.5)), Disposition::Completed);
+        assert_eq!(s.assign(t, "only", 0, 3000), Some(2));
+        assert_eq!(
+            s.on_result(&result(t, "only", 0.5), 0),
+            Disposition::Completed
+        );
         assert!(s.finished());
     }
 
@@ -468,39 +552,94 @@ mod tests {
         s.worker_up("a", "h");
         s.worker_up("b", "h");
         let t = s.add_trial(vec![0.0]);
-        assert_eq!(s.assign(t, "a", 1000), Some(1));
+        assert_eq!(s.assign(t, "a", 0, 1000), Some(1));
         // Another worker, an attempt never issued, a trial never proposed.
-        assert_eq!(s.on_result(&result(t, "b", 9.0)), Disposition::NotIssued);
+        assert_eq!(s.on_result(&result(t, "b", 9.0), 0), Disposition::NotIssued);
         let mut r = result(t, "a", 9.0);
         r.attempt = 2;
-        assert_eq!(s.on_result(&r), Disposition::NotIssued);
-        assert_eq!(s.on_result(&result(7, "a", 9.0)), Disposition::Unknown);
+        assert_eq!(s.on_result(&r, 0), Disposition::NotIssued);
+        assert_eq!(s.on_result(&result(7, "a", 9.0), 0), Disposition::Unknown);
         assert_eq!((s.errors.not_issued, s.errors.unknown_trial), (2, 1));
         // Worker a still holds its trial; its own result completes it.
         assert!(s.idle_workers() == ["b"]);
-        assert_eq!(s.on_result(&result(t, "a", 0.5)), Disposition::Completed);
+        assert_eq!(s.on_result(&result(t, "a", 0.5), 0), Disposition::Completed);
         assert_eq!(s.best.as_ref().unwrap().score, 0.5);
     }
 
     #[test]
     fn trials_orphaned_by_the_metric_agent_are_requeued_when_it_is_back() {
-        let mut s = RunState::new(3);
+        let mut s = RunState::new(4);
+        s.grace_ms = 60_000;
         s.worker_up("a", "h");
         s.worker_up("b", "h");
+        s.worker_up("c", "h");
+        // One trial took 100 ms: a typical trial.
+        let t0 = s.add_trial(vec![0.0]);
+        s.assign(t0, "c", 0, 60_000);
+        assert_eq!(
+            s.on_result(&result(t0, "c", 0.1), 100),
+            Disposition::Completed
+        );
         let t1 = s.add_trial(vec![0.1]);
         let t2 = s.add_trial(vec![0.2]);
-        s.assign(t1, "a", 10_000);
-        s.assign(t2, "b", 10_000);
+        let t3 = s.add_trial(vec![0.3]);
+        s.assign(t1, "a", 1000, 61_000);
+        s.assign(t2, "b", 1000, 61_000);
+        s.assign(t3, "c", 1150, 61_150);
         let orphaned = s.running_trials();
-        assert_eq!(orphaned, [t1, t2]);
+        assert_eq!(orphaned, [t1, t2, t3]);
         // Trial 2's result made it before the metric agent went away.
-        assert_eq!(s.on_result(&result(t2, "b", 0.5)), Disposition::Completed);
-        assert_eq!(s.requeue_orphaned(&orphaned), [t1]);
+        assert_eq!(
+            s.on_result(&result(t2, "b", 0.5), 1100),
+            Disposition::Completed
+        );
+        // Back at 1250: a is done with trial 1 (issued at 1000, 2 x 100 ms); c may still be
+        // executing trial 3 until 1350.
+        assert_eq!(s.requeue_orphaned(&orphaned, 1250), [t1]);
         assert_eq!(s.idle_workers(), ["a", "b"]);
-        assert_eq!(s.assign(t1, "b", 20_000), Some(2));
+        assert!(s.expire_leases(1300, 60_000).is_empty());
+        assert_eq!(s.expire_leases(1351, 60_000), [t3]);
+        assert_eq!(s.idle_workers(), ["a", "b", "c"]);
+        assert_eq!(s.assign(t1, "b", 1400, 61_400), Some(2));
         // The first attempt's result, late, still counts.
-        assert_eq!(s.on_result(&result(t1, "a", 0.7)), Disposition::Completed);
-        assert_eq!(s.errors.reissued, 1);
+        assert_eq!(
+            s.on_result(&result(t1, "a", 0.7), 1500),
+            Disposition::Completed
+        );
+        assert_eq!(s.errors.reissued, 2);
+    }
+
+    #[test]
+    fn a_late_failure_does_not_beat_a_live_attempt_and_other_holders_are_freed() {
+        let mut s = RunState::new(1);
+        s.grace_ms = 100;
+        s.worker_up("a", "h");
+        s.worker_up("b", "h");
+        let t = s.add_trial(vec![0.0]);
+        s.assign(t, "a", 0, 1000);
+        assert_eq!(s.expire_leases(1001, 100), vec![t]);
+        assert_eq!(s.assign(t, "b", 0, 5000), Some(2));
+        // Attempt 1 reports a failure late: ignored, a is free again, b goes on.
+        let mut late = result(t, "a", 0.0);
+        late.error = Some("invalid contact clouds".into());
+        assert_eq!(s.on_result(&late, 1050), Disposition::StaleFailure);
+        assert_eq!(s.idle_workers(), ["a"]);
+        // Attempt 1 succeeding instead would complete the trial, and b, which can only
+        // produce a duplicate now, is freed after the grace.
+        let mut s2 = s.clone();
+        assert_eq!(
+            s2.on_result(&result(t, "a", 0.4), 1060),
+            Disposition::Completed
+        );
+        assert!(s2.expire_leases(1100, 100).is_empty());
+        assert_eq!(s2.idle_workers(), ["a"]);
+        s2.expire_leases(1161, 100);
+        assert_eq!(s2.idle_workers(), ["a", "b"]);
+        // In s, b's own result completes the trial.
+        let mut r = result(t, "b", 0.6);
+        r.attempt = 2;
+        assert_eq!(s.on_result(&r, 1100), Disposition::Completed);
+        assert_eq!(s.errors.failed, 0);
     }
 
     #[test]
@@ -508,10 +647,10 @@ mod tests {
         let mut s = RunState::new(1);
         s.worker_up("a", "h");
         let t = s.add_trial(vec![0.0]);
-        s.assign(t, "a", 10);
+        s.assign(t, "a", 0, 10);
         let mut r = result(t, "a", 0.0);
         r.error = Some("unreachable".into());
-        assert_eq!(s.on_result(&r), Disposition::Failed);
+        assert_eq!(s.on_result(&r, 0), Disposition::Failed);
         assert!(s.finished());
         assert!(s.observations.is_empty());
     }

@@ -185,9 +185,19 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
                 // Wait for the world's object if perception has not spoken yet.
                 while world.is_none() {
                     match objects.recv().await {
-                        Some(r) => if let Ok(e) = r.message {
-                            world = world_object(config, Some(&e)).map(Arc::new);
-                            world_name = Some(e.object.clone());
+                        Some(r) => match r.message {
+                            Ok(e) if e.run_id == *run => {
+                                world = world_object(config, Some(&e)).map(Arc::new);
+                                world_name = Some(e.object.clone());
+                            }
+                            Ok(e) => {
+                                bad += 1;
+                                tracing::warn!("hand {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
+                            }
+                            Err(e) => {
+                                bad += 1;
+                                tracing::warn!("hand {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
+                            }
                         },
                         None => return Ok(()),
                     }

@@ -50,10 +50,12 @@ fn check_chunk(what: &'static str, value: &str) -> Result<(), KeyError> {
     if ok {
         Ok(())
     } else {
-        Err(KeyError {
-            what,
-            value: value.to_string(),
-        })
+        // The value goes into error messages and logs: at most 80 characters of it.
+        let shown: String = match value.char_indices().nth(80) {
+            Some((cut, _)) => format!("{}...", &value[..cut]),
+            None => value.to_string(),
+        };
+        Err(KeyError { what, value: shown })
     }
 }
 
@@ -250,7 +252,9 @@ pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
         [root, run, "alive", kind, host, id, "json"] => (root, run, kind, host, id, Encoding::Json),
         _ => return None,
     };
-    if *root != ROOT {
+    // Host and id become parts of other keys (a worker's command key): a token whose host
+    // or id is not a valid chunk (a `*`, say) is not an agent.
+    if *root != ROOT || check_chunk("host", host).is_err() || check_agent_id(id).is_err() {
         return None;
     }
     Some(AliveKey {
@@ -375,6 +379,8 @@ mod tests {
             ("hand-1", Encoding::Json)
         );
         assert!(parse_alive_key(&format!("{key}/xml")).is_none());
+        assert!(parse_alive_key("graspopt/r/alive/hand/h/*").is_none());
+        assert!(parse_alive_key("graspopt/r/alive/hand/**/h1").is_none());
     }
 
     #[test]

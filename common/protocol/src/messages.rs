@@ -212,6 +212,7 @@ impl Message for ContactClouds {
         })
     }
     fn validate(&self) -> Result<(), String> {
+        crate::keys::check_agent_id(&self.worker).map_err(|e| format!("worker: {e}"))?;
         self.palm_pose.validate("palm_pose")?;
         if let Some(g) = self.min_gap
             && !(g.is_finite() && g >= 0.0)
@@ -283,6 +284,7 @@ impl Message for TrialResult {
         &self.run_id
     }
     fn validate(&self) -> Result<(), String> {
+        crate::keys::check_agent_id(&self.worker).map_err(|e| format!("worker: {e}"))?;
         if self.error.is_none() {
             finite("score", &[self.score])?;
         }

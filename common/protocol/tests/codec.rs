@@ -129,7 +129,7 @@ fn bincode_payload_starts_with_the_wire_version() {
 #[test]
 fn a_hand_written_json_result_decodes() {
     // What an agent in another language writes, from docs/protocol.md.
-    let text = r#"{"wire": 1, "run_id": "run-1", "trial_id": 4, "attempt": 1,
+    let text = r#"{"wire": 2, "run_id": "run-1", "trial_id": 4, "attempt": 1,
         "worker": "py-hand", "scorer": "py", "score": -2.5, "metrics": null,
         "contacts": 0, "fingers_in_contact": 0, "cloud_points": 0, "cloud_transport": "",
         "error": null}"#;
@@ -148,10 +148,10 @@ fn wrong_version_is_refused_by_name() {
         "{e}"
     );
     assert!(e.to_string().contains("TrialResult"));
-    let text = r#"{"wire": 2, "run_id": "r"}"#;
+    let text = r#"{"wire": 1, "run_id": "r"}"#;
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(
-        matches!(e, DecodeError::WrongVersion { found: 2, .. }),
+        matches!(e, DecodeError::WrongVersion { found: 1, .. }),
         "{e}"
     );
 }
@@ -209,7 +209,7 @@ fn invalid_content_is_refused_naming_the_field() {
         .unwrap_err();
     assert!(e.to_string().contains("score"), "{e}");
 
-    let text = r#"{"wire": 1, "run_id": "a/b", "trial_id": 4}"#;
+    let text = r#"{"wire": 2, "run_id": "a/b", "trial_id": 4}"#;
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
 }

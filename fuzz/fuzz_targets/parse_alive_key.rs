@@ -1,0 +1,39 @@
+//! Key expressions from the network, as UTF-8 text (other inputs are skipped: Zenoh keys are
+//! strings): liveliness tokens (`parse_alive_key`), topic keys (`Topic::classify`), and
+//! `sanitize_chunk` / `Encoding::from_mime` on the same text.
+//!
+//! Checks: never panics; a parsed liveliness token or topic key is rebuilt, by the key
+//! builders of the run it names, into exactly the input; `sanitize_chunk` always gives a
+//! valid key chunk.
+#![no_main]
+
+use graspopt_protocol::keys::{check_agent_id, parse_alive_key, sanitize_chunk};
+use graspopt_protocol::{Encoding, RunId, Topic};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(key) = std::str::from_utf8(data) else {
+        return;
+    };
+    if let Some(alive) = parse_alive_key(key) {
+        let mut rebuilt = alive.run.alive_key(alive.kind, &alive.host, &alive.id);
+        if alive.encoding == Encoding::Json {
+            rebuilt.push_str("/json");
+        }
+        assert_eq!(rebuilt, key, "{alive:?}");
+    }
+    if let Some((run, topic)) = Topic::classify(key) {
+        let rebuilt = match topic {
+            Topic::Object => run.object_key(),
+            Topic::Command => run.command_key(key.split('/').nth(3).unwrap_or_default()),
+            Topic::Clouds => run.clouds_key(),
+            Topic::Result => run.result_key(),
+            Topic::Status => run.status_key(),
+        };
+        assert_eq!(rebuilt, key, "{topic:?}");
+    }
+    let chunk = sanitize_chunk(key);
+    assert!(check_agent_id(&chunk).is_ok(), "{key:?} sanitized to {chunk:?}");
+    assert!(RunId::new(&chunk).is_ok(), "{key:?} sanitized to {chunk:?}");
+    let _ = Encoding::from_mime(key);
+});
