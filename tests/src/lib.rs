@@ -291,6 +291,19 @@ impl Cluster {
         serde_json::from_str(stdout.trim()).unwrap()
     }
 
+    /// Flags of an in-test client of this cluster's router (no shared memory, no
+    /// scouting), with a Zenoh configuration file if given.
+    pub fn client_args(&self, zenoh_config: Option<PathBuf>) -> graspopt_bus::BusArgs {
+        graspopt_bus::BusArgs {
+            connect: vec![self.endpoint.clone()],
+            mode: Some(graspopt_bus::BusMode::Client),
+            zenoh_config,
+            no_multicast_scouting: true,
+            no_shm: true,
+            ..Default::default()
+        }
+    }
+
     /// The log of one of this cluster's processes.
     pub fn log(&self, name: &str) -> String {
         log(&self.dir, name)

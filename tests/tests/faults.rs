@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use graspopt_bus::{Bus, BusArgs, BusMode, CongestionControl};
+use graspopt_bus::{Bus, CongestionControl};
 use graspopt_e2e::{Cluster, check_journal, lost_and_recorded_twice, report, signal};
 use graspopt_journal::{Journal, TrialState};
 use graspopt_protocol::{
@@ -159,15 +159,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     let run = RunId::new("bad").unwrap();
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let first: TrialResult = runtime.block_on(async {
-        let bus = Bus::open(&BusArgs {
-            connect: vec![c.endpoint.clone()],
-            mode: Some(BusMode::Client),
-            no_multicast_scouting: true,
-            no_shm: true,
-            ..Default::default()
-        })
-        .await
-        .unwrap();
+        let bus = Bus::open(&c.client_args(None)).await.unwrap();
         let results = bus
             .subscribe::<TrialResult>(&run.result_key())
             .await

@@ -10,7 +10,7 @@
 
 use std::time::Duration;
 
-use graspopt_bus::{Bus, BusArgs, BusMode, CongestionControl, zenoh_encoding};
+use graspopt_bus::{Bus, CongestionControl, zenoh_encoding};
 use graspopt_e2e::{Cluster, check_journal, report, wait_until};
 use graspopt_journal::TrialRow;
 use graspopt_protocol::{
@@ -247,15 +247,7 @@ fn send_noise(c: &Cluster) -> Sent {
     let (result, object, clouds, command, suggest) = templates();
     let runtime = tokio::runtime::Runtime::new().unwrap();
     runtime.block_on(async {
-        let bus = Bus::open(&BusArgs {
-            connect: vec![c.endpoint.clone()],
-            mode: Some(BusMode::Client),
-            no_multicast_scouting: true,
-            no_shm: true,
-            ..Default::default()
-        })
-        .await
-        .unwrap();
+        let bus = Bus::open(&c.client_args(None)).await.unwrap();
         // Start once the run is under way (the first trial has been issued).
         let results = bus
             .subscribe::<TrialResult>(&run.result_key())

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
-use graspopt_bus::{Bus, BusArgs, BusMode};
+use graspopt_bus::Bus;
 use graspopt_e2e::{
     Cluster, check_journal, cloud_transport, completed_now, lost_and_recorded_twice, report,
     wait_until,
@@ -356,15 +356,7 @@ fn degenerate_contacts_never_leave_a_trial_stuck() {
     let started = Instant::now();
     // The hand stays alive (bus and token kept) until the run is over.
     let (expected, _hand) = runtime.block_on(async {
-        let bus = Bus::open(&BusArgs {
-            connect: vec![c.endpoint.clone()],
-            mode: Some(BusMode::Client),
-            no_multicast_scouting: true,
-            no_shm: true,
-            ..Default::default()
-        })
-        .await
-        .unwrap();
+        let bus = Bus::open(&c.client_args(None)).await.unwrap();
         let commands = bus
             .subscribe::<TrialCommand>(&run.command_key("hand-x"))
             .await

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use graspopt_bus::{Bus, BusArgs, BusMode};
+use graspopt_bus::Bus;
 use graspopt_e2e::{Cluster, check_journal, cloud_transport, repo_root, report};
 use graspopt_protocol::{AgentKind, Encoding, RunId, TrialResult};
 use serde_json::json;
@@ -28,17 +28,6 @@ fn router_config(dir: &Path) -> Vec<String> {
     let path = dir.join("router.json5");
     std::fs::write(&path, text.replace(relative, absolute.to_str().unwrap())).unwrap();
     vec!["--zenoh-config".into(), path.to_str().unwrap().into()]
-}
-
-fn client(c: &Cluster, config: Option<PathBuf>) -> BusArgs {
-    BusArgs {
-        connect: vec![c.endpoint.clone()],
-        mode: Some(BusMode::Client),
-        zenoh_config: config,
-        no_multicast_scouting: true,
-        no_shm: true,
-        ..Default::default()
-    }
 }
 
 /// A result that the coordinator would take for trial `id` from `hand-1`, the only worker,
@@ -94,24 +83,24 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let (refused, forged_sent, observed, posing) = runtime.block_on(async {
         // No credentials, and a wrong password: refused when connecting.
-        let anonymous = Bus::open(&client(&c, None)).await;
+        let anonymous = Bus::open(&c.client_args(None)).await;
         let wrong = c.dir.join("wrong.json5");
         let text = std::fs::read_to_string(role("hand")).unwrap();
         std::fs::write(&wrong, text.replace("change-me-hand", "guess")).unwrap();
-        let guessed = Bus::open(&client(&c, Some(wrong))).await;
+        let guessed = Bus::open(&c.client_args(Some(wrong))).await;
         let refused = [anonymous.is_err(), guessed.is_err()];
 
         // An observer may watch the results, and a hand may publish clouds; neither may
         // publish a result. Both try, for every trial, all through the run.
         // (The watcher is a session of its own: a session delivers its own puts to its own
         // subscribers without the router.)
-        let watcher = Bus::open(&client(&c, Some(role("observer"))))
+        let watcher = Bus::open(&c.client_args(Some(role("observer"))))
             .await
             .unwrap();
-        let observer = Bus::open(&client(&c, Some(role("observer"))))
+        let observer = Bus::open(&c.client_args(Some(role("observer"))))
             .await
             .unwrap();
-        let hand = Bus::open(&client(&c, Some(role("hand")))).await.unwrap();
+        let hand = Bus::open(&c.client_args(Some(role("hand")))).await.unwrap();
         let results = watcher
             .subscribe::<TrialResult>(&run.result_key())
             .await

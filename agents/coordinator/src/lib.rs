@@ -590,18 +590,8 @@ mod tests {
         }
         let (_, mut state) = open_run(&mut journal, &run, &spec, true).unwrap();
         let result = |attempt: u32, worker: &str| TrialResult {
-            run_id: run.clone(),
-            trial_id: 1,
             attempt,
-            worker: worker.into(),
-            scorer: "m".into(),
-            score: 0.5,
-            metrics: None,
-            contacts: 1,
-            fingers_in_contact: 1,
-            cloud_points: 1,
-            cloud_transport: String::new(),
-            error: None,
+            ..crate::state::tests::result(1, worker, 0.5)
         };
         assert!(!state.was_issued(&result(1, "b")));
         assert!(state.was_issued(&result(2, "b")));

@@ -457,11 +457,12 @@ impl RunState {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use graspopt_protocol::RunId;
 
-    fn result(trial_id: u64, worker: &str, score: f64) -> TrialResult {
+    /// A result of attempt 1 of run `r`.
+    pub(crate) fn result(trial_id: u64, worker: &str, score: f64) -> TrialResult {
         TrialResult {
             run_id: RunId::new("r").unwrap(),
             trial_id,
