@@ -18,6 +18,9 @@ fn optimizer_with_100_observations(warm_rounds: usize) -> Optimizer {
     let f = TestFunction::Hartmann6;
     let mut s = recommended_settings();
     s.minimize = true;
+    // 100 random observations look like a stagnating search: without this the restart rule
+    // would start a new epoch and the rounds would model 6 points instead of 100.
+    s.restart = None;
     let bounds = vec![(0.0, 1.0); 6];
     let mut opt = match Optimizer::new(&bounds, s, 1) {
         Ok(o) => o,

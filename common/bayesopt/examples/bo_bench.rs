@@ -86,6 +86,16 @@ fn main() {
             _ => graspopt_bayesopt::OutputTransform::None,
         };
     }
+    if let Some(v) = env("BO_RESTART") {
+        // window,tol,init,tabu_radius (anything else: off)
+        let p: Vec<f64> = v.split(',').filter_map(|t| t.parse().ok()).collect();
+        settings.restart = (p.len() == 4).then(|| graspopt_bayesopt::RestartRule {
+            window: p[0] as usize,
+            tol: p[1],
+            init: p[2] as usize,
+            tabu_radius: p[3],
+        });
+    }
     if let Some(b) = env("BO_BATCH") {
         settings.batch = match b.as_str() {
             "clmin" => graspopt_bayesopt::BatchStrategy::ConstantLiarMin,

@@ -13,6 +13,8 @@ fn main() {
     let f = TestFunction::Hartmann6;
     let mut s = recommended_settings();
     s.minimize = true;
+    // keep the 100-observation model (the restart rule would start a new, small epoch)
+    s.restart = None;
     if let Some(v) = std::env::var("OV_FIT").ok().and_then(|v| v.parse().ok()) {
         s.fit.max_iter = v;
         s.fit.warm_max_iter = v;

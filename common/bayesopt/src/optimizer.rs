@@ -62,6 +62,24 @@ impl Default for StopRule {
     }
 }
 
+/// Restart of a stagnating search (trust-region-style): once the best value of the current
+/// epoch has not improved by more than `tol` times the epoch's observed range over its last
+/// `window` observations, a new epoch starts with `init` random points and a model of the new
+/// epoch's observations only, and the acquisition is penalised inside a ball of radius
+/// `tabu_radius * sqrt(d)` (unit cube) around the incumbent of every earlier epoch, so the
+/// search looks for another basin instead of polishing the old one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RestartRule {
+    /// Observations without significant improvement before restarting (>= 1).
+    pub window: usize,
+    /// Significant improvement, as a fraction of the epoch's observed range of y.
+    pub tol: f64,
+    /// Random points at the start of each new epoch (>= 2).
+    pub init: usize,
+    /// Radius of the balls around earlier incumbents, as a fraction of `sqrt(d)`.
+    pub tabu_radius: f64,
+}
+
 /// Why the optimizer says to stop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum StopReason {
@@ -115,6 +133,9 @@ pub struct Settings {
     pub diversify_depth: usize,
     /// Monotone transform of the outputs applied before standardising.
     pub output_transform: OutputTransform,
+    /// Restart of a stagnating search (None: off). See [`RestartRule`].
+    #[serde(default)]
+    pub restart: Option<RestartRule>,
     /// Stopping rule.
     pub stop: StopRule,
 }
@@ -138,6 +159,7 @@ impl Default for Settings {
             diversify_every: 0,
             diversify_depth: 1,
             explore_below_ei: None,
+            restart: None,
             stop: StopRule::default(),
         }
     }
@@ -168,6 +190,16 @@ impl Settings {
             return Err(BoError::InvalidSetting(format!(
                 "UCB beta must be > 0, got {beta}"
             )));
+        }
+        if let Some(r) = self.restart
+            && !(r.tol >= 0.0
+                && r.tol.is_finite()
+                && r.tabu_radius >= 0.0
+                && r.tabu_radius.is_finite())
+        {
+            return Err(BoError::InvalidSetting(
+                "restart tol and tabu_radius must be finite and >= 0".into(),
+            ));
         }
         if self.stop.relative_ei_threshold.is_nan() || self.stop.relative_ei_threshold < 0.0 {
             return Err(BoError::InvalidSetting(
@@ -208,6 +240,12 @@ pub struct Optimizer {
     rounds: usize,
     low_ei_streak: usize,
     last_round: RoundInfo,
+    /// First observation of the current epoch (see [`RestartRule`]).
+    #[serde(default)]
+    epoch_start: usize,
+    /// Incumbents (unit cube) of earlier epochs.
+    #[serde(default)]
+    tabu: Vec<Vec<f64>>,
 }
 
 struct Standardised {
@@ -398,6 +436,8 @@ impl Optimizer {
             rounds: 0,
             low_ei_streak: 0,
             last_round: RoundInfo::default(),
+            epoch_start: 0,
+            tabu: Vec::new(),
         })
     }
 
@@ -459,6 +499,17 @@ impl Optimizer {
         self.hyper.as_ref()
     }
 
+    /// Number of restarts so far (see [`RestartRule`]); the model uses the observations
+    /// from index [`Optimizer::epoch_start`] on.
+    pub fn restarts(&self) -> usize {
+        self.tabu.len()
+    }
+
+    /// First observation of the current epoch (0 before any restart).
+    pub fn epoch_start(&self) -> usize {
+        self.epoch_start
+    }
+
     /// Diagnostics of the last proposal round.
     pub fn last_round(&self) -> &RoundInfo {
         &self.last_round
@@ -483,6 +534,27 @@ impl Optimizer {
             }
         }
         best.map(|i| (self.xs[i].clone(), self.ys[i]))
+    }
+
+    /// Whether the current epoch stagnates under `rule` (after its initial design).
+    fn epoch_stagnates(&self, rule: &RestartRule) -> bool {
+        let from = self.epoch_start.min(self.ys.len());
+        let ys = &self.ys[from..];
+        let init = if from > 0 {
+            rule.init.max(2)
+        } else {
+            self.n_init()
+        };
+        let w = rule.window.max(1);
+        if ys.len() < init + w {
+            return false;
+        }
+        let sign = if self.settings.minimize { -1.0 } else { 1.0 };
+        let best_of = |v: &[f64]| v.iter().map(|y| sign * y).fold(f64::NEG_INFINITY, f64::max);
+        let now = best_of(ys);
+        let before = best_of(&ys[..ys.len() - w]);
+        let lo = ys.iter().map(|y| sign * y).fold(f64::INFINITY, f64::min);
+        now - before <= rule.tol * (now - lo)
     }
 
     fn n_init(&self) -> usize {
@@ -568,7 +640,8 @@ impl Optimizer {
 
     fn standardised(&self) -> Standardised {
         let sign = if self.settings.minimize { -1.0 } else { 1.0 };
-        let mut y: Vec<f64> = self.ys.iter().map(|v| sign * v).collect();
+        let from = self.epoch_start.min(self.ys.len());
+        let mut y: Vec<f64> = self.ys[from..].iter().map(|v| sign * v).collect();
         let warp = match self.settings.output_transform {
             OutputTransform::None => None,
             OutputTransform::TailLog => TailWarp::fit(&y).map(Warp::Tail),
@@ -595,7 +668,7 @@ impl Optimizer {
             1.0
         };
         Standardised {
-            x: self.xs.iter().map(|p| self.to_unit(p)).collect(),
+            x: self.xs[from..].iter().map(|p| self.to_unit(p)).collect(),
             y: y.iter().map(|v| (v - mean) / std).collect(),
             mean,
             std,
@@ -662,9 +735,26 @@ impl Optimizer {
         let d = self.dim();
         let mut out: Vec<Vec<f64>> = Vec::with_capacity(q);
         let mut info = RoundInfo::default();
+        if let Some(rule) = self.settings.restart
+            && self.epoch_stagnates(&rule)
+        {
+            let sign = if self.settings.minimize { -1.0 } else { 1.0 };
+            let from = self.epoch_start;
+            if let Some(i) = (from..self.ys.len())
+                .max_by(|a, b| (sign * self.ys[*a]).total_cmp(&(sign * self.ys[*b])))
+            {
+                self.tabu.push(self.to_unit(&self.xs[i]));
+            }
+            self.epoch_start = self.ys.len();
+        }
+        let epoch_init = match self.settings.restart {
+            Some(rule) if self.epoch_start > 0 => rule.init.max(2),
+            _ => self.n_init(),
+        };
+        let epoch_len = self.xs.len() - self.epoch_start.min(self.xs.len());
         // Initial design (and fallback while fewer than 2 observations exist).
         while out.len() < q
-            && (self.xs.len() + self.pending.len() + out.len() < self.n_init() || self.xs.len() < 2)
+            && (epoch_len + self.pending.len() + out.len() < epoch_init || epoch_len < 2)
         {
             let u = self.rng.unit_point(d);
             out.push(self.unit_to_box(&u));
@@ -802,14 +892,41 @@ impl Optimizer {
         let lo = vec![0.0; d];
         let hi = vec![1.0; d];
         let acq = self.settings.acquisition;
+        // Penalty (and its gradient) inside the balls around earlier epochs' incumbents:
+        // linear in the squared distance, steep enough to dominate the acquisition.
+        let radius = self
+            .settings
+            .restart
+            .map_or(0.0, |r| r.tabu_radius * (d as f64).sqrt());
+        let r2 = radius * radius;
+        let penalty = |u: &[f64], mut g: Option<&mut [f64]>| -> f64 {
+            let mut p = 0.0;
+            if r2 <= 0.0 {
+                return p;
+            }
+            let k = 1e3 / r2;
+            for c in &self.tabu {
+                let d2: f64 = u.iter().zip(c).map(|(a, b)| (a - b) * (a - b)).sum();
+                if d2 < r2 {
+                    p -= k * (r2 - d2);
+                    if let Some(g) = g.as_deref_mut() {
+                        for ((gi, a), b) in g.iter_mut().zip(u).zip(c) {
+                            *gi += 2.0 * k * (a - b);
+                        }
+                    }
+                }
+            }
+            p
+        };
         let value = |u: &[f64]| -> f64 {
             let (m, v) = gp.predict(u);
-            match acq {
+            let a = match acq {
                 AcquisitionKind::ExpectedImprovement => {
                     log_expected_improvement(m, v, incumbent, xi)
                 }
                 AcquisitionKind::Ucb { beta } => acquisition::ucb(m, v, beta),
-            }
+            };
+            a + penalty(u, None)
         };
         let ds = DirectSettings {
             max_evals: ((self.settings.direct_evals_per_dim * d) as f64 * budget_share)
@@ -826,14 +943,15 @@ impl Optimizer {
                 let (u, v) = direct::polish(
                     |u, g| {
                         let (m, var) = gp.predict_with_grad(u, &mut dm, &mut dv);
-                        match acq {
+                        let a = match acq {
                             AcquisitionKind::ExpectedImprovement => {
                                 acquisition::log_ei_with_grad(m, var, &dm, &dv, incumbent, xi, g)
                             }
                             AcquisitionKind::Ucb { beta } => {
                                 acquisition::ucb_with_grad(m, var, &dm, &dv, beta, g)
                             }
-                        }
+                        };
+                        a + penalty(u, Some(g))
                     },
                     start,
                     &lo,

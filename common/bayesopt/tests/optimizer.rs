@@ -73,6 +73,39 @@ fn serde_round_trip_continues_identically() {
 }
 
 #[test]
+fn restarts_round_trip_and_continue_identically() {
+    let s = Settings {
+        restart: Some(graspopt_bayesopt::RestartRule {
+            window: 2,
+            tol: 1.0,
+            init: 2,
+            tabu_radius: 0.1,
+        }),
+        ..fast_settings()
+    };
+    let mut a = Optimizer::new(&branin_bounds(), s, 11).unwrap();
+    for _ in 0..14 {
+        step(&mut a, 1);
+    }
+    assert!(a.restarts() >= 1, "tol = 1 must restart");
+    assert!(a.epoch_start() > 0 && a.epoch_start() <= a.len());
+    let json = serde_json::to_string(&a).unwrap();
+    let mut b: Optimizer = serde_json::from_str(&json).unwrap();
+    assert_eq!(a, b);
+    for _ in 0..5 {
+        assert_eq!(step(&mut a, 1), step(&mut b, 1));
+    }
+    assert_eq!(step(&mut a, 2), step(&mut b, 2));
+    assert_eq!(a, b);
+    // the best value covers every epoch
+    let min = a
+        .observations()
+        .map(|(_, y)| y)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(a.best().unwrap().1, min);
+}
+
+#[test]
 fn batch_points_are_distinct_and_pending_is_tracked() {
     let mut opt = Optimizer::new(&branin_bounds(), fast_settings(), 3).unwrap();
     for _ in 0..2 {
