@@ -498,3 +498,11 @@ pub fn lost_and_recorded_twice(path: &Path, run: &str, n: u64) -> (u64, u64) {
     let twice = results.values().filter(|&&c| c > 1).count() as u64;
     (lost, twice)
 }
+
+/// Asserts that a finished run of `n` trials lost none and recorded none twice; returns the
+/// number lost (0) for the test's report.
+pub fn assert_nothing_lost(path: &Path, run: &str, n: u64) -> u64 {
+    let (lost, twice) = lost_and_recorded_twice(path, run, n);
+    assert_eq!((lost, twice), (0, 0), "trials lost, trials recorded twice");
+    lost
+}

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use graspopt_bus::Bus;
 use graspopt_e2e::{
-    Cluster, check_journal, cloud_transport, completed_now, lost_and_recorded_twice, report,
+    Cluster, Proc, assert_nothing_lost, check_journal, cloud_transport, completed_now, report,
     wait_until,
 };
 use graspopt_journal::{Journal, TrialRow, TrialState};
@@ -44,11 +44,22 @@ fn check_after_kill(path: &std::path::Path, run: &str, kept: &mut Completed) -> 
     true
 }
 
-/// Trials of the run not completed in the journal (asserted to be none); for the report.
-fn figures(path: &std::path::Path, run: &str, n: u64) -> u64 {
-    let (lost, twice) = lost_and_recorded_twice(path, run, n);
-    assert_eq!((lost, twice), (0, 0), "trials lost, trials recorded twice");
-    lost
+/// Waits for the last coordinator of a run of `n` trials, checks the journal (every trial
+/// completed once, those in `kept` unchanged); returns the final status and the trials lost.
+fn finish_keeping(
+    c: &Cluster,
+    coordinator: Proc,
+    run: &str,
+    n: u64,
+    kept: &Completed,
+) -> (serde_json::Value, u64) {
+    let status = c.final_status(coordinator, Duration::from_secs(120));
+    assert_eq!(status["completed"], n, "{status}");
+    let after = completed(&check_journal(&c.journal(), run, n as usize));
+    for (id, before) in kept {
+        assert_eq!(after.get(id), Some(before), "trial {id} changed");
+    }
+    (status, assert_nothing_lost(&c.journal(), run, n))
 }
 
 /// The coordinator SIGKILLed three times in one run and restarted with `--resume` each time:
@@ -84,14 +95,7 @@ fn a_coordinator_killed_three_times_loses_nothing() {
             &[&flags[..], &["--resume"]].concat(),
         );
     }
-    let status = c.final_status(coordinator, Duration::from_secs(120));
-    assert_eq!(status["completed"], 24, "{status}");
-    let trials = check_journal(&journal, "ck", 24);
-    let after = completed(&trials);
-    for (id, before) in &kept {
-        assert_eq!(after.get(id), Some(before), "trial {id} changed");
-    }
-    let lost = figures(&journal, "ck", 24);
+    let (status, lost) = finish_keeping(&c, coordinator, "ck", 24, &kept);
     report(json!({
         "test": "coordinator killed and restarted",
         "faults": 3, "trials": 24, "lost": lost,
@@ -133,14 +137,7 @@ fn the_journal_survives_kill_9_at_any_point() {
     // The kills were spread over the run, not after its end.
     assert!(kept.len() < 80, "the run finished before the last kill");
     let coordinator = c.coordinator_as("coordinator-last", "cuboid", "80", "3", &flags);
-    let status = c.final_status(coordinator, Duration::from_secs(120));
-    assert_eq!(status["completed"], 80, "{status}");
-    let trials = check_journal(&journal, "jk", 80);
-    let after = completed(&trials);
-    for (id, before) in &kept {
-        assert_eq!(after.get(id), Some(before), "trial {id} changed");
-    }
-    let lost = figures(&journal, "jk", 80);
+    let (_, lost) = finish_keeping(&c, coordinator, "jk", 80, &kept);
     report(json!({
         "test": "journal: kill -9 of the coordinator at scattered moments",
         "faults": delays_ms.len(), "integrity_checks_passed": checks,
@@ -223,7 +220,7 @@ fn metric_and_planner_restarts_stall_the_run_only_while_they_are_away() {
         })
         .count();
     assert!(orphans_reissued >= 1, "no orphaned trial was re-issued");
-    let lost = figures(&journal, "rs", 20);
+    let lost = assert_nothing_lost(&journal, "rs", 20);
     report(json!({
         "test": "metric and planner agents restarted",
         "faults": 2, "trials": 20, "lost": lost,
@@ -272,7 +269,7 @@ fn the_run_survives_a_router_restart() {
         status["errors"]["reissued"].as_u64().unwrap() >= 1,
         "{status}"
     );
-    let lost = figures(&journal, "rr", 16);
+    let lost = assert_nothing_lost(&journal, "rr", 16);
     report(json!({
         "test": "router restarted (network cut for every agent)",
         "faults": 1, "trials": 16, "lost": lost,

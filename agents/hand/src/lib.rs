@@ -20,7 +20,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use graspopt_bus::{Bus, CloudSender, now_ms};
+use graspopt_bus::{Bus, CloudSender, Received, now_ms};
 use graspopt_convert::{TrialTag, clouds_from_outcome, isometry};
 use graspopt_protocol::{AgentKind, ContactClouds, ObjectEstimate, RunId, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
@@ -134,6 +134,35 @@ pub fn world_object(config: &HandConfig, estimate: Option<&ObjectEstimate>) -> O
     }
 }
 
+/// The object estimate `r` carries if it is a valid one of `run`; otherwise the rejection is
+/// counted in `bad` and logged.
+fn estimate_of_run(
+    r: Received<ObjectEstimate>,
+    run: &RunId,
+    id: &str,
+    bad: &mut u64,
+) -> Option<ObjectEstimate> {
+    match r.message {
+        Ok(e) if e.run_id == *run => Some(e),
+        Ok(e) => {
+            *bad += 1;
+            tracing::warn!(
+                "hand {id}: object estimate of run {} ignored ({bad} bad messages)",
+                e.run_id
+            );
+            None
+        }
+        Err(e) => {
+            *bad += 1;
+            tracing::warn!(
+                "hand {id}: bad object estimate on {} ({bad} bad messages): {e}",
+                r.key
+            );
+            None
+        }
+    }
+}
+
 /// Serves trial commands until the task is cancelled.
 pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
     if let Some(path) = &config.replay {
@@ -153,19 +182,14 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
     let mut bad = 0u64;
     loop {
         tokio::select! {
-            Some(r) = objects.recv() => match r.message {
-                Ok(e) if e.run_id != *run => {
-                    bad += 1;
-                    tracing::warn!("hand {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
-                }
-                Ok(e) if config.object.is_none() && config.mesh.is_none() && world_name.as_deref() != Some(&e.object) => {
+            Some(r) = objects.recv() => {
+                if let Some(e) = estimate_of_run(r, run, &config.id, &mut bad)
+                    && config.object.is_none()
+                    && config.mesh.is_none()
+                    && world_name.as_deref() != Some(&e.object)
+                {
                     world = world_object(config, Some(&e)).map(Arc::new);
                     world_name = Some(e.object.clone());
-                }
-                Ok(_) => {}
-                Err(e) => {
-                    bad += 1;
-                    tracing::warn!("hand {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
                 }
             },
             Some(r) = commands.recv() => {
@@ -185,20 +209,12 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
                 // Wait for the world's object if perception has not spoken yet.
                 while world.is_none() {
                     match objects.recv().await {
-                        Some(r) => match r.message {
-                            Ok(e) if e.run_id == *run => {
+                        Some(r) => {
+                            if let Some(e) = estimate_of_run(r, run, &config.id, &mut bad) {
                                 world = world_object(config, Some(&e)).map(Arc::new);
                                 world_name = Some(e.object.clone());
                             }
-                            Ok(e) => {
-                                bad += 1;
-                                tracing::warn!("hand {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
-                            }
-                            Err(e) => {
-                                bad += 1;
-                                tracing::warn!("hand {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
-                            }
-                        },
+                        }
                         None => return Ok(()),
                     }
                 }
