@@ -164,9 +164,13 @@ where
             .map(|(ci, (l, u))| l + ci * (u - l))
             .collect()
     };
+    let mut x = vec![0.0; d];
     let mut eval = |c: &[f64], evals: &mut usize| -> f64 {
         *evals += 1;
-        let v = f(&to_x(c));
+        for ((xi, ci), (l, u)) in x.iter_mut().zip(c).zip(lower.iter().zip(upper)) {
+            *xi = l + ci * (u - l);
+        }
+        let v = f(&x);
         if v.is_finite() { -v } else { 1e300 }
     };
     let mut evals = 0usize;

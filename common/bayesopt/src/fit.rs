@@ -180,46 +180,81 @@ impl<'a> Objective<'a> {
     /// Negative log posterior (up to a constant) at `theta`; gradient into `grad`.
     /// Returns +inf when the kernel matrix cannot be factorised.
     pub fn value_grad(&self, theta: &[f64], grad: &mut [f64]) -> f64 {
+        let mut ws = Workspace::default();
+        let v = self.value(theta, &mut ws);
+        self.gradient(theta, &mut ws, grad);
+        v
+    }
+
+    /// Negative log posterior at `theta`, leaving in `ws` the factorisation that
+    /// [`Objective::gradient`] at the same `theta` reuses. +inf when the kernel matrix cannot
+    /// be factorised.
+    fn value(&self, theta: &[f64], ws: &mut Workspace) -> f64 {
         let (n, d) = (self.n, self.d);
-        let inv_l2: Vec<f64> = theta[..d].iter().map(|t| (-2.0 * t).exp()).collect();
+        ws.inv_l2.clear();
+        ws.inv_l2
+            .extend(theta[..d].iter().map(|t| (-2.0 * t).exp()));
         let s = theta[d].exp();
         let noise = theta[d + 1].exp();
-        let mut k = vec![0.0; n * n];
-        let mut gmat = vec![0.0; n * n.saturating_sub(1) / 2];
+        // Every entry read below is written first (the strict upper triangle of K is never
+        // read), so the buffers are only resized, not cleared.
+        ws.k.resize(n * n, 0.0);
+        ws.gmat.resize(n * n.saturating_sub(1) / 2, 0.0);
+        let (k, gmat) = (&mut ws.k, &mut ws.gmat);
         let mut p = 0;
         for i in 0..n {
             for j in 0..i {
                 let row = &self.diff2[p * d..(p + 1) * d];
-                let r2: f64 = row.iter().zip(&inv_l2).map(|(a, b)| a * b).sum();
+                let r2: f64 = row.iter().zip(&ws.inv_l2).map(|(a, b)| a * b).sum();
                 let (rho, g) = self.kind.profile(r2.sqrt());
-                k[i * n + j] = s * rho;
-                k[j * n + i] = s * rho;
+                k[i * n + j] = s * rho; // lower triangle only: all that is read
                 gmat[p] = s * g;
                 p += 1;
             }
             k[i * n + i] = s + noise;
         }
-        let Ok((l, jitter)) = linalg::cholesky_jitter(&k, n) else {
-            grad.iter_mut().for_each(|g| *g = 0.0);
+        ws.factorised = linalg::cholesky_jitter_into(k, n, &mut ws.l).is_ok();
+        if !ws.factorised {
             return f64::INFINITY;
-        };
-        let _ = jitter;
-        let mut alpha = self.y.to_vec();
-        linalg::solve_lower_in_place(&l, n, &mut alpha);
-        linalg::solve_upper_t_in_place(&l, n, &mut alpha);
-        let fit: f64 = self.y.iter().zip(&alpha).map(|(a, b)| a * b).sum();
+        }
+        let l = &ws.l;
+        ws.alpha.clear();
+        ws.alpha.extend_from_slice(self.y);
+        linalg::solve_lower_in_place(l, n, &mut ws.alpha);
+        linalg::solve_upper_t_in_place(l, n, &mut ws.alpha);
+        let fit: f64 = self.y.iter().zip(&ws.alpha).map(|(a, b)| a * b).sum();
         let logdet: f64 = (0..n).map(|i| l[i * n + i].ln()).sum();
         let nll = 0.5 * fit + logdet + 0.5 * n as f64 * LN_2PI;
-        // W = alpha alpha^T - K^{-1}; dLML/dtheta = 0.5 tr(W dK/dtheta).
-        let kinv = linalg::inverse_from_cholesky(&l, n);
+        // Priors: normal on each log parameter.
+        let mut prior = 0.0;
+        for (idx, &t) in theta[..d + 2].iter().enumerate() {
+            let (mean, sd) = self.prior(idx);
+            let z = (t - mean) / sd;
+            prior += 0.5 * z * z;
+        }
+        nll + prior
+    }
+
+    /// Gradient of the negative log posterior at `theta`, the point of the last
+    /// [`Objective::value`] call with `ws` (zero where that failed).
+    fn gradient(&self, theta: &[f64], ws: &mut Workspace, grad: &mut [f64]) {
+        let (n, d) = (self.n, self.d);
         grad.iter_mut().for_each(|g| *g = 0.0);
+        if !ws.factorised {
+            return;
+        }
+        let s = theta[d].exp();
+        let noise = theta[d + 1].exp();
+        // W = alpha alpha^T - K^{-1}; dLML/dtheta = 0.5 tr(W dK/dtheta).
+        linalg::inverse_lower_from_cholesky_into(&ws.l, n, &mut ws.lt, &mut ws.kinv);
+        let (alpha, kinv, k, gmat, inv_l2) = (&ws.alpha, &ws.kinv, &ws.k, &ws.gmat, &ws.inv_l2);
         let mut trace_w = 0.0;
-        let mut ws = 0.0; // sum W_ij K_ij without noise (signal part)
-        p = 0;
+        let mut wsum = 0.0; // sum W_ij K_ij without noise (signal part)
+        let mut p = 0;
         for i in 0..n {
             for j in 0..i {
                 let w = alpha[i] * alpha[j] - kinv[i * n + j];
-                ws += 2.0 * w * k[i * n + j];
+                wsum += 2.0 * w * k[i * n + j];
                 let gw = 2.0 * w * gmat[p];
                 let row = &self.diff2[p * d..(p + 1) * d];
                 for kk in 0..d {
@@ -229,28 +264,66 @@ impl<'a> Objective<'a> {
             }
             let wii = alpha[i] * alpha[i] - kinv[i * n + i];
             trace_w += wii;
-            ws += wii * s;
+            wsum += wii * s;
         }
         // grad holds d(LML); convert to d(NLL) = -0.5 * ...
         for g in grad[..d].iter_mut() {
             *g *= -0.5;
         }
-        grad[d] = -0.5 * ws;
+        grad[d] = -0.5 * wsum;
         grad[d + 1] = -0.5 * noise * trace_w;
         // Priors: normal on each log parameter.
-        let st = self.settings;
-        let mut prior = 0.0;
-        let mut add = |idx: usize, mean: f64, sd: f64, grad: &mut [f64]| {
-            let z = (theta[idx] - mean) / sd;
-            prior += 0.5 * z * z;
-            grad[idx] += z / sd;
-        };
-        for kk in 0..d {
-            add(kk, st.length_scale_log_mean, st.length_scale_log_sd, grad);
+        for (idx, &t) in theta[..d + 2].iter().enumerate() {
+            let (mean, sd) = self.prior(idx);
+            grad[idx] += (t - mean) / sd / sd;
         }
-        add(d, st.signal_log_mean, st.signal_log_sd, grad);
-        add(d + 1, st.noise_log_mean, st.noise_log_sd, grad);
-        nll + prior
+    }
+
+    /// Mean and standard deviation of the normal prior on `theta[idx]`.
+    fn prior(&self, idx: usize) -> (f64, f64) {
+        let st = self.settings;
+        if idx < self.d {
+            (st.length_scale_log_mean, st.length_scale_log_sd)
+        } else if idx == self.d {
+            (st.signal_log_mean, st.signal_log_sd)
+        } else {
+            (st.noise_log_mean, st.noise_log_sd)
+        }
+    }
+}
+
+/// Buffers of one evaluation of an [`Objective`], kept between evaluations (no allocation per
+/// call), with the factorisation computed for the value that the gradient reuses.
+#[derive(Default)]
+struct Workspace {
+    inv_l2: Vec<f64>,
+    /// Kernel matrix K (noise on the diagonal), n x n.
+    k: Vec<f64>,
+    /// `s g(r)` per pair (packed lower triangle).
+    gmat: Vec<f64>,
+    /// Cholesky factor of K.
+    l: Vec<f64>,
+    /// K^{-1} y.
+    alpha: Vec<f64>,
+    /// Scratch and lower triangle of K^{-1} (gradient only).
+    lt: Vec<f64>,
+    kinv: Vec<f64>,
+    /// Whether `l` and `alpha` are valid (the factorisation succeeded).
+    factorised: bool,
+}
+
+/// An [`Objective`] with its workspace, for the two-step L-BFGS interface.
+struct FitProblem<'o, 'a> {
+    obj: &'o Objective<'a>,
+    ws: Workspace,
+}
+
+impl lbfgs::Problem for FitProblem<'_, '_> {
+    fn value(&mut self, theta: &[f64]) -> f64 {
+        self.obj.value(theta, &mut self.ws)
+    }
+    fn gradient(&mut self, theta: &[f64], g: &mut [f64]) {
+        self.obj.gradient(theta, &mut self.ws, g);
     }
 }
 
@@ -303,8 +376,12 @@ pub fn fit_map(
         settings.max_iter
     };
     let mut best: Option<(Vec<f64>, f64)> = None;
+    let mut problem = FitProblem {
+        obj: &obj,
+        ws: Workspace::default(),
+    };
     for s in starts {
-        let m = lbfgs::minimize_box(|t, g| obj.value_grad(t, g), &s, &lo, &hi, iters, 1e-5);
+        let m = lbfgs::minimize_problem(&mut problem, &s, &lo, &hi, iters, 1e-5);
         if m.f.is_finite() && best.as_ref().is_none_or(|b| m.f < b.1) {
             best = Some((m.x, m.f));
         }

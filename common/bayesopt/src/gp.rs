@@ -75,9 +75,8 @@ impl Gp {
         let mut k = vec![0.0; n * n];
         for i in 0..n {
             for j in 0..i {
-                let v = kernel.eval(&x[i], &x[j]);
-                k[i * n + j] = v;
-                k[j * n + i] = v;
+                // lower triangle only: all that the factorisation reads
+                k[i * n + j] = kernel.eval(&x[i], &x[j]);
             }
             k[i * n + i] = kernel.signal_variance + noise;
         }
@@ -138,30 +137,65 @@ impl Gp {
     /// `xs` must have the GP's dimension (checked by the caller layers; extra coordinates are
     /// ignored and missing ones treated as absent terms).
     pub fn predict(&self, xs: &[f64]) -> (f64, f64) {
+        self.predict_with_buffer(xs, &mut Vec::new())
+    }
+
+    /// [`Gp::predict`] using `v` as scratch (no allocation once it has the capacity; for
+    /// callers that predict at many points).
+    pub fn predict_with_buffer(&self, xs: &[f64], v: &mut Vec<f64>) -> (f64, f64) {
+        v.clear();
+        self.kernel_row_from(xs, 0, v);
+        let mean = linalg::dot(v, &self.alpha);
+        linalg::solve_lower_in_place(&self.l, self.x.len(), v);
+        let var = self.kernel.signal_variance - linalg::dot(v, v);
+        (mean, var.max(0.0))
+    }
+
+    /// [`Gp::predict`] that also leaves the kernel row `k(xs, x_i)` in `k` and `L^{-1} k` in
+    /// `v`, reusing their first `from` entries: these must be those of a GP whose first
+    /// `from` conditioning points are this one's (with the same kernel), e.g. the GP this one
+    /// was extended from by [`Gp::push`], so only the rows of the appended points are
+    /// computed. The result is bit-identical to [`Gp::predict`].
+    pub fn predict_extending(
+        &self,
+        xs: &[f64],
+        from: usize,
+        k: &mut Vec<f64>,
+        v: &mut Vec<f64>,
+    ) -> (f64, f64) {
         let n = self.x.len();
+        let from = from.min(n).min(k.len()).min(v.len());
+        k.truncate(from);
+        v.truncate(from);
+        self.kernel_row_from(xs, from, k);
+        v.extend_from_slice(&k[from..]);
+        linalg::solve_lower_rows_from(&self.l, n, v, from);
+        let mean = linalg::dot(k, &self.alpha);
+        let var = self.kernel.signal_variance - linalg::dot(v, v);
+        (mean, var.max(0.0))
+    }
+
+    /// Append `k(xs, x_i)` for the conditioning points `i >= from` to `out`.
+    fn kernel_row_from(&self, xs: &[f64], from: usize, out: &mut Vec<f64>) {
         let d = self.dim;
-        let mut p = [0.0f64; 16];
-        let mut v = Vec::with_capacity(n);
+        out.reserve(self.x.len().saturating_sub(from));
         if d <= 16 && xs.len() == d {
+            let mut p = [0.0f64; 16];
             for k in 0..d {
                 p[k] = xs[k] * self.inv_ls[k];
             }
             let (kind, sv) = (self.kernel.kind, self.kernel.signal_variance);
-            for row in self.xs_scaled.chunks_exact(d) {
+            for row in self.xs_scaled.chunks_exact(d).skip(from) {
                 let mut r2 = 0.0;
                 for k in 0..d {
                     let t = p[k] - row[k];
                     r2 += t * t;
                 }
-                v.push(sv * kind.rho(r2.sqrt()));
+                out.push(sv * kind.rho(r2.sqrt()));
             }
         } else {
-            v.extend(self.x.iter().map(|xi| self.kernel.eval(xs, xi)));
+            out.extend(self.x[from..].iter().map(|xi| self.kernel.eval(xs, xi)));
         }
-        let mean = linalg::dot(&v, &self.alpha);
-        linalg::solve_lower_in_place(&self.l, n, &mut v);
-        let var = self.kernel.signal_variance - linalg::dot(&v, &v);
-        (mean, var.max(0.0))
     }
 
     /// Posterior mean and variance with their gradients with respect to `xs`.
@@ -355,6 +389,34 @@ mod tests {
             let (a, b) = gp.predict(&[t]);
             let (c, d) = full.predict(&[t]);
             assert!((a - c).abs() < 1e-8 && (b - d).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn predict_variants_are_bit_identical() {
+        let k = Kernel {
+            kind: KernelKind::Matern32,
+            length_scales: vec![0.3, 0.5, 0.8],
+            signal_variance: 1.3,
+        };
+        let mut r = crate::rng::Rng::new(4);
+        let x: Vec<Vec<f64>> = (0..23).map(|_| r.unit_point(3)).collect();
+        let y: Vec<f64> = x.iter().map(|p| p[0].sin() - p[1] * p[2]).collect();
+        let gp = Gp::new(x, y, k, 1e-4).unwrap();
+        let mut g2 = gp.clone();
+        g2.push(vec![0.2, 0.4, 0.6], -1.0).unwrap();
+        g2.push(vec![0.7, 0.1, 0.3], 0.5).unwrap();
+        let (mut buf, mut kr, mut vr) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..20 {
+            let p = r.unit_point(3);
+            let (m, v) = gp.predict(&p);
+            assert_eq!(gp.predict_with_buffer(&p, &mut buf), (m, v));
+            assert_eq!(gp.predict_extending(&p, 0, &mut kr, &mut vr), (m, v));
+            // rows of `gp` reused for the GP extended by two fantasy points
+            assert_eq!(
+                g2.predict_extending(&p, gp.len(), &mut kr, &mut vr),
+                g2.predict(&p)
+            );
         }
     }
 

@@ -11,6 +11,8 @@
 //! restored optimizer proposes exactly what the original would have (serde_json needs its
 //! `float_roundtrip` feature for bit-exact floats).
 
+use std::collections::HashMap;
+
 use serde::{Deserialize, Serialize};
 
 use crate::acquisition::{
@@ -791,14 +793,28 @@ impl Optimizer {
                 } else {
                     1.0
                 };
-                let (mut u, mut ei) = self.maximize_acquisition(&gp, incumbent, xi, share)?;
+                let depth = self.settings.diversify_depth.max(1);
+                // In a diversification round each maximisation keeps its kernel rows for the
+                // next one, whose GP only has fantasy points appended (see `RowMemo`).
+                let mut memo = diversify.then(RowMemo::default);
+                let (mut u, mut ei) =
+                    self.maximize_acquisition(&gp, incumbent, xi, share, None, memo.as_mut())?;
                 if diversify {
                     // Diversification round: assume the EI maximiser is as bad as the worst
                     // observation (constant liar, min) and propose the next EI maximiser.
                     let mut g2 = gp.clone();
-                    for _ in 0..self.settings.diversify_depth.max(1) {
+                    for step in 0..depth {
                         g2.push(u.clone(), y_min_std)?;
-                        let (u2, ei2) = self.maximize_acquisition(&g2, incumbent, xi, share)?;
+                        let previous = memo.take();
+                        memo = (step + 1 < depth).then(RowMemo::default);
+                        let (u2, ei2) = self.maximize_acquisition(
+                            &g2,
+                            incumbent,
+                            xi,
+                            share,
+                            previous.as_ref(),
+                            memo.as_mut(),
+                        )?;
                         u = u2;
                         ei = ei.max(ei2);
                     }
@@ -881,12 +897,16 @@ impl Optimizer {
 
     /// Maximise the acquisition on the unit cube: DIRECT then L-BFGS polish from the best
     /// centres. Returns the point and its EI (standardised units; the UCB value for UCB).
+    /// `reuse`: kernel rows kept by the previous maximisation on a GP that `gp` extends (see
+    /// [`RowMemo`]); `record`: where to keep this one's.
     fn maximize_acquisition(
         &self,
         gp: &Gp,
         incumbent: f64,
         xi: f64,
         budget_share: f64,
+        reuse: Option<&RowMemo>,
+        mut record: Option<&mut RowMemo>,
     ) -> Result<(Vec<f64>, f64)> {
         let d = self.dim();
         let lo = vec![0.0; d];
@@ -918,8 +938,34 @@ impl Optimizer {
             }
             p
         };
+        let mut buffer = Vec::new();
+        let (mut k_row, mut v_row) = (Vec::new(), Vec::new());
+        if let Some(rec) = record.as_deref_mut() {
+            rec.len = gp.len();
+            rec.rows.clear();
+        }
         let value = |u: &[f64]| -> f64 {
-            let (m, v) = gp.predict(u);
+            let (m, v) = if reuse.is_none() && record.is_none() {
+                gp.predict_with_buffer(u, &mut buffer)
+            } else {
+                let key: Vec<u64> = u.iter().map(|c| c.to_bits()).collect();
+                let mut from = 0;
+                if let Some((len, row)) = reuse.and_then(|r| r.rows.get(&key).map(|w| (r.len, w))) {
+                    k_row.clear();
+                    k_row.extend_from_slice(&row[..len]);
+                    v_row.clear();
+                    v_row.extend_from_slice(&row[len..]);
+                    from = len;
+                }
+                let mv = gp.predict_extending(u, from, &mut k_row, &mut v_row);
+                if let Some(rec) = record.as_deref_mut() {
+                    let mut row = Vec::with_capacity(2 * k_row.len());
+                    row.extend_from_slice(&k_row);
+                    row.extend_from_slice(&v_row);
+                    rec.rows.insert(key, row);
+                }
+                mv
+            };
             let a = match acq {
                 AcquisitionKind::ExpectedImprovement => {
                     log_expected_improvement(m, v, incumbent, xi)
@@ -977,6 +1023,18 @@ impl Optimizer {
         };
         Ok((best_u, ei))
     }
+}
+
+/// Kernel rows `k(u, x_i)` and `L^{-1} k` of the first `len` conditioning points at every
+/// point `u` (keyed by its bits) where one DIRECT run evaluated the acquisition. The runs of a
+/// diversification round maximise on the same GP with fantasy points appended, and DIRECT
+/// revisits many of the same points (a third to a half of them): there only the rows of the
+/// appended points are computed ([`Gp::predict_extending`], bit-identical to a full
+/// prediction).
+#[derive(Default)]
+struct RowMemo {
+    len: usize,
+    rows: HashMap<Vec<u64>, Vec<f64>>,
 }
 
 impl AskTell for Optimizer {
