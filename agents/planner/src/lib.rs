@@ -1,5 +1,6 @@
 //! The planner agent: answers the coordinator's proposal requests with the Bayesian
-//! optimization engine (`graspopt-bayesopt`) or random search.
+//! optimization engine (`graspopt-bayesopt`, with `Settings::for_grasps`: the thesis's
+//! settings with the misses' scores compressed) or random search.
 //!
 //! A request carries the whole history of the run (observations in completion order and the
 //! trials pending), so the planner holds no state that matters: it keeps the engine of the
@@ -76,7 +77,7 @@ impl Planner {
                 PlannerMethod::Bo => {
                     let settings = Settings {
                         n_init: req.initial.map(|n| n as usize),
-                        ..Settings::default()
+                        ..Settings::for_grasps()
                     };
                     Engine::Bo(Box::new(
                         Optimizer::new(&bounds, settings, req.seed).map_err(|e| e.to_string())?,

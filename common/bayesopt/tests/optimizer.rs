@@ -302,3 +302,38 @@ fn branin_quick_run_finds_the_basin() {
     let best = trace.last().copied().unwrap();
     assert!(TestFunction::Branin.regret(best) < 0.01, "{best}");
 }
+
+#[test]
+fn expected_improvement_vanishes_at_observations_and_not_between_them() {
+    let mut opt = Optimizer::new(&[(0.0, 1.0)], Settings::for_grasps(), 5).unwrap();
+    assert!(opt.expected_improvement(&[0.5]).is_err(), "no data yet");
+    // A smooth 1D bump observed at five points, then one model-based round to fit.
+    let f = |x: f64| -(x - 0.62) * (x - 0.62);
+    for x in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        opt.observe(&[x], f(x)).unwrap();
+    }
+    let next = opt.suggest(1).unwrap();
+    opt.clear_pending();
+    let at_data = opt.expected_improvement(&[0.5]).unwrap();
+    let at_next = opt.expected_improvement(&next[0]).unwrap();
+    assert!(
+        (0.0..1e-3).contains(&at_data),
+        "EI {at_data} at an observation"
+    );
+    assert!(
+        at_next > 10.0 * at_data.max(1e-6),
+        "EI {at_next} at the proposal"
+    );
+    // Near the optimum (between 0.5 and 0.75) EI beats the far, bad end.
+    assert!(
+        opt.expected_improvement(&[0.62]).unwrap() > opt.expected_improvement(&[0.02]).unwrap()
+    );
+    assert!(
+        opt.expected_improvement(&[0.5, 0.5]).is_err(),
+        "wrong dimension"
+    );
+    assert!(
+        opt.expected_improvement(&[f64::NAN]).is_err(),
+        "not a number"
+    );
+}
