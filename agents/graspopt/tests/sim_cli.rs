@@ -172,3 +172,75 @@ fn experiment_metrics_writes_every_figure_and_a_report() {
         assert!(dir.join(format!("fig4.9-4.15-{object}.png")).exists());
     }
 }
+
+#[test]
+fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
+    let dir = tempdir("experiment-bo");
+    let out = graspopt(&[
+        "experiment",
+        "bo",
+        "--seeds",
+        "2",
+        "--budget",
+        "8",
+        "--budget-6d",
+        "6",
+        "--steps",
+        "5,3",
+        "--objects",
+        "sphere,mug",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for heading in [
+        "Figures 4.16-4.17",
+        "Table 4.1",
+        "Figures 4.18-4.24",
+        "Figures 4.25-4.27",
+        "6D pose space",
+    ] {
+        assert!(report.contains(heading), "report lacks {heading}");
+    }
+    // Table 4.1 has a row per object with the 15-point grid.
+    assert!(report.contains("| sphere | 15 |") && report.contains("| mug | 15 |"));
+    let mut named = 0;
+    for word in report.split(|c: char| c.is_whitespace() || c == ',' || c == '|') {
+        if word.ends_with(".svg") || word.ends_with(".csv") {
+            assert!(dir.join(word).exists(), "{word} missing");
+            named += 1;
+        }
+    }
+    // 1D: 2 objects x (2 CSV + up to 4 SVG); 2D: 2 x (map + 2 CSV + SVG); 6D: 2 x 3.
+    assert!(named >= 2 * 4 + 2 * 4 + 2 * 3, "{named} files named");
+    // Per-seed counts: two seeds of BO and two of random search, each naming its seed.
+    let seeds =
+        std::fs::read_to_string(dir.join("fig4.25-4.27-mug-bo-vs-random-seeds.csv")).unwrap();
+    let rows: Vec<&str> = seeds.lines().skip(1).collect();
+    assert_eq!(rows.len(), 4, "{seeds}");
+    assert!(rows[0].starts_with("bo,0,") && rows[3].starts_with("random,1,"));
+    let curves = std::fs::read_to_string(dir.join("6d-sphere-bo-vs-random-curves.csv")).unwrap();
+    assert_eq!(curves.lines().count(), 1 + 2 * 6);
+}
+
+#[test]
+fn experiment_bo_bad_input_is_named() {
+    for (args, expected) in [
+        (vec!["--engine", "magic"], "unknown engine \"magic\""),
+        (vec!["--objects", "teapot"], "unknown object `teapot`"),
+        (vec!["--steps", "5"], "--steps \"5\""),
+        (vec!["--seeds", "0"], "--seeds must be at least 1"),
+    ] {
+        let mut all = vec!["experiment", "bo", "--parts", "1d"];
+        all.extend(args);
+        let out = graspopt(&all);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expected), "{err}");
+    }
+}

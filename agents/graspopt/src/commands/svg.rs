@@ -87,6 +87,15 @@ pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, xs: &[f64], ys: &[f64]
     lines_plot(title, xlabel, ylabel, xs, &[("", ys.to_vec())])
 }
 
+const COLOURS: [&str; 6] = [
+    "rgb(31,119,180)",
+    "rgb(214,39,40)",
+    "rgb(44,160,44)",
+    "rgb(148,103,189)",
+    "rgb(255,127,14)",
+    "rgb(23,190,207)",
+];
+
 /// Several named series against the same `xs`, with a legend when names are given.
 pub fn lines_plot(
     title: &str,
@@ -95,22 +104,62 @@ pub fn lines_plot(
     xs: &[f64],
     series: &[(&str, Vec<f64>)],
 ) -> String {
-    const COLOURS: [&str; 6] = [
-        "rgb(31,119,180)",
-        "rgb(214,39,40)",
-        "rgb(44,160,44)",
-        "rgb(148,103,189)",
-        "rgb(255,127,14)",
-        "rgb(23,190,207)",
-    ];
+    bands_plot(title, xlabel, ylabel, xs, series, &[], None)
+}
+
+/// [`lines_plot`] with a shaded band `(low, high)` behind series `k` for each `bands[k]`
+/// (empty bands are skipped) and an optional dashed horizontal reference line with a label.
+pub fn bands_plot(
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    xs: &[f64],
+    series: &[(&str, Vec<f64>)],
+    bands: &[(Vec<f64>, Vec<f64>)],
+    reference: Option<(f64, &str)>,
+) -> String {
     let mut out = String::new();
     header(&mut out, title);
     let width = W - LEFT - 30.0;
     let xr = range(xs.iter().copied());
-    let yr = range(series.iter().flat_map(|(_, ys)| ys.iter().copied()));
+    let yr = range(
+        series
+            .iter()
+            .flat_map(|(_, ys)| ys.iter().copied())
+            .chain(bands.iter().flat_map(|(l, h)| l.iter().chain(h).copied()))
+            .chain(reference.map(|r| r.0)),
+    );
     axes(&mut out, xr, yr, xlabel, ylabel, width);
     let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
     let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
+    for (k, (low, high)) in bands.iter().enumerate() {
+        let upper = xs.iter().zip(high).map(|(&x, &y)| (x, y));
+        let lower = xs.iter().zip(low).rev().map(|(&x, &y)| (x, y));
+        let points: Vec<String> = upper
+            .chain(lower)
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|(x, y)| format!("{:.2},{:.2}", px(x), py(y)))
+            .collect();
+        if !points.is_empty() {
+            let _ = writeln!(
+                out,
+                r#"<polygon points="{}" fill="{}" fill-opacity="0.18" stroke="none"/>"#,
+                points.join(" "),
+                COLOURS[k % COLOURS.len()]
+            );
+        }
+    }
+    if let Some((value, label)) = reference {
+        let _ = writeln!(
+            out,
+            r#"<line x1="{LEFT}" y1="{0:.2}" x2="{1}" y2="{0:.2}" stroke="black" stroke-dasharray="6 4"/><text x="{2}" y="{3:.2}" text-anchor="end">{4}</text>"#,
+            py(value),
+            LEFT + width,
+            LEFT + width - 4.0,
+            py(value) - 4.0,
+            escape(label)
+        );
+    }
     if yr.0 < 0.0 && yr.1 > 0.0 {
         let _ = writeln!(
             out,
@@ -144,6 +193,233 @@ pub fn lines_plot(
                 escape(name)
             );
         }
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+/// The model of a 1D run after some trials (thesis figures 4.16-4.17): in the upper panel
+/// the posterior mean with a two-sigma band, the true scan in grey, the samples as dots and
+/// the next trial as a vertical line; in the lower panel the expected improvement.
+pub struct ModelPlot<'a> {
+    pub title: &'a str,
+    pub xlabel: &'a str,
+    pub xs: &'a [f64],
+    pub mean: &'a [f64],
+    pub sd: &'a [f64],
+    pub ei: &'a [f64],
+    /// The score along the same `xs` from a grid scan, if known.
+    pub truth: Option<&'a [f64]>,
+    pub samples: &'a [(f64, f64)],
+    pub next: Option<f64>,
+}
+
+/// Draws a [`ModelPlot`].
+pub fn model_plot(p: &ModelPlot) -> String {
+    const HEIGHT: f64 = 560.0;
+    let width = W - LEFT - 30.0;
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{HEIGHT}" viewBox="0 0 {W} {HEIGHT}" font-family="sans-serif" font-size="12">
+<rect width="{W}" height="{HEIGHT}" fill="white"/>
+<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>
+"#,
+        W / 2.0,
+        escape(p.title)
+    );
+    let xr = range(p.xs.iter().copied());
+    let upper: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m + 2.0 * s).collect();
+    let lower: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m - 2.0 * s).collect();
+    // The score axis spans the scan, the samples and the mean (padded by a tenth); the band
+    // is clipped to it, since it can be far wider where the model has seen only misses.
+    let yr = {
+        let (lo, hi) = range(
+            p.mean
+                .iter()
+                .chain(p.truth.unwrap_or(&[]))
+                .copied()
+                .chain(p.samples.iter().map(|s| s.1)),
+        );
+        let pad = 0.1 * (hi - lo);
+        (lo - pad, hi + pad)
+    };
+    let er = range(p.ei.iter().copied().chain([0.0]));
+    let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
+    // (top, bottom) of each panel in pixels.
+    let panels = [(TOP, 370.0), (400.0, HEIGHT - BOTTOM)];
+    let py = |panel: usize, r: (f64, f64), y: f64| {
+        let (t, b) = panels[panel];
+        b - (y.clamp(r.0, r.1) - r.0) / (r.1 - r.0) * (b - t)
+    };
+    let line = |out: &mut String, panel: usize, r: (f64, f64), ys: &[f64], style: &str| {
+        let pts: Vec<String> =
+            p.xs.iter()
+                .zip(ys)
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|(&x, &y)| format!("{:.2},{:.2}", px(x), py(panel, r, y)))
+                .collect();
+        let _ = writeln!(
+            out,
+            r#"<polyline points="{}" fill="none" {style}/>"#,
+            pts.join(" ")
+        );
+    };
+    for (k, (t, b)) in panels.iter().enumerate() {
+        let r = if k == 0 { yr } else { er };
+        let _ = writeln!(
+            out,
+            r#"<rect x="{LEFT}" y="{t}" width="{width}" height="{}" fill="none" stroke="black"/>"#,
+            b - t
+        );
+        for i in 0..=2 {
+            let v = r.0 + (r.1 - r.0) * i as f64 / 2.0;
+            let y = py(k, r, v);
+            let _ = writeln!(
+                out,
+                r#"<text x="{}" y="{:.2}" text-anchor="end">{v:.3}</text>"#,
+                LEFT - 6.0,
+                y + 4.0
+            );
+        }
+        let label = if k == 0 { "score" } else { "EI (engine units)" };
+        let _ = writeln!(
+            out,
+            r#"<text transform="translate(16 {}) rotate(-90)" text-anchor="middle">{label}</text>"#,
+            (t + b) / 2.0
+        );
+    }
+    for i in 0..=4 {
+        let x = xr.0 + (xr.1 - xr.0) * i as f64 / 4.0;
+        let _ = writeln!(
+            out,
+            r#"<text x="{:.2}" y="{}" text-anchor="middle">{x:.3}</text>"#,
+            px(x),
+            HEIGHT - BOTTOM + 18.0
+        );
+    }
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+        LEFT + width / 2.0,
+        HEIGHT - 12.0,
+        escape(p.xlabel)
+    );
+    let band: Vec<String> =
+        p.xs.iter()
+            .zip(&upper)
+            .chain(p.xs.iter().zip(&lower).rev())
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|(&x, &y)| format!("{:.2},{:.2}", px(x), py(0, yr, y)))
+            .collect();
+    let _ = writeln!(
+        out,
+        r#"<polygon points="{}" fill="rgb(214,39,40)" fill-opacity="0.15" stroke="none"/>"#,
+        band.join(" ")
+    );
+    if let Some(truth) = p.truth {
+        line(
+            &mut out,
+            0,
+            yr,
+            truth,
+            r#"stroke="gray" stroke-width="1.5""#,
+        );
+    }
+    line(
+        &mut out,
+        0,
+        yr,
+        &upper,
+        r#"stroke="rgb(214,39,40)" stroke-dasharray="5 3""#,
+    );
+    line(
+        &mut out,
+        0,
+        yr,
+        &lower,
+        r#"stroke="rgb(214,39,40)" stroke-dasharray="5 3""#,
+    );
+    line(
+        &mut out,
+        0,
+        yr,
+        p.mean,
+        r#"stroke="rgb(214,39,40)" stroke-width="2""#,
+    );
+    line(
+        &mut out,
+        1,
+        er,
+        p.ei,
+        r#"stroke="rgb(31,119,180)" stroke-width="2""#,
+    );
+    for &(x, y) in p.samples {
+        let _ = writeln!(
+            out,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="4" fill="rgb(214,39,40)" stroke="black"/>"#,
+            px(x),
+            py(0, yr, y)
+        );
+    }
+    if let Some(x) = p.next {
+        let _ = writeln!(
+            out,
+            r#"<line x1="{0:.2}" y1="{TOP}" x2="{0:.2}" y2="{1}" stroke="rgb(44,160,44)" stroke-width="1.5" stroke-dasharray="2 2"/>"#,
+            px(x),
+            HEIGHT - BOTTOM
+        );
+    }
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="{}">mean, 2 sd (red), scan (grey), samples (dots), next trial (green)</text>"#,
+        LEFT + 6.0,
+        TOP + 14.0
+    );
+    out.push_str("</svg>\n");
+    out
+}
+
+/// A heatmap ([`heatmap`]) with samples drawn on it as dots coloured by their own value on
+/// the map's scale, the best one as a larger ring.
+pub fn samples_map(
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    grid: (&[f64], &[f64], &[Vec<f64>]),
+    samples: &[(f64, f64, f64)],
+) -> String {
+    let (xs, ys, z) = grid;
+    let mut out = heatmap(title, xlabel, ylabel, xs, ys, z);
+    out.truncate(out.trim_end().len() - "</svg>".len());
+    let width = W - LEFT - RIGHT;
+    let xr = range(xs.iter().copied());
+    let yr = range(ys.iter().copied());
+    let zr = range(z.iter().flatten().copied());
+    let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
+    let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
+    // A veil over the map so the samples stand out.
+    let _ = writeln!(
+        out,
+        r#"<rect x="{LEFT}" y="{TOP}" width="{width}" height="{}" fill="white" fill-opacity="0.45"/>"#,
+        H - BOTTOM - TOP
+    );
+    for &(x, y, v) in samples {
+        let (r, g, b) = colour((v - zr.0) / (zr.1 - zr.0));
+        let _ = writeln!(
+            out,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="4.5" fill="rgb({r},{g},{b})" stroke="black" stroke-width="0.8"/>"#,
+            px(x),
+            py(y)
+        );
+    }
+    if let Some(&(x, y, _)) = samples.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
+        let _ = writeln!(
+            out,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
+            px(x),
+            py(y)
+        );
     }
     out.push_str("</svg>\n");
     out

@@ -13,26 +13,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use clap::{Args, Subcommand};
-use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::{ContactModel, Object, ParamKind};
-use graspopt_trial::scan::{ScanPoint, linspace, scan_grid};
+use clap::Args;
+use graspopt_sim::{ContactModel, ParamKind};
+use graspopt_trial::scan::ScanPoint;
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
 
-use super::setup::space_for;
-use super::svg;
-
-#[derive(Args, Debug)]
-pub struct ExperimentArgs {
-    #[command(subcommand)]
-    pub which: Experiment,
-}
-
-#[derive(Subcommand, Debug)]
-pub enum Experiment {
-    /// The metric figures of thesis chapter 4 (4.3-4.15).
-    Metrics(MetricsArgs),
-}
+use super::{OBJECTS, argmax, evaluator, scan, write};
+use crate::commands::svg;
 
 #[derive(Args, Debug)]
 pub struct MetricsArgs {
@@ -50,68 +37,13 @@ pub struct MetricsArgs {
     pub threads: usize,
 }
 
-pub fn run(args: &ExperimentArgs) -> Result<std::process::ExitCode> {
-    match &args.which {
-        Experiment::Metrics(m) => metrics(m)?,
-    }
-    Ok(std::process::ExitCode::SUCCESS)
-}
-
-const OBJECTS: [&str; 7] = [
-    "sphere",
-    "wine_glass",
-    "cylinder",
-    "mug",
-    "cuboid",
-    "rotated_cuboid",
-    "star_prism",
-];
-
-fn evaluator(object: &str, kinds: &[ParamKind]) -> Result<Evaluator> {
-    let object = Object::by_name(object)?;
-    let space = space_for(&object, kinds)?;
-    Ok(Evaluator::new(object, hand_by_name("barrett")?, space))
-}
-
-fn scan(
-    ev: &Evaluator,
-    steps: &[usize],
-    threads: usize,
-) -> Result<(Vec<Vec<f64>>, Vec<ScanPoint>)> {
-    let axes: Vec<Vec<f64>> = ev
-        .space
-        .bounds()
-        .iter()
-        .zip(steps)
-        .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
-        .collect();
-    let points = scan_grid(ev, &axes, threads, &|_| {})?;
-    Ok((axes, points))
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> Result<String> {
-    let path = dir.join(name);
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(name.to_string())
-}
-
 /// Width of the parameter range where `pred` holds (grid spacing counted per point).
 fn span(xs: &[f64], points: &[ScanPoint], pred: impl Fn(&ScanPoint) -> bool) -> f64 {
     let step = if xs.len() > 1 { xs[1] - xs[0] } else { 0.0 };
     points.iter().filter(|p| pred(p)).count() as f64 * step
 }
 
-fn argmax(points: &[ScanPoint]) -> &ScanPoint {
-    let mut best = &points[0];
-    for p in points {
-        if p.score.score > best.score.score {
-            best = p;
-        }
-    }
-    best
-}
-
-fn metrics(args: &MetricsArgs) -> Result<()> {
+pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     let dir = &args.out;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut report = String::from(
@@ -328,7 +260,7 @@ fn map_row(
     let z: Vec<Vec<f64>> = (0..axes[0].len())
         .map(|i| {
             (0..axes[1].len())
-                .map(|j| super::scan::touched_score(&points[i * axes[1].len() + j]))
+                .map(|j| crate::commands::scan::touched_score(&points[i * axes[1].len() + j]))
                 .collect()
         })
         .collect();

@@ -1,0 +1,584 @@
+//! `graspopt experiment bo`: the thesis's Bayesian-optimisation experiments (sections 4.6-4.8)
+//! in the simulator, over seeds, into a folder of CSV and SVG files with a markdown report:
+//!
+//! - 4.16-4.17: 1D runs on the sphere and the star prism, the model at four steps (samples,
+//!   GP mean, two-sigma band, EI), with the thesis's settings and stopping rule;
+//! - 4.18-4.24: 2D sample maps of a run on each of the seven objects over the grid scan;
+//! - Table 4.1: grid size against BO trials, in total (until the engine's stopping rule) and
+//!   to within 5/10/20% of the grid maximum, medians over seeds;
+//! - 4.25-4.27: best so far against trials, BO against random search, mean and spread over
+//!   seeds, on every object; and the same in the 6D pose space, against the best value any run
+//!   found (no grid in 6D).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use graspopt_bayesopt::Method;
+use graspopt_experiment::{
+    Comparison, Engine, MethodSummary, SearchSettings, Snapshot, TARGET_FRACTIONS, compare, median,
+    run_with_snapshots,
+};
+use graspopt_sim::{ContactModel, ParamKind};
+use graspopt_trial::Evaluator;
+
+use super::{OBJECTS, argmax, evaluator, scan, write};
+use crate::commands::setup::Contacts;
+use crate::commands::svg;
+
+#[derive(Args, Debug)]
+pub struct BoArgs {
+    /// Output folder.
+    #[arg(long, default_value = "results/experiment-bo")]
+    pub out: PathBuf,
+    /// Seeds per method and object.
+    #[arg(long, default_value_t = 10)]
+    pub seeds: u64,
+    /// The first seed (seeds run from it upwards).
+    #[arg(long, default_value_t = 0)]
+    pub first_seed: u64,
+    /// Trials per 2D run (the thesis compared over 100).
+    #[arg(long, default_value_t = 100)]
+    pub budget: usize,
+    /// Trials per 6D run.
+    #[arg(long, default_value_t = 100)]
+    pub budget_6d: usize,
+    /// Grid of the 2D reference scan, approach x vertical (the thesis's 2,211 points).
+    #[arg(long, default_value = "67,33")]
+    pub steps: String,
+    /// Objects (comma-separated; default the seven of the thesis).
+    #[arg(long, value_delimiter = ',')]
+    pub objects: Vec<String>,
+    /// Parts to run: 1d (figs 4.16-4.17), 2d (4.18-4.27, Table 4.1), 6d.
+    #[arg(long, value_delimiter = ',', default_values_t = [Part::OneD, Part::TwoD, Part::SixD])]
+    pub parts: Vec<Part>,
+    /// The engine's settings: grasp (the thesis's with the misses' scores compressed),
+    /// benchmark (tuned on Branin and Hartmann6) or thesis (as written).
+    #[arg(long, default_value = "grasp")]
+    pub engine: String,
+    /// Contact model scored.
+    #[arg(long, value_enum, default_value_t = Contacts::Surface)]
+    pub contacts: Contacts,
+    /// Worker threads (0: all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Part {
+    #[value(name = "1d")]
+    OneD,
+    #[value(name = "2d")]
+    TwoD,
+    #[value(name = "6d")]
+    SixD,
+}
+
+impl std::fmt::Display for Part {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Part::OneD => "1d",
+            Part::TwoD => "2d",
+            Part::SixD => "6d",
+        })
+    }
+}
+
+fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Bo => "bo",
+        Method::BoThesis => "bo-thesis",
+        Method::Random => "random",
+    }
+}
+
+/// The evaluator of `object` over `kinds` with the chosen contact model.
+fn object_evaluator(object: &str, kinds: &[ParamKind], contacts: Contacts) -> Result<Evaluator> {
+    let mut ev = evaluator(object, kinds)?;
+    ev.score.contacts = match contacts {
+        Contacts::Surface => ContactModel::Surface,
+        Contacts::Patch => ContactModel::CircularPatch,
+        Contacts::Mean => ContactModel::MeanPoint,
+    };
+    Ok(ev)
+}
+
+pub(super) fn bo(args: &BoArgs) -> Result<()> {
+    let engine = Engine::parse(&args.engine)?;
+    if args.seeds == 0 || args.budget < 2 || args.budget_6d < 2 {
+        bail!("--seeds must be at least 1 and --budget, --budget-6d at least 2");
+    }
+    let steps: Vec<usize> = args
+        .steps
+        .split(',')
+        .map(|s| s.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--steps {:?}: expected two counts like 67,33", args.steps))?;
+    if steps.len() != 2 || steps.iter().any(|&n| n < 2) {
+        bail!(
+            "--steps {:?}: expected two counts of at least 2, like 67,33",
+            args.steps
+        );
+    }
+    let objects: Vec<String> = if args.objects.is_empty() {
+        OBJECTS.iter().map(|s| s.to_string()).collect()
+    } else {
+        args.objects.clone()
+    };
+    for o in &objects {
+        graspopt_sim::Object::by_name(o)?;
+    }
+    let dir = &args.out;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let seeds: Vec<u64> = (args.first_seed..args.first_seed.saturating_add(args.seeds)).collect();
+    let mut report = format!(
+        "# Bayesian-optimisation experiments (thesis 4.6-4.8)\n\nRegenerated by `graspopt experiment bo --seeds {} --first-seed {} --budget {} --budget-6d {} --steps {} --engine {}`. \
+         Barrett hand, {} contact model, BW score (a trial that touches nothing scores below every grasp, by how far it missed). \
+         Engine settings `{}`; random search is uniform over the same box. Seeds {}-{}. \
+         \"Within p%\" means a best score of at least `max - p |max|`.\n\n",
+        args.seeds,
+        args.first_seed,
+        args.budget,
+        args.budget_6d,
+        args.steps,
+        engine.name(),
+        format!("{:?}", args.contacts).to_lowercase(),
+        engine.name(),
+        seeds[0],
+        seeds[seeds.len() - 1]
+    );
+    let started = std::time::Instant::now();
+    if args.parts.contains(&Part::OneD) {
+        one_d(dir, args, engine, &mut report)?;
+    }
+    if args.parts.contains(&Part::TwoD) {
+        two_d(dir, args, engine, &objects, &steps, &seeds, &mut report)?;
+    }
+    if args.parts.contains(&Part::SixD) {
+        six_d(dir, args, engine, &objects, &seeds, &mut report)?;
+    }
+    let _ = writeln!(
+        report,
+        "\nWall time: {:.0} s.",
+        started.elapsed().as_secs_f64()
+    );
+    let path = dir.join("report.md");
+    std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// Figures 4.16-4.17: a 1D run on the sphere and on the star prism (two random points, stop
+/// when EI vanishes), the model at four steps.
+fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Result<()> {
+    report.push_str(
+        "## Figures 4.16-4.17: 1D runs along the approach axis (2 random points, stop when EI vanishes)\n\n\
+         | object | trials until the engine stopped | best found | grid maximum (201 points) | files |\n|---|---|---|---|---|\n",
+    );
+    for (fig, object) in [("4.16", "sphere"), ("4.17", "star_prism")] {
+        let ev = object_evaluator(object, &[ParamKind::Approach], args.contacts)?;
+        let (_, truth) = scan(&ev, &[201], args.threads)?;
+        let settings = SearchSettings {
+            method: Method::Bo,
+            budget: 40,
+            n_init: Some(2),
+            stop_on_small_ei: true,
+            engine: Some(engine.settings()),
+        };
+        let (trace, snaps) = run_with_snapshots(&ev, &settings, args.first_seed, 201)?;
+        let mut csv = String::from("trials,approach,mean,sd,ei\n");
+        for s in &snaps {
+            for i in 0..s.grid.len() {
+                let _ = writeln!(
+                    csv,
+                    "{},{},{},{},{}",
+                    s.trials, s.grid[i], s.mean[i], s.sd[i], s.ei[i]
+                );
+            }
+        }
+        let mut files = vec![write(dir, &format!("fig{fig}-{object}-model.csv"), &csv)?];
+        let mut samples_csv = String::from("trial,approach,score\n");
+        for (i, (p, y)) in trace.params.iter().zip(&trace.scores).enumerate() {
+            let _ = writeln!(samples_csv, "{},{},{y}", i + 1, p[0]);
+        }
+        files.push(write(
+            dir,
+            &format!("fig{fig}-{object}-samples.csv"),
+            &samples_csv,
+        )?);
+        let truth_scores: Vec<f64> = truth.iter().map(|p| p.score.score).collect();
+        for snap in pick_four(&snaps) {
+            let samples: Vec<(f64, f64)> = trace.params[..snap.trials]
+                .iter()
+                .zip(&trace.scores)
+                .map(|(p, y)| (p[0], *y))
+                .collect();
+            let title = format!("Fig. {fig}: {object}, after {} trials", snap.trials);
+            files.push(write(
+                dir,
+                &format!("fig{fig}-{object}-after-{:02}.svg", snap.trials),
+                &svg::model_plot(&svg::ModelPlot {
+                    title: &title,
+                    xlabel: "approach offset (m)",
+                    xs: &snap.grid,
+                    mean: &snap.mean,
+                    sd: &snap.sd,
+                    ei: &snap.ei,
+                    truth: Some(&truth_scores),
+                    samples: &samples,
+                    next: snap.next,
+                }),
+            )?);
+        }
+        let best = trace.best().map_or(f64::NAN, |b| b.1);
+        let _ = writeln!(
+            report,
+            "| {object} | {}{} | {best:.4} | {:.4} at {:.3} | {} |",
+            trace.scores.len(),
+            if trace.ei_stop_at.is_some() {
+                ""
+            } else {
+                " (budget)"
+            },
+            argmax(&truth).score.score,
+            argmax(&truth).params[0],
+            files.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// Four snapshots like the thesis's panels: the first model, two steps later, halfway, last.
+fn pick_four(snaps: &[Snapshot]) -> Vec<&Snapshot> {
+    let n = snaps.len();
+    let mut idx = vec![0, 2.min(n.saturating_sub(1)), n / 2, n.saturating_sub(1)];
+    idx.sort_unstable();
+    idx.dedup();
+    idx.into_iter().filter_map(|i| snaps.get(i)).collect()
+}
+
+/// A median trial count with the seeds that got there ("-" when fewer than half did).
+fn fmt_median(m: Option<f64>, reached: usize, seeds: usize) -> String {
+    match m {
+        Some(v) => format!("{v} ({reached}/{seeds})"),
+        None => format!("- ({reached}/{seeds})"),
+    }
+}
+
+/// Writes the per-seed counts and the mean/spread curves of a comparison, and its plot.
+fn comparison_files(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    cmp: &Comparison,
+    reference_label: &str,
+) -> Result<Vec<String>> {
+    let mut csv = String::from(
+        "method,seed,trials_to_5pct,trials_to_10pct,trials_to_20pct,ei_stop_at,best\n",
+    );
+    for m in &cmp.methods {
+        for (t, counts) in m.traces.iter().zip(&m.trials_to) {
+            let c = counts.map(|c| c.map_or(String::new(), |n| n.to_string()));
+            let _ = writeln!(
+                csv,
+                "{},{},{},{},{},{},{}",
+                method_name(m.method),
+                t.seed,
+                c[0],
+                c[1],
+                c[2],
+                t.ei_stop_at.map_or(String::new(), |n| n.to_string()),
+                t.best().map_or(f64::NAN, |b| b.1)
+            );
+        }
+    }
+    let mut files = vec![write(dir, &format!("{stem}-seeds.csv"), &csv)?];
+    let mut curves = String::from("method,trial,mean_best,std_best,min_best,max_best\n");
+    for m in &cmp.methods {
+        for i in 0..m.mean_best.len() {
+            let _ = writeln!(
+                curves,
+                "{},{},{},{},{},{}",
+                method_name(m.method),
+                i + 1,
+                m.mean_best[i],
+                m.std_best[i],
+                m.min_best[i],
+                m.max_best[i]
+            );
+        }
+    }
+    files.push(write(dir, &format!("{stem}-curves.csv"), &curves)?);
+    let xs: Vec<f64> = (1..=cmp.budget).map(|i| i as f64).collect();
+    let series: Vec<(&str, Vec<f64>)> = cmp
+        .methods
+        .iter()
+        .map(|m| (method_name(m.method), m.mean_best.clone()))
+        .collect();
+    let bands: Vec<(Vec<f64>, Vec<f64>)> = cmp
+        .methods
+        .iter()
+        .map(|m| {
+            let lo = m
+                .mean_best
+                .iter()
+                .zip(&m.std_best)
+                .map(|(a, s)| a - s)
+                .collect();
+            let hi = m
+                .mean_best
+                .iter()
+                .zip(&m.std_best)
+                .map(|(a, s)| a + s)
+                .collect();
+            (lo, hi)
+        })
+        .collect();
+    files.push(write(
+        dir,
+        &format!("{stem}.svg"),
+        &svg::bands_plot(
+            title,
+            "trial",
+            "best score so far (mean, 1 sd band)",
+            &xs,
+            &series,
+            &bands,
+            Some((cmp.reference, reference_label)),
+        ),
+    )?);
+    Ok(files)
+}
+
+fn summary(cmp: &Comparison, method: Method) -> Result<&MethodSummary> {
+    cmp.methods
+        .iter()
+        .find(|m| m.method == method)
+        .with_context(|| format!("no runs of {}", method_name(method)))
+}
+
+/// Figures 4.18-4.27 and Table 4.1 on every object in 2D.
+fn two_d(
+    dir: &Path,
+    args: &BoArgs,
+    engine: Engine,
+    objects: &[String],
+    steps: &[usize],
+    seeds: &[u64],
+    report: &mut String,
+) -> Result<()> {
+    let grid_size = steps[0] * steps[1];
+    let mut table = format!(
+        "## Table 4.1: grid size versus BO trials (approach x vertical, medians over {} seeds)\n\n\
+         Total: trials until the engine's stopping rule (EI vanished) fired, within a budget of {}; \
+         a seed that never stopped counts as the budget. 5/10/20%: trials to within that much of the grid maximum \
+         (seeds that got there in brackets; a seed that never did counts as budget + 1).\n\n\
+         | object | grid | grid max | BO total | BO 5% | BO 10% | BO 20% | random 5% | random 10% | random 20% | BO best (median) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        seeds.len(),
+        args.budget
+    );
+    let mut maps = String::from(
+        "\n## Figures 4.18-4.24: 2D samples of the first seed over the grid scan\n\n| object | samples (until the stop or the budget) | best sample | file |\n|---|---|---|---|\n",
+    );
+    let mut curves = String::from(
+        "\n## Figures 4.25-4.27: best so far versus trial, BO versus random (mean and 1 sd over seeds; every object)\n\n| object | files |\n|---|---|\n",
+    );
+    let kinds = [ParamKind::Approach, ParamKind::Vertical];
+    for object in objects {
+        let ev = object_evaluator(object, &kinds, args.contacts)?;
+        let (axes, grid) = scan(&ev, steps, args.threads)?;
+        let best = argmax(&grid);
+        let reference = best.score.score;
+        let method = Method::Bo;
+        let template = SearchSettings {
+            method,
+            budget: args.budget,
+            n_init: None,
+            stop_on_small_ei: false,
+            engine: Some(engine.settings()),
+        };
+        let cmp = compare(
+            &ev,
+            &[method, Method::Random],
+            seeds,
+            &template,
+            Some(reference),
+            args.threads,
+        )?;
+        let bo = summary(&cmp, method)?;
+        let random = summary(&cmp, Method::Random)?;
+        let totals: Vec<f64> = bo
+            .traces
+            .iter()
+            .map(|t| t.ei_stop_at.unwrap_or(args.budget) as f64)
+            .collect();
+        let finals: Vec<f64> = bo
+            .traces
+            .iter()
+            .map(|t| t.best().map_or(f64::NAN, |b| b.1))
+            .collect();
+        let cells = |m: &MethodSummary| -> Vec<String> {
+            (0..TARGET_FRACTIONS.len())
+                .map(|k| fmt_median(m.median_trials_to[k], m.reached[k], seeds.len()))
+                .collect()
+        };
+        let (b, r) = (cells(bo), cells(random));
+        let _ = writeln!(
+            table,
+            "| {object} | {grid_size} | {reference:.4} | {} | {} | {} | {} | {} | {} | {} | {:.4} |",
+            median(&totals).unwrap_or(f64::NAN),
+            b[0],
+            b[1],
+            b[2],
+            r[0],
+            r[1],
+            r[2],
+            median(&finals).unwrap_or(f64::NAN)
+        );
+        // Sample map of seed 0.
+        let first = &bo.traces[0];
+        let shown = first.ei_stop_at.unwrap_or(first.scores.len());
+        let samples: Vec<(f64, f64, f64)> = first.params[..shown]
+            .iter()
+            .zip(&first.scores)
+            .map(|(p, y)| (p[0], p[1], *y))
+            .collect();
+        let z: Vec<Vec<f64>> = (0..axes[0].len())
+            .map(|i| {
+                (0..axes[1].len())
+                    .map(|j| crate::commands::scan::touched_score(&grid[i * axes[1].len() + j]))
+                    .collect()
+            })
+            .collect();
+        let map = write(
+            dir,
+            &format!("fig4.18-4.24-{object}-samples.svg"),
+            &svg::samples_map(
+                &format!(
+                    "BO samples on the {object} (seed {}, {shown} trials)",
+                    first.seed
+                ),
+                "approach offset (m)",
+                "vertical offset (m)",
+                (&axes[0], &axes[1], &z),
+                &samples,
+            ),
+        )?;
+        let top = samples
+            .iter()
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .map_or(f64::NAN, |s| s.2);
+        let _ = writeln!(maps, "| {object} | {shown} | {top:.4} | {map} |");
+        let files = comparison_files(
+            dir,
+            &format!("fig4.25-4.27-{object}-bo-vs-random"),
+            &format!("Best so far on the {object}: {} vs random", engine.name()),
+            &cmp,
+            "grid maximum",
+        )?;
+        let _ = writeln!(curves, "| {object} | {} |", files.join(", "));
+        eprintln!("2d {object}: done");
+    }
+    report.push_str(&table);
+    report.push_str(&maps);
+    report.push_str(&curves);
+    Ok(())
+}
+
+/// BO versus random in the 6D pose space (three offsets, three rotations) on every object.
+fn six_d(
+    dir: &Path,
+    args: &BoArgs,
+    engine: Engine,
+    objects: &[String],
+    seeds: &[u64],
+    report: &mut String,
+) -> Result<()> {
+    let checkpoints: Vec<usize> = [25, 50, args.budget_6d]
+        .into_iter()
+        .filter(|&n| n <= args.budget_6d)
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let at: Vec<String> = checkpoints.iter().map(|n| format!("@{n}")).collect();
+    let _ = writeln!(
+        report,
+        "\n## 6D pose space: BO versus random (offsets and rotation vector, budget {}, {} seeds)\n\n\
+         No grid in 6D: the median over seeds of the best score after {} trials, and the trials to within 20% \
+         of the best score any run of either method found (seeds that got there in brackets).\n\n\
+         | object | best of all runs | BO median best {} | random median best {} | BO 20% | random 20% | files |\n|---|---|---|---|---|---|---|",
+        args.budget_6d,
+        seeds.len(),
+        at.join(", "),
+        at.join(" / "),
+        at.join(" / ")
+    );
+    let kinds = [
+        ParamKind::Approach,
+        ParamKind::Lateral,
+        ParamKind::Vertical,
+        ParamKind::RotX,
+        ParamKind::RotY,
+        ParamKind::RotZ,
+    ];
+    for object in objects {
+        let ev = object_evaluator(object, &kinds, args.contacts)?;
+        let method = Method::Bo;
+        let template = SearchSettings {
+            method,
+            budget: args.budget_6d,
+            n_init: None,
+            stop_on_small_ei: false,
+            engine: Some(engine.settings()),
+        };
+        let cmp = compare(
+            &ev,
+            &[method, Method::Random],
+            seeds,
+            &template,
+            None,
+            args.threads,
+        )?;
+        let medians_at = |m: &MethodSummary| -> String {
+            checkpoints
+                .iter()
+                .map(|&n| {
+                    let v: Vec<f64> = m
+                        .traces
+                        .iter()
+                        .filter_map(|t| t.best_so_far().get(n - 1).copied())
+                        .collect();
+                    format!("{:.4}", median(&v).unwrap_or(f64::NAN))
+                })
+                .collect::<Vec<_>>()
+                .join(" / ")
+        };
+        let bo = summary(&cmp, Method::Bo)?;
+        let random = summary(&cmp, Method::Random)?;
+        let twenty =
+            |m: &MethodSummary| fmt_median(m.median_trials_to[2], m.reached[2], seeds.len());
+        let files = comparison_files(
+            dir,
+            &format!("6d-{object}-bo-vs-random"),
+            &format!(
+                "6D, best so far on the {object}: {} vs random",
+                engine.name()
+            ),
+            &cmp,
+            "best of all runs",
+        )?;
+        let _ = writeln!(
+            report,
+            "| {object} | {:.4} | {} | {} | {} | {} | {} |",
+            cmp.reference,
+            medians_at(bo),
+            medians_at(random),
+            twenty(bo),
+            twenty(random),
+            files.join(", ")
+        );
+        eprintln!("6d {object}: done");
+    }
+    Ok(())
+}

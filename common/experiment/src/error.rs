@@ -1,0 +1,23 @@
+//! Errors of an experiment: the engine's, the trial's, or bad settings.
+
+use thiserror::Error;
+
+/// Why an experiment could not run.
+#[derive(Debug, Error)]
+pub enum ExperimentError {
+    /// The optimisation engine refused (bad bounds or settings).
+    #[error("optimizer: {0}")]
+    Optimizer(#[from] graspopt_bayesopt::BoError),
+    /// A trial could not be run or scored.
+    #[error("trial at {params:?}: {source}")]
+    Trial {
+        params: Vec<f64>,
+        source: graspopt_trial::TrialError,
+    },
+    /// A trial scored a value that is not finite.
+    #[error("trial at {params:?} scored {score}, not a finite number")]
+    NonFinite { params: Vec<f64>, score: f64 },
+    /// The experiment's own settings are wrong.
+    #[error("{0}")]
+    Settings(String),
+}

@@ -1,0 +1,25 @@
+//! Bayesian optimisation and its baselines run on simulated grasp trials: the experiments
+//! of thesis sections 4.6-4.8 (1D runs with the model at each step, 2D sample maps, trials
+//! to within 5/10/20% of the grid maximum, BO versus random search over seeds) as data.
+//!
+//! This crate joins the trial evaluator (`graspopt-trial`: parameters in, score out) and the
+//! optimisation engine (`graspopt-bayesopt`). The scores are maximised. It knows nothing of
+//! files, plots or the bus: `graspopt experiment bo` writes what it returns.
+//!
+//! - [`search`]: one seeded run of a method on an evaluator, as a [`Trace`].
+//! - [`target`]: trials to within a fraction of a reference value, medians over seeds.
+//! - [`compare`]: many seeds of several methods in parallel, summarised per method.
+//! - [`snapshot`]: the GP mean, its standard deviation and EI along a 1D space after each step.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod compare;
+pub mod error;
+pub mod search;
+pub mod snapshot;
+pub mod target;
+
+pub use compare::{Comparison, MethodSummary, compare};
+pub use error::ExperimentError;
+pub use search::{Engine, SearchSettings, Trace, run};
+pub use snapshot::{Snapshot, run_with_snapshots};
+pub use target::{TARGET_FRACTIONS, median, trials_to_within};

@@ -1,0 +1,210 @@
+//! One seeded run of a method on a simulated grasp: the engine (with the benchmark or the
+//! thesis settings) or uniform random search, one trial at a time, maximising the score.
+
+use graspopt_bayesopt::benchmark::recommended_settings;
+use graspopt_bayesopt::{AskTell, Method, Optimizer, RandomSearch, Settings, StopReason};
+use graspopt_trial::Evaluator;
+use serde::{Deserialize, Serialize};
+
+use crate::error::ExperimentError;
+
+/// How a run goes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SearchSettings {
+    /// Which method: [`Method::Random`] or an engine run (the engine settings come from
+    /// `engine`, or from the method: `Bo` the benchmark settings, `BoThesis` the thesis's).
+    pub method: Method,
+    /// Trials at most.
+    pub budget: usize,
+    /// Size of the engine's random initial design (None: the engine's default, 5 in 2D).
+    pub n_init: Option<usize>,
+    /// Stop before the budget once the engine says the expected improvement has vanished
+    /// (thesis 3.4); otherwise the run goes on and [`Trace::ei_stop_at`] records when the
+    /// engine would have stopped. Random search always uses the whole budget.
+    pub stop_on_small_ei: bool,
+    /// The engine's settings, replacing [`engine_settings`] of the method (ignored by random
+    /// search; `minimize` is forced off).
+    #[serde(default)]
+    pub engine: Option<Settings>,
+}
+
+/// Which engine settings a BO run uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Engine {
+    /// The thesis's method (Matern 3/2, EI with `xi = sigma_f^2 / 100`, DIRECT, stop when EI
+    /// vanishes) with the bad tail of the scores compressed logarithmically
+    /// (`Settings::for_grasps`). The best measured on the seven objects (docs/benchmarks.md).
+    Grasp,
+    /// The settings tuned on the Branin and Hartmann6 test functions
+    /// (`benchmark::recommended_settings`).
+    Benchmark,
+    /// The thesis's settings as written.
+    Thesis,
+}
+
+impl Engine {
+    /// Every engine, for help texts.
+    pub const ALL: [Engine; 3] = [Engine::Grasp, Engine::Benchmark, Engine::Thesis];
+
+    /// The settings, maximising.
+    pub fn settings(self) -> Settings {
+        let mut s = match self {
+            Engine::Grasp => Settings::for_grasps(),
+            Engine::Benchmark => recommended_settings(),
+            Engine::Thesis => Settings::default(),
+        };
+        s.minimize = false;
+        s
+    }
+
+    /// `grasp`, `benchmark` or `thesis`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Grasp => "grasp",
+            Engine::Benchmark => "benchmark",
+            Engine::Thesis => "thesis",
+        }
+    }
+
+    /// Parses [`Engine::name`].
+    pub fn parse(name: &str) -> Result<Self, ExperimentError> {
+        Engine::ALL
+            .into_iter()
+            .find(|e| e.name() == name)
+            .ok_or_else(|| {
+                ExperimentError::Settings(format!(
+                    "unknown engine {name:?}: expected grasp, benchmark or thesis"
+                ))
+            })
+    }
+}
+
+/// The trials of one run, in order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Trace {
+    pub method: Method,
+    pub seed: u64,
+    /// Parameters of each trial (the trial space's units).
+    pub params: Vec<Vec<f64>>,
+    /// Score of each trial.
+    pub scores: Vec<f64>,
+    /// Trials after which the engine first said the expected improvement had vanished
+    /// (its stopping rule, thesis 3.4), if it did.
+    pub ei_stop_at: Option<usize>,
+}
+
+impl Trace {
+    /// The best score after each trial.
+    pub fn best_so_far(&self) -> Vec<f64> {
+        let mut best = f64::NEG_INFINITY;
+        self.scores
+            .iter()
+            .map(|s| {
+                best = best.max(*s);
+                best
+            })
+            .collect()
+    }
+
+    /// The best trial: its index and score.
+    pub fn best(&self) -> Option<(usize, f64)> {
+        self.scores
+            .iter()
+            .copied()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+}
+
+enum Searcher {
+    Engine(Box<Optimizer>),
+    Random(RandomSearch),
+}
+
+impl Searcher {
+    fn ask_tell(&mut self) -> &mut dyn AskTell {
+        match self {
+            Searcher::Engine(o) => o.as_mut(),
+            Searcher::Random(r) => r,
+        }
+    }
+}
+
+/// Scores `params`, refusing a score that is not finite.
+pub(crate) fn score(ev: &Evaluator, params: &[f64]) -> Result<f64, ExperimentError> {
+    let score = ev.score(params).map_err(|source| ExperimentError::Trial {
+        params: params.to_vec(),
+        source,
+    })?;
+    if !score.is_finite() {
+        return Err(ExperimentError::NonFinite {
+            params: params.to_vec(),
+            score,
+        });
+    }
+    Ok(score)
+}
+
+/// Runs `settings.method` on `ev` with `seed`.
+pub fn run(ev: &Evaluator, settings: &SearchSettings, seed: u64) -> Result<Trace, ExperimentError> {
+    run_observed(ev, settings, seed, &mut |_, _| Ok(()))
+}
+
+/// [`run`], calling `after(engine, trace)` after every trial of an engine run.
+pub(crate) fn run_observed(
+    ev: &Evaluator,
+    settings: &SearchSettings,
+    seed: u64,
+    after: &mut dyn FnMut(&Optimizer, &Trace) -> Result<(), ExperimentError>,
+) -> Result<Trace, ExperimentError> {
+    if settings.budget == 0 {
+        return Err(ExperimentError::Settings(
+            "the budget must be at least one trial".into(),
+        ));
+    }
+    let bounds = ev.space.bounds();
+    let engine = match (&settings.engine, settings.method) {
+        (_, Method::Random) => None,
+        (Some(custom), _) => Some(Settings {
+            minimize: false,
+            ..custom.clone()
+        }),
+        (None, Method::Bo) => Some(Engine::Benchmark.settings()),
+        (None, Method::BoThesis) => Some(Engine::Thesis.settings()),
+    };
+    let mut searcher = match engine {
+        Some(mut s) => {
+            s.n_init = settings.n_init.or(s.n_init);
+            Searcher::Engine(Box::new(Optimizer::new(&bounds, s, seed)?))
+        }
+        None => Searcher::Random(RandomSearch::new(&bounds, false, seed)?),
+    };
+    let mut trace = Trace {
+        method: settings.method,
+        seed,
+        params: Vec::with_capacity(settings.budget),
+        scores: Vec::with_capacity(settings.budget),
+        ei_stop_at: None,
+    };
+    while trace.scores.len() < settings.budget {
+        let next = searcher.ask_tell().suggest(1)?;
+        for p in next {
+            let y = score(ev, &p)?;
+            searcher.ask_tell().observe(&p, y)?;
+            trace.params.push(p);
+            trace.scores.push(y);
+        }
+        if let Searcher::Engine(opt) = &searcher {
+            after(opt, &trace)?;
+            if trace.ei_stop_at.is_none()
+                && opt.stop_reason() == Some(StopReason::SmallExpectedImprovement)
+            {
+                trace.ei_stop_at = Some(trace.scores.len());
+                if settings.stop_on_small_ei {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(trace)
+}
