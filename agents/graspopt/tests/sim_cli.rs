@@ -184,11 +184,11 @@ fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
         "--budget",
         "8",
         "--budget-6d",
-        "6",
+        "12",
         "--steps",
         "5,3",
         "--objects",
-        "sphere,mug",
+        "sphere,mug,sphere",
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -207,8 +207,10 @@ fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
     ] {
         assert!(report.contains(heading), "report lacks {heading}");
     }
-    // Table 4.1 has a row per object with the 15-point grid.
-    assert!(report.contains("| sphere | 15 |") && report.contains("| mug | 15 |"));
+    // Table 4.1 has one row per object (the repeated name runs once) with the 15-point grid
+    // and the thesis's figures beside.
+    assert_eq!(report.matches("| sphere | 15 |").count(), 1, "{report}");
+    assert!(report.contains("| mug | 15 |") && report.contains("331 / 55 / 55 / 1 |"));
     let mut named = 0;
     for word in report.split(|c: char| c.is_whitespace() || c == ',' || c == '|') {
         if word.ends_with(".svg") || word.ends_with(".csv") {
@@ -225,22 +227,62 @@ fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
     assert_eq!(rows.len(), 4, "{seeds}");
     assert!(rows[0].starts_with("bo,0,") && rows[3].starts_with("random,1,"));
     let curves = std::fs::read_to_string(dir.join("6d-sphere-bo-vs-random-curves.csv")).unwrap();
-    assert_eq!(curves.lines().count(), 1 + 2 * 6);
+    assert_eq!(curves.lines().count(), 1 + 2 * 12);
+    // The 1D samples name the EI at which the engine chose each trial from the third on.
+    let samples = std::fs::read_to_string(dir.join("fig4.16-sphere-samples.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = samples
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert!(
+        rows.len() >= 3 && rows[..2].iter().all(|r| r[3].is_empty()),
+        "{samples}"
+    );
+    assert!(rows[2][3].parse::<f64>().unwrap() > 0.0, "{samples}");
 }
 
 #[test]
 fn experiment_bo_bad_input_is_named() {
+    let dir = tempdir("experiment-bo-bad");
     for (args, expected) in [
-        (vec!["--engine", "magic"], "unknown engine \"magic\""),
+        (
+            vec!["--engine", "magic"],
+            "invalid value 'magic' for '--engine",
+        ),
         (vec!["--objects", "teapot"], "unknown object `teapot`"),
-        (vec!["--steps", "5"], "--steps \"5\""),
-        (vec!["--seeds", "0"], "--seeds must be at least 1"),
+        (
+            vec!["--objects", "sphere,,mug"],
+            "--objects has an empty name",
+        ),
+        (vec!["--steps", "5"], "--steps \"5\": expected two counts"),
+        (
+            vec!["--steps", "5,100000"],
+            "each count must be between 2 and 1000",
+        ),
+        (vec!["--seeds", "0"], "--seeds must be between 1 and 1000"),
+        (
+            vec!["--first-seed", "18446744073709551615"],
+            "--first-seed + --seeds must stay below 2^64",
+        ),
+        (
+            vec!["--parts", "2d", "--budget", "5"],
+            "--budget must be more than the engine's 5 random initial trials in 2D",
+        ),
+        (
+            vec!["--parts", "6d", "--budget-6d", "10"],
+            "--budget-6d must be more than the engine's 10 random initial trials in 6D",
+        ),
     ] {
-        let mut all = vec!["experiment", "bo", "--parts", "1d"];
+        let mut all = vec!["experiment", "bo", "--out", dir.to_str().unwrap()];
         all.extend(args);
         let out = graspopt(&all);
         assert!(!out.status.success());
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(expected), "{err}");
     }
+    assert!(
+        !dir.join("report.md").exists(),
+        "a refused run wrote a report"
+    );
 }

@@ -203,7 +203,7 @@ pub struct LevelSummary {
     /// Seeds run.
     pub seeds: usize,
     /// Median evaluations, counting seeds that never reached it as `budget + 1`
-    /// (None if fewer than half reached it).
+    /// (None unless more than half reached it, so the median is an evaluation count).
     pub median_evals: Option<f64>,
     /// Median rounds, same convention.
     pub median_rounds: Option<f64>,
@@ -224,7 +224,7 @@ pub fn aggregate(summaries: &[SeedSummary], budget: usize, q: usize) -> Vec<Leve
                 .iter()
                 .map(|s| s.rounds_to[k].map_or(rounds_for(budget, q) as f64 + 1.0, |e| e as f64))
                 .collect();
-            let ok = 2 * reached >= summaries.len() && !summaries.is_empty();
+            let ok = 2 * reached > summaries.len();
             LevelSummary {
                 level: REGRET_LEVELS[k],
                 reached,

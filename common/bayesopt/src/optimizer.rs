@@ -47,7 +47,8 @@ pub struct StopRule {
     pub budget: Option<usize>,
     /// Stop on small EI only after this many observations (None: 10 x d).
     pub min_evals: Option<usize>,
-    /// Threshold on the best EI divided by the observed range of y.
+    /// Threshold on the best EI divided by the observed range of y (of the current epoch,
+    /// after the output transform if any; see [`RoundInfo::relative_ei`]).
     pub relative_ei_threshold: f64,
     /// Number of consecutive proposal rounds below the threshold needed to stop.
     pub patience: usize,
@@ -229,7 +230,8 @@ impl Settings {
 pub struct RoundInfo {
     /// EI (standardised units) at the first model-based proposal of the round.
     pub best_ei: Option<f64>,
-    /// The same divided by the observed range of y (raw units).
+    /// The same divided by the range of the modelled outputs (the observed range of y of
+    /// the current epoch, after the output transform if any).
     pub relative_ei: Option<f64>,
     /// xi used (standardised units).
     pub xi: Option<f64>,
@@ -716,19 +718,28 @@ impl Optimizer {
         Ok(gp)
     }
 
+    /// The GP of the current epoch's observations with the last fit's hyperparameters (the
+    /// prior's before the first fit), and the standardisation its outputs went through (its
+    /// `x` moved into the GP). Needs at least one observation.
+    fn current_model(&self) -> Result<(Gp, Standardised)> {
+        if self.xs.is_empty() {
+            return Err(BoError::NotEnoughData("no observation yet".into()));
+        }
+        let mut data = self.standardised();
+        let h = self.hyper.clone().unwrap_or_else(|| {
+            Hyperparameters::from_theta(&self.settings.fit.prior_mean(self.dim()))
+        });
+        let x = std::mem::take(&mut data.x);
+        let gp = Gp::new(x, data.y.clone(), h.kernel(self.settings.kernel), h.noise)?;
+        Ok((gp, data))
+    }
+
     /// Posterior mean and standard deviation of the objective at `x` (raw units, the user's
     /// sign convention), with the hyperparameters of the last fit (prior ones before the
     /// first). Needs at least one observation.
     pub fn predict(&self, x: &[f64]) -> Result<(f64, f64)> {
         self.check_point(x)?;
-        if self.xs.is_empty() {
-            return Err(BoError::NotEnoughData("no observation yet".into()));
-        }
-        let data = self.standardised();
-        let h = self.hyper.clone().unwrap_or_else(|| {
-            Hyperparameters::from_theta(&self.settings.fit.prior_mean(self.dim()))
-        });
-        let gp = Gp::new(data.x, data.y, h.kernel(self.settings.kernel), h.noise)?;
+        let (gp, data) = self.current_model()?;
         let (m, v) = gp.predict(&self.to_unit(x));
         let sign = if self.settings.minimize { -1.0 } else { 1.0 };
         let w = data.mean + data.std * m;
@@ -739,21 +750,16 @@ impl Optimizer {
         })
     }
 
-    /// Expected improvement at `x` as the next proposal round sees it before any pending
-    /// point: standardised (and transformed) outputs, the last fit's hyperparameters, `xi`
-    /// from the settings, against the best observation of the current epoch. Needs at least
-    /// one observation.
+    /// Expected improvement at `x` under the current model: the current epoch's outputs
+    /// standardised (and transformed), the last fit's hyperparameters, `xi` from the
+    /// settings, against the best observation; pending points are ignored. Called right
+    /// after a one-point [`Optimizer::suggest`] (before its point is observed), this is the
+    /// acquisition that round maximised, without restart penalties or diversification.
+    /// Needs at least one observation.
     pub fn expected_improvement(&self, x: &[f64]) -> Result<f64> {
         self.check_point(x)?;
-        if self.xs.is_empty() {
-            return Err(BoError::NotEnoughData("no observation yet".into()));
-        }
-        let data = self.standardised();
+        let (gp, data) = self.current_model()?;
         let best = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let h = self.hyper.clone().unwrap_or_else(|| {
-            Hyperparameters::from_theta(&self.settings.fit.prior_mean(self.dim()))
-        });
-        let gp = Gp::new(data.x, data.y, h.kernel(self.settings.kernel), h.noise)?;
         let xi = self.settings.xi.xi(gp.kernel().signal_variance);
         let (m, v) = gp.predict(&self.to_unit(x));
         Ok(crate::acquisition::expected_improvement(m, v, best, xi))
@@ -869,11 +875,14 @@ impl Optimizer {
                 };
                 if info.best_ei.is_none() {
                     info.best_ei = Some(ei);
-                    let ymax = self.ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                    let ymin = self.ys.iter().copied().fold(f64::INFINITY, f64::min);
+                    // The range of the modelled outputs (standardised, after the output
+                    // transform, this epoch): without a transform, EI over the observed range
+                    // of y; with one, a few compressed misses do not inflate the range.
+                    let ymax = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    let ymin = data.y.iter().copied().fold(f64::INFINITY, f64::min);
                     let range = ymax - ymin;
                     let rel = if range > 0.0 {
-                        ei * data.std / range
+                        ei / range
                     } else {
                         f64::INFINITY
                     };

@@ -1,163 +1,76 @@
-//! Tries engine settings on the 2D grasp landscapes of the seven objects: per variant, the
-//! median trials to within 5% of the grid maximum over seeds, next to random search.
-//! `cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
+//! Tries engine settings on the 2D grasp landscapes of the built-in objects: per variant, the
+//! median trials to within 5% of the grid maximum (67 x 33 grid) over seeds. This is how the
+//! `grasp` engine was chosen (docs/benchmarks.md).
+//!
+//! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
+//! with variants `random`, `thesis`, `benchmark`, `grasp` and `grasp-` followed by one change:
+//! `rank`, `xi0`, `init3`, `init8`, `m52`, `pm` (pessimistic prior mean), `m52-pm`, `noise`
+//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`.
 
-use graspopt_bayesopt::{
-    Method, OutputTransform, Settings, XiRule, benchmark::recommended_settings,
-};
+use graspopt_bayesopt::benchmark::recommended_settings;
+use graspopt_bayesopt::{AcquisitionKind, KernelKind, Method, OutputTransform, Settings, XiRule};
 use graspopt_experiment::{SearchSettings, compare};
 use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::{Object, ParamKind, TrialSpace};
+use graspopt_sim::{Object, TrialSpace};
 use graspopt_trial::Evaluator;
 use graspopt_trial::scan::{linspace, scan_grid};
 
 fn variant(name: &str) -> Option<Settings> {
-    let t = Settings::default();
-    let b = recommended_settings();
-    Some(match name {
-        "thesis" => t,
-        "bo" => b,
-        "thesis-tail" => Settings {
-            output_transform: OutputTransform::TailLog,
-            ..t
-        },
-        "thesis-rank" => Settings {
-            output_transform: OutputTransform::Rank,
-            ..t
-        },
-        "thesis-xi0" => Settings {
-            xi: XiRule::Fixed(0.0),
-            ..t
-        },
-        "thesis-init8" => Settings {
-            n_init: Some(8),
-            ..t
-        },
-        "thesis-init3" => Settings {
-            n_init: Some(3),
-            ..t
-        },
-        "thesis-div2" => Settings {
-            diversify_every: 2,
-            ..t
-        },
-        "thesis-tail-div2" => Settings {
-            diversify_every: 2,
-            output_transform: OutputTransform::TailLog,
-            ..t
-        },
-        "bo-norestart" => Settings { restart: None, ..b },
-        "bo-nodiv" => Settings {
-            diversify_every: 0,
-            ..b
-        },
-        "bo-nopm" => Settings {
-            prior_mean_quantile: None,
-            ..b
-        },
-        "bo-thesisxi" => Settings {
-            xi: XiRule::ThesisSignalVariance,
-            ..b
-        },
-        "bo-none" => Settings {
-            output_transform: OutputTransform::None,
-            ..b
-        },
-        "tail-noise" => Settings {
-            output_transform: OutputTransform::TailLog,
-            fit: graspopt_bayesopt::FitSettings {
-                noise_log_mean: 1e-2f64.ln(),
-                ..t.fit.clone()
-            },
-            ..t.clone()
-        },
-        "tail-ls01" => Settings {
-            output_transform: OutputTransform::TailLog,
-            fit: graspopt_bayesopt::FitSettings {
-                length_scale_log_mean: 0.1f64.ln(),
-                ..t.fit.clone()
-            },
-            ..t.clone()
-        },
-        "tail-ucb" => Settings {
-            output_transform: OutputTransform::TailLog,
-            acquisition: graspopt_bayesopt::AcquisitionKind::Ucb { beta: 4.0 },
-            ..t.clone()
-        },
-        "tail-xi0" => Settings {
-            output_transform: OutputTransform::TailLog,
-            xi: XiRule::Fixed(0.0),
-            ..t.clone()
-        },
-        "tail-init8" => Settings {
-            output_transform: OutputTransform::TailLog,
-            n_init: Some(8),
-            ..t.clone()
-        },
-        "tail-init3" => Settings {
-            output_transform: OutputTransform::TailLog,
-            n_init: Some(3),
-            ..t.clone()
-        },
-        "tail-m52" => Settings {
-            output_transform: OutputTransform::TailLog,
-            kernel: graspopt_bayesopt::KernelKind::Matern52,
-            ..t.clone()
-        },
-        "tail-pm" => Settings {
-            output_transform: OutputTransform::TailLog,
-            prior_mean_quantile: Some(0.0),
-            ..t.clone()
-        },
-        "tail-restart" => Settings {
-            output_transform: OutputTransform::TailLog,
-            restart: b.restart,
-            ..t.clone()
-        },
-        "tail-explore" => Settings {
-            output_transform: OutputTransform::TailLog,
-            explore_below_ei: Some(1e-3),
-            ..t.clone()
-        },
-        "tail-m52-pm" => Settings {
-            output_transform: OutputTransform::TailLog,
-            kernel: graspopt_bayesopt::KernelKind::Matern52,
-            prior_mean_quantile: Some(0.0),
-            ..t.clone()
-        },
-        "random" => t,
+    let grasp = Settings::for_grasps();
+    let mut s = match name {
+        "random" | "thesis" => return Some(Settings::default()),
+        "benchmark" => return Some(recommended_settings()),
+        "grasp" => return Some(grasp),
+        _ => grasp.clone(),
+    };
+    match name.strip_prefix("grasp-")? {
+        "rank" => s.output_transform = OutputTransform::Rank,
+        "xi0" => s.xi = XiRule::Fixed(0.0),
+        "init3" => s.n_init = Some(3),
+        "init8" => s.n_init = Some(8),
+        "m52" => s.kernel = KernelKind::Matern52,
+        "pm" => s.prior_mean_quantile = Some(0.0),
+        "m52-pm" => {
+            s.kernel = KernelKind::Matern52;
+            s.prior_mean_quantile = Some(0.0);
+        }
+        "noise" => s.fit.noise_log_mean = 1e-2f64.ln(),
+        "ls01" => s.fit.length_scale_log_mean = 0.1f64.ln(),
+        "ucb" => s.acquisition = AcquisitionKind::Ucb { beta: 4.0 },
+        "explore" => s.explore_below_ei = Some(1e-3),
+        "restart" => s.restart = recommended_settings().restart,
         _ => return None,
-    })
+    }
+    Some(s)
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let seeds: u64 = args[0].parse().expect("seeds");
-    let budget: usize = args[1].parse().expect("budget");
-    let all = [
-        "sphere",
-        "wine_glass",
-        "cylinder",
-        "mug",
-        "cuboid",
-        "rotated_cuboid",
-        "star_prism",
-    ];
+    let (Some(seeds), Some(budget)) = (
+        args.first().and_then(|s| s.parse::<u64>().ok()),
+        args.get(1).and_then(|s| s.parse::<usize>().ok()),
+    ) else {
+        eprintln!("usage: tune SEEDS BUDGET VARIANT...");
+        std::process::exit(2);
+    };
     let only = std::env::var("OBJECTS").unwrap_or_default();
-    let objects: Vec<&str> = all
-        .into_iter()
-        .filter(|o| only.is_empty() || only.split(',').any(|x| x == *o))
-        .collect();
-    let mut evs = Vec::new();
-    for o in objects {
-        let object = Object::by_name(o).expect("object");
-        let full = TrialSpace::full_6d(&object);
-        let params = [ParamKind::Approach, ParamKind::Vertical]
-            .iter()
-            .map(|k| *full.params.iter().find(|p| p.kind == *k).expect("param"))
-            .collect();
-        let space = TrialSpace::new(full.reference, params).expect("space");
-        let ev = Evaluator::new(object, hand_by_name("barrett").expect("hand"), space);
+    let seed0: u64 = std::env::var("SEED0")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let seeds: Vec<u64> = (seed0..seed0 + seeds).collect();
+    let mut landscapes = Vec::new();
+    for name in Object::names() {
+        if !only.is_empty() && !only.split(',').any(|o| o == name) {
+            continue;
+        }
+        let object = Object::by_name(name).expect("a built-in object");
+        let space = TrialSpace::approach_vertical_2d(&object);
+        let ev = Evaluator::new(
+            object,
+            hand_by_name("barrett").expect("the Barrett hand"),
+            space,
+        );
         let axes: Vec<Vec<f64>> = ev
             .space
             .bounds()
@@ -165,18 +78,13 @@ fn main() {
             .zip([67, 33])
             .map(|(&(l, h), n)| linspace(l, h, n))
             .collect();
-        let grid = scan_grid(&ev, &axes, 0, &|_| {}).expect("scan");
+        let grid = scan_grid(&ev, &axes, 0, &|_| {}).expect("the grid scan");
         let max = grid
             .iter()
             .map(|p| p.score.score)
             .fold(f64::NEG_INFINITY, f64::max);
-        evs.push((o, ev, max));
+        landscapes.push((name, ev, max));
     }
-    let seed0: u64 = std::env::var("SEED0")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    let seeds: Vec<u64> = (seed0..seed0 + seeds).collect();
     for name in &args[2..] {
         let Some(settings) = variant(name) else {
             eprintln!("unknown variant {name}");
@@ -194,22 +102,13 @@ fn main() {
             stop_on_small_ei: false,
             engine: Some(settings),
         };
-        let t0 = std::time::Instant::now();
-        let mut line = format!("{name:>18}:");
-        let mut worst: f64 = 0.0;
-        for (o, ev, max) in &evs {
-            let c = compare(ev, &[method], &seeds, &template, Some(*max), 0).expect("compare");
+        let mut line = format!("{name:>14}:");
+        for (object, ev, max) in &landscapes {
+            let c = compare(ev, &[method], &seeds, &template, Some(*max), 0).expect("the runs");
             let m = &c.methods[0];
-            let v = m.median_trials_to[0].unwrap_or(f64::INFINITY);
-            worst = worst.max(v);
-            line += &format!(
-                " {}={}({}/{})",
-                o.get(..4).unwrap_or(o),
-                v,
-                m.reached[0],
-                seeds.len()
-            );
+            let median = m.median_trials_to[0].map_or("-".to_string(), |v| v.to_string());
+            line += &format!(" {object}={median}({}/{})", m.reached[0], seeds.len());
         }
-        println!("{line}  worst={worst} [{:.0}s]", t0.elapsed().as_secs_f64());
+        println!("{line}");
     }
 }

@@ -25,7 +25,7 @@ pub struct MethodSummary {
     /// Seeds that got within each fraction.
     pub reached: [usize; 3],
     /// Median trials to each fraction, a seed that never got there counted as budget + 1;
-    /// None when fewer than half the seeds got there.
+    /// None unless more than half the seeds got there (so the median is a trial count).
     pub median_trials_to: [Option<f64>; 3],
     /// Mean over seeds of the best score after each trial (a run that stopped early keeps
     /// its last best).
@@ -87,9 +87,8 @@ pub fn compare(
             });
         }
     });
-    let results = results
-        .into_inner()
-        .map_err(|_| ExperimentError::Settings("a comparison worker panicked".into()))?;
+    // A worker's panic is re-raised by the scope, so a poisoned lock cannot be seen here.
+    let results = results.into_inner().unwrap_or_else(|e| e.into_inner());
     let mut traces = Vec::with_capacity(jobs.len());
     for r in results {
         traces.push(
@@ -116,7 +115,13 @@ pub fn compare(
     })
 }
 
-fn summarise(method: Method, traces: Vec<Trace>, reference: f64, budget: usize) -> MethodSummary {
+/// Summarises one method's runs against `reference` (`budget`: the trials per run).
+pub fn summarise(
+    method: Method,
+    traces: Vec<Trace>,
+    reference: f64,
+    budget: usize,
+) -> MethodSummary {
     let curves: Vec<Vec<f64>> = traces.iter().map(Trace::best_so_far).collect();
     let trials_to: Vec<[Option<usize>; 3]> = curves
         .iter()
@@ -130,7 +135,7 @@ fn summarise(method: Method, traces: Vec<Trace>, reference: f64, budget: usize) 
             .iter()
             .map(|t| t[k].map_or(budget as f64 + 1.0, |n| n as f64))
             .collect();
-        if 2 * reached[k] >= traces.len() {
+        if 2 * reached[k] > traces.len() {
             median_trials_to[k] = median(&counts);
         }
     }
@@ -159,5 +164,59 @@ fn summarise(method: Method, traces: Vec<Trace>, reference: f64, budget: usize) 
         std_best,
         min_best,
         max_best,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trace(scores: &[f64]) -> Trace {
+        Trace {
+            method: Method::Random,
+            seed: 0,
+            params: scores.iter().map(|_| vec![0.0]).collect(),
+            scores: scores.to_vec(),
+            ei_stop_at: None,
+        }
+    }
+
+    /// Four seeds against the reference 1.0, `reaching` of them within 5% (from 0.95).
+    fn runs(reaching: usize) -> Vec<Trace> {
+        let good = [
+            trace(&[0.0, 0.96, 0.96, 0.96]),
+            trace(&[0.0, 0.5, 0.97, 0.97]),
+            trace(&[0.0, 0.5, 0.97, 0.97]),
+        ];
+        (0..4)
+            .map(|i| {
+                if i < reaching {
+                    good[i].clone()
+                } else {
+                    trace(&[0.0, 0.5, 0.6, 0.7])
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn medians_are_trial_counts_only_when_most_seeds_got_there() {
+        // Two of four: no median (it would average 3 and the 'never' count, 5).
+        let half = summarise(Method::Random, runs(2), 1.0, 4);
+        assert_eq!(half.reached[0], 2);
+        assert_eq!(half.median_trials_to[0], None);
+        // Three of four: the median of 2, 3, 3 and 5 is 3.
+        let most = summarise(Method::Random, runs(3), 1.0, 4);
+        assert_eq!(
+            most.trials_to.iter().map(|t| t[0]).collect::<Vec<_>>(),
+            vec![Some(2), Some(3), Some(3), None]
+        );
+        assert_eq!(most.median_trials_to[0], Some(3.0));
+        // Within 20% (from 0.8): the same three seeds.
+        assert_eq!(most.reached[2], 3);
+        // The curves, per trial over the four seeds.
+        assert_eq!(most.mean_best[1], (0.96 + 0.5 + 0.5 + 0.5) / 4.0);
+        assert_eq!(most.max_best[3], 0.97);
+        assert_eq!(most.min_best[3], 0.7);
     }
 }

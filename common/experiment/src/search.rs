@@ -22,8 +22,8 @@ pub struct SearchSettings {
     /// (thesis 3.4); otherwise the run goes on and [`Trace::ei_stop_at`] records when the
     /// engine would have stopped. Random search always uses the whole budget.
     pub stop_on_small_ei: bool,
-    /// The engine's settings, replacing [`engine_settings`] of the method (ignored by random
-    /// search; `minimize` is forced off).
+    /// The engine's settings, replacing the method's (`Bo`: [`Engine::Benchmark`],
+    /// `BoThesis`: [`Engine::Thesis`]); ignored by random search; `minimize` is forced off.
     #[serde(default)]
     pub engine: Option<Settings>,
 }
@@ -43,9 +43,6 @@ pub enum Engine {
 }
 
 impl Engine {
-    /// Every engine, for help texts.
-    pub const ALL: [Engine; 3] = [Engine::Grasp, Engine::Benchmark, Engine::Thesis];
-
     /// The settings, maximising.
     pub fn settings(self) -> Settings {
         let mut s = match self {
@@ -64,18 +61,6 @@ impl Engine {
             Engine::Benchmark => "benchmark",
             Engine::Thesis => "thesis",
         }
-    }
-
-    /// Parses [`Engine::name`].
-    pub fn parse(name: &str) -> Result<Self, ExperimentError> {
-        Engine::ALL
-            .into_iter()
-            .find(|e| e.name() == name)
-            .ok_or_else(|| {
-                ExperimentError::Settings(format!(
-                    "unknown engine {name:?}: expected grasp, benchmark or thesis"
-                ))
-            })
     }
 }
 
@@ -147,15 +132,21 @@ pub(crate) fn score(ev: &Evaluator, params: &[f64]) -> Result<f64, ExperimentErr
 
 /// Runs `settings.method` on `ev` with `seed`.
 pub fn run(ev: &Evaluator, settings: &SearchSettings, seed: u64) -> Result<Trace, ExperimentError> {
-    run_observed(ev, settings, seed, &mut |_, _| Ok(()))
+    run_observed(ev, settings, seed, &mut |_, _, _| Ok(()))
 }
 
-/// [`run`], calling `after(engine, trace)` after every trial of an engine run.
+/// Called after each proposal round of an engine run with the engine, the trials so far and
+/// the points proposed.
+pub(crate) type OnProposal<'a> =
+    dyn FnMut(&Optimizer, &Trace, &[Vec<f64>]) -> Result<(), ExperimentError> + 'a;
+
+/// [`run`], calling `proposed(engine, trace, points)` after every proposal round of an
+/// engine run, before its points are scored and observed.
 pub(crate) fn run_observed(
     ev: &Evaluator,
     settings: &SearchSettings,
     seed: u64,
-    after: &mut dyn FnMut(&Optimizer, &Trace) -> Result<(), ExperimentError>,
+    proposed: &mut OnProposal,
 ) -> Result<Trace, ExperimentError> {
     if settings.budget == 0 {
         return Err(ExperimentError::Settings(
@@ -188,21 +179,22 @@ pub(crate) fn run_observed(
     };
     while trace.scores.len() < settings.budget {
         let next = searcher.ask_tell().suggest(1)?;
+        if let Searcher::Engine(opt) = &searcher {
+            proposed(opt, &trace, &next)?;
+        }
         for p in next {
             let y = score(ev, &p)?;
             searcher.ask_tell().observe(&p, y)?;
             trace.params.push(p);
             trace.scores.push(y);
         }
-        if let Searcher::Engine(opt) = &searcher {
-            after(opt, &trace)?;
-            if trace.ei_stop_at.is_none()
-                && opt.stop_reason() == Some(StopReason::SmallExpectedImprovement)
-            {
-                trace.ei_stop_at = Some(trace.scores.len());
-                if settings.stop_on_small_ei {
-                    break;
-                }
+        if let Searcher::Engine(opt) = &searcher
+            && trace.ei_stop_at.is_none()
+            && opt.stop_reason() == Some(StopReason::SmallExpectedImprovement)
+        {
+            trace.ei_stop_at = Some(trace.scores.len());
+            if settings.stop_on_small_ei {
+                break;
             }
         }
     }

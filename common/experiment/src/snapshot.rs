@@ -1,6 +1,6 @@
-//! A 1D run with the model at every step (thesis figures 4.16-4.17): after each trial, the
-//! GP posterior mean and standard deviation and the expected improvement along the whole
-//! parameter range, with the samples so far and the trial proposed next.
+//! A 1D run with the model at every step (thesis figures 4.16-4.17): before each trial from
+//! the third on, the model that chose it (GP posterior mean and standard deviation and the
+//! expected improvement along the whole parameter range) and the trial it chose.
 
 use graspopt_trial::Evaluator;
 use graspopt_trial::scan::linspace;
@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::ExperimentError;
 use crate::search::{SearchSettings, Trace, run_observed};
 
-/// The model after some trials of a 1D run.
+/// The model of a 1D run after some trials, as it chose the next trial.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Snapshot {
     /// Trials observed.
@@ -23,12 +23,16 @@ pub struct Snapshot {
     /// Expected improvement as the engine sees it (`Optimizer::expected_improvement`: its
     /// standardised, transformed units, with its `xi`).
     pub ei: Vec<f64>,
-    /// The trial proposed next, if the run went on.
-    pub next: Option<f64>,
+    /// The trial it chose next.
+    pub next: f64,
+    /// The expected improvement there (the maximum the engine found; it can lie between
+    /// grid values, above every value of `ei`).
+    pub next_ei: f64,
 }
 
-/// Runs an engine method on a one-parameter `ev` and returns the run and a snapshot after
-/// every trial from the second on, on a grid of `points` values.
+/// Runs an engine method on a one-parameter `ev` and returns the run and, on a grid of
+/// `points` values, a snapshot of the model that chose each trial from the third on (a model
+/// needs two observations).
 pub fn run_with_snapshots(
     ev: &Evaluator,
     settings: &SearchSettings,
@@ -49,7 +53,10 @@ pub fn run_with_snapshots(
     let (lo, hi) = ev.space.bounds()[0];
     let grid = linspace(lo, hi, points);
     let mut snaps: Vec<Snapshot> = Vec::new();
-    let mut take = |opt: &graspopt_bayesopt::Optimizer, trace: &Trace| {
+    let mut take = |opt: &graspopt_bayesopt::Optimizer, trace: &Trace, next: &[Vec<f64>]| {
+        let Some(next) = next.first().and_then(|p| p.first()).copied() else {
+            return Ok(());
+        };
         if trace.scores.len() < 2 {
             return Ok(());
         }
@@ -59,7 +66,8 @@ pub fn run_with_snapshots(
             mean: Vec::with_capacity(points),
             sd: Vec::with_capacity(points),
             ei: Vec::with_capacity(points),
-            next: None,
+            next,
+            next_ei: opt.expected_improvement(&[next])?,
         };
         for &x in &grid {
             let (m, s) = opt.predict(&[x])?;
@@ -76,8 +84,5 @@ pub fn run_with_snapshots(
         ));
     }
     let trace = run_observed(ev, settings, seed, &mut take)?;
-    for s in &mut snaps {
-        s.next = trace.params.get(s.trials).map(|p| p[0]);
-    }
     Ok((trace, snaps))
 }

@@ -41,6 +41,16 @@ pub enum Contacts {
     Mean,
 }
 
+impl From<Contacts> for ContactModel {
+    fn from(c: Contacts) -> Self {
+        match c {
+            Contacts::Surface => ContactModel::Surface,
+            Contacts::Patch => ContactModel::CircularPatch,
+            Contacts::Mean => ContactModel::MeanPoint,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Frame {
     Object,
@@ -64,11 +74,7 @@ impl SimArgs {
         let space = space_for(&object, kinds)?;
         let hand = hand_by_name(&self.hand)?;
         let mut ev = Evaluator::new(object, hand, space);
-        ev.score.contacts = match self.contacts {
-            Contacts::Surface => ContactModel::Surface,
-            Contacts::Patch => ContactModel::CircularPatch,
-            Contacts::Mean => ContactModel::MeanPoint,
-        };
+        ev.score.contacts = self.contacts.into();
         ev.score.metric = Metric::parse(&self.metric)?;
         ev.score.frame = match self.frame {
             Frame::Object => ReferenceFrame::Object,

@@ -107,6 +107,32 @@ pub fn lines_plot(
     bands_plot(title, xlabel, ylabel, xs, series, &[], None)
 }
 
+/// A shaded band between `low` and `high` over `xs`, mapped to pixels by `to_px`.
+fn band(
+    out: &mut String,
+    xs: &[f64],
+    low: &[f64],
+    high: &[f64],
+    to_px: (&dyn Fn(f64) -> f64, &dyn Fn(f64) -> f64),
+    colour: &str,
+    opacity: f64,
+) {
+    let upper = xs.iter().zip(high).map(|(&x, &y)| (x, y));
+    let lower = xs.iter().zip(low).rev().map(|(&x, &y)| (x, y));
+    let points: Vec<String> = upper
+        .chain(lower)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| format!("{:.2},{:.2}", to_px.0(x), to_px.1(y)))
+        .collect();
+    if !points.is_empty() {
+        let _ = writeln!(
+            out,
+            r#"<polygon points="{}" fill="{colour}" fill-opacity="{opacity}" stroke="none"/>"#,
+            points.join(" ")
+        );
+    }
+}
+
 /// [`lines_plot`] with a shaded band `(low, high)` behind series `k` for each `bands[k]`
 /// (empty bands are skipped) and an optional dashed horizontal reference line with a label.
 pub fn bands_plot(
@@ -133,21 +159,8 @@ pub fn bands_plot(
     let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
     let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
     for (k, (low, high)) in bands.iter().enumerate() {
-        let upper = xs.iter().zip(high).map(|(&x, &y)| (x, y));
-        let lower = xs.iter().zip(low).rev().map(|(&x, &y)| (x, y));
-        let points: Vec<String> = upper
-            .chain(lower)
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .map(|(x, y)| format!("{:.2},{:.2}", px(x), py(y)))
-            .collect();
-        if !points.is_empty() {
-            let _ = writeln!(
-                out,
-                r#"<polygon points="{}" fill="{}" fill-opacity="0.18" stroke="none"/>"#,
-                points.join(" "),
-                COLOURS[k % COLOURS.len()]
-            );
-        }
+        let colour = COLOURS[k % COLOURS.len()];
+        band(&mut out, xs, low, high, (&px, &py), colour, 0.18);
     }
     if let Some((value, label)) = reference {
         let _ = writeln!(
@@ -231,16 +244,14 @@ pub fn model_plot(p: &ModelPlot) -> String {
     let xr = range(p.xs.iter().copied());
     let upper: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m + 2.0 * s).collect();
     let lower: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m - 2.0 * s).collect();
-    // The score axis spans the scan, the samples and the mean (padded by a tenth); the band
-    // is clipped to it, since it can be far wider where the model has seen only misses.
+    // The score axis spans the scan where given (its finite values: grasps, not misses), else
+    // the samples and the mean, padded by a tenth; everything else is clipped to it (misses
+    // sit on the bottom edge), since the band can be far wider where the model saw misses.
     let yr = {
-        let (lo, hi) = range(
-            p.mean
-                .iter()
-                .chain(p.truth.unwrap_or(&[]))
-                .copied()
-                .chain(p.samples.iter().map(|s| s.1)),
-        );
+        let (lo, hi) = match p.truth {
+            Some(truth) if truth.iter().any(|v| v.is_finite()) => range(truth.iter().copied()),
+            _ => range(p.mean.iter().copied().chain(p.samples.iter().map(|s| s.1))),
+        };
         let pad = 0.1 * (hi - lo);
         (lo - pad, hi + pad)
     };
@@ -305,17 +316,15 @@ pub fn model_plot(p: &ModelPlot) -> String {
         HEIGHT - 12.0,
         escape(p.xlabel)
     );
-    let band: Vec<String> =
-        p.xs.iter()
-            .zip(&upper)
-            .chain(p.xs.iter().zip(&lower).rev())
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .map(|(&x, &y)| format!("{:.2},{:.2}", px(x), py(0, yr, y)))
-            .collect();
-    let _ = writeln!(
-        out,
-        r#"<polygon points="{}" fill="rgb(214,39,40)" fill-opacity="0.15" stroke="none"/>"#,
-        band.join(" ")
+    let to_py = |y: f64| py(0, yr, y);
+    band(
+        &mut out,
+        p.xs,
+        &lower,
+        &upper,
+        (&px, &to_py),
+        "rgb(214,39,40)",
+        0.15,
     );
     if let Some(truth) = p.truth {
         line(
@@ -396,8 +405,13 @@ pub fn samples_map(
     let xr = range(xs.iter().copied());
     let yr = range(ys.iter().copied());
     let zr = range(z.iter().flatten().copied());
-    let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
-    let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
+    // Grid value k is drawn as cell k, so a sample at it goes to the cell's centre.
+    let (nx, ny) = (xs.len().max(2) as f64, ys.len().max(2) as f64);
+    let px = |x: f64| LEFT + ((x - xr.0) / (xr.1 - xr.0) * (nx - 1.0) + 0.5) * width / nx;
+    let py = |y: f64| {
+        let h = H - BOTTOM - TOP;
+        (H - BOTTOM) - ((y - yr.0) / (yr.1 - yr.0) * (ny - 1.0) + 0.5) * h / ny
+    };
     // A veil over the map so the samples stand out.
     let _ = writeln!(
         out,
@@ -518,6 +532,26 @@ mod tests {
         assert_eq!(colour(1.0), (250, 230, 40));
         assert_eq!(colour(2.0), colour(1.0));
         assert_eq!(colour(f64::NAN), colour(0.0));
+    }
+
+    #[test]
+    fn samples_sit_on_the_centres_of_their_grid_cells() {
+        let (xs, ys) = ([0.0, 1.0, 2.0, 3.0], [10.0, 20.0]);
+        let z = vec![vec![0.0, 1.0]; 4];
+        // One sample on the first grid point, one on the last.
+        let samples = [(0.0, 10.0, 0.0), (3.0, 20.0, 1.0)];
+        let svg = samples_map("m", "x", "y", (&xs, &ys, &z), &samples);
+        let (cw, ch) = ((W - LEFT - RIGHT) / 4.0, (H - BOTTOM - TOP) / 2.0);
+        for (i, j) in [(0, 0), (3, 1)] {
+            let (cx, cy) = (
+                LEFT + (i as f64 + 0.5) * cw,
+                H - BOTTOM - (j as f64 + 0.5) * ch,
+            );
+            assert!(
+                svg.contains(&format!(r#"<circle cx="{cx:.2}" cy="{cy:.2}" r="4.5""#)),
+                "no dot at cell ({i}, {j}) = ({cx:.2}, {cy:.2}): {svg}"
+            );
+        }
     }
 
     #[test]

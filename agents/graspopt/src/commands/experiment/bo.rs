@@ -1,31 +1,50 @@
 //! `graspopt experiment bo`: the thesis's Bayesian-optimisation experiments (sections 4.6-4.8)
 //! in the simulator, over seeds, into a folder of CSV and SVG files with a markdown report:
 //!
-//! - 4.16-4.17: 1D runs on the sphere and the star prism, the model at four steps (samples,
-//!   GP mean, two-sigma band, EI), with the thesis's settings and stopping rule;
-//! - 4.18-4.24: 2D sample maps of a run on each of the seven objects over the grid scan;
+//! - 4.16-4.17: 1D runs on the sphere and the star prism with the chosen engine (two random
+//!   points, stop when EI vanishes): the model that chose each trial (samples, GP mean,
+//!   two-sigma band, EI), four of them drawn;
+//! - 4.18-4.24: the samples of a 2D run on each object over the grid scan;
 //! - Table 4.1: grid size against BO trials, in total (until the engine's stopping rule) and
-//!   to within 5/10/20% of the grid maximum, medians over seeds;
+//!   to within 5/10/20% of the grid maximum, medians over seeds, beside random search and the
+//!   thesis's figures;
 //! - 4.25-4.27: best so far against trials, BO against random search, mean and spread over
-//!   seeds, on every object; and the same in the 6D pose space, against the best value any run
-//!   found (no grid in 6D).
+//!   seeds, on every object; and the same in the 6D pose space (no grid in 6D).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use graspopt_bayesopt::Method;
+use graspopt_bayesopt::{Method, Settings};
 use graspopt_experiment::{
     Comparison, Engine, MethodSummary, SearchSettings, Snapshot, TARGET_FRACTIONS, compare, median,
     run_with_snapshots,
 };
-use graspopt_sim::{ContactModel, ParamKind};
+use graspopt_sim::ParamKind;
 use graspopt_trial::Evaluator;
 
-use super::{OBJECTS, argmax, evaluator, scan, write};
+use super::{OBJECTS, argmax, evaluator, scan, touched_grid, write};
 use crate::commands::setup::Contacts;
 use crate::commands::svg;
+
+/// Thesis Table 4.1 (total, 5%, 10%, 20%), its rows read as shifted by one line (the text's
+/// table starts with an unnamed row and ends with an empty one).
+const THESIS_TABLE_4_1: [(&str, [u32; 4]); 7] = [
+    ("sphere", [551, 14, 14, 14]),
+    ("wine_glass", [306, 31, 19, 19]),
+    ("cylinder", [485, 39, 20, 20]),
+    ("mug", [331, 55, 55, 1]),
+    ("cuboid", [564, 1, 1, 1]),
+    ("rotated_cuboid", [388, 59, 59, 59]),
+    ("star_prism", [402, 105, 105, 31]),
+];
+
+/// Largest accepted values of the size flags (beyond them a run takes hours or the grid does
+/// not fit in memory).
+const MAX_SEEDS: u64 = 1000;
+const MAX_BUDGET: usize = 2000;
+const MAX_STEPS: usize = 1000;
 
 #[derive(Args, Debug)]
 pub struct BoArgs {
@@ -47,7 +66,8 @@ pub struct BoArgs {
     /// Grid of the 2D reference scan, approach x vertical (the thesis's 2,211 points).
     #[arg(long, default_value = "67,33")]
     pub steps: String,
-    /// Objects (comma-separated; default the seven of the thesis).
+    /// Objects of the 2D and 6D parts, comma-separated (default: the seven of the thesis);
+    /// the 1D part always runs on the sphere and the star prism, as the thesis's figures.
     #[arg(long, value_delimiter = ',')]
     pub objects: Vec<String>,
     /// Parts to run: 1d (figs 4.16-4.17), 2d (4.18-4.27, Table 4.1), 6d.
@@ -55,8 +75,8 @@ pub struct BoArgs {
     pub parts: Vec<Part>,
     /// The engine's settings: grasp (the thesis's with the misses' scores compressed),
     /// benchmark (tuned on Branin and Hartmann6) or thesis (as written).
-    #[arg(long, default_value = "grasp")]
-    pub engine: String,
+    #[arg(long, value_enum, default_value_t = EngineArg::Grasp)]
+    pub engine: EngineArg,
     /// Contact model scored.
     #[arg(long, value_enum, default_value_t = Contacts::Surface)]
     pub contacts: Contacts,
@@ -85,78 +105,147 @@ impl std::fmt::Display for Part {
     }
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EngineArg {
+    Grasp,
+    Benchmark,
+    Thesis,
+}
+
+impl From<EngineArg> for Engine {
+    fn from(e: EngineArg) -> Self {
+        match e {
+            EngineArg::Grasp => Engine::Grasp,
+            EngineArg::Benchmark => Engine::Benchmark,
+            EngineArg::Thesis => Engine::Thesis,
+        }
+    }
+}
+
 fn method_name(m: Method) -> &'static str {
     match m {
-        Method::Bo => "bo",
-        Method::BoThesis => "bo-thesis",
+        Method::Bo | Method::BoThesis => "bo",
         Method::Random => "random",
     }
+}
+
+/// `star_prism` as a reader writes it: `star prism`.
+fn display(object: &str) -> String {
+    object.replace('_', " ")
 }
 
 /// The evaluator of `object` over `kinds` with the chosen contact model.
 fn object_evaluator(object: &str, kinds: &[ParamKind], contacts: Contacts) -> Result<Evaluator> {
     let mut ev = evaluator(object, kinds)?;
-    ev.score.contacts = match contacts {
-        Contacts::Surface => ContactModel::Surface,
-        Contacts::Patch => ContactModel::CircularPatch,
-        Contacts::Mean => ContactModel::MeanPoint,
-    };
+    ev.score.contacts = contacts.into();
     Ok(ev)
 }
 
-pub(super) fn bo(args: &BoArgs) -> Result<()> {
-    let engine = Engine::parse(&args.engine)?;
-    if args.seeds == 0 || args.budget < 2 || args.budget_6d < 2 {
-        bail!("--seeds must be at least 1 and --budget, --budget-6d at least 2");
+/// The checked flags of a run.
+struct Plan {
+    engine: Engine,
+    steps: [usize; 2],
+    objects: Vec<String>,
+    seeds: Vec<u64>,
+}
+
+fn plan(args: &BoArgs) -> Result<Plan> {
+    if !(1..=MAX_SEEDS).contains(&args.seeds) {
+        bail!(
+            "--seeds must be between 1 and {MAX_SEEDS}, got {}",
+            args.seeds
+        );
     }
+    let Some(end) = args.first_seed.checked_add(args.seeds) else {
+        bail!("--first-seed + --seeds must stay below 2^64");
+    };
     let steps: Vec<usize> = args
         .steps
         .split(',')
         .map(|s| s.trim().parse::<usize>())
         .collect::<Result<_, _>>()
         .with_context(|| format!("--steps {:?}: expected two counts like 67,33", args.steps))?;
-    if steps.len() != 2 || steps.iter().any(|&n| n < 2) {
+    let [nx, ny] = steps[..] else {
+        bail!("--steps {:?}: expected two counts, like 67,33", args.steps);
+    };
+    if ![nx, ny].iter().all(|n| (2..=MAX_STEPS).contains(n)) {
         bail!(
-            "--steps {:?}: expected two counts of at least 2, like 67,33",
+            "--steps {:?}: each count must be between 2 and {MAX_STEPS}",
             args.steps
         );
     }
-    let objects: Vec<String> = if args.objects.is_empty() {
+    // A run no longer than the engine's random initial design is random search.
+    for (flag, budget, dim, part) in [
+        ("--budget", args.budget, 2, Part::TwoD),
+        ("--budget-6d", args.budget_6d, 6, Part::SixD),
+    ] {
+        let init = Settings::default_n_init(dim);
+        if args.parts.contains(&part) && !(init < budget && budget <= MAX_BUDGET) {
+            bail!(
+                "{flag} must be more than the engine's {init} random initial trials in {dim}D and at most {MAX_BUDGET}, got {budget}"
+            );
+        }
+    }
+    let mut objects: Vec<String> = Vec::new();
+    let named: Vec<String> = if args.objects.is_empty() {
         OBJECTS.iter().map(|s| s.to_string()).collect()
     } else {
-        args.objects.clone()
+        args.objects.iter().map(|s| s.trim().to_string()).collect()
     };
-    for o in &objects {
-        graspopt_sim::Object::by_name(o)?;
+    for o in named {
+        if o.is_empty() {
+            bail!("--objects has an empty name (two commas in a row?)");
+        }
+        graspopt_sim::Object::by_name(&o)?;
+        if !objects.contains(&o) {
+            objects.push(o);
+        }
     }
+    Ok(Plan {
+        engine: args.engine.into(),
+        steps: [nx, ny],
+        objects,
+        seeds: (args.first_seed..end).collect(),
+    })
+}
+
+pub(super) fn bo(args: &BoArgs) -> Result<()> {
+    let plan = plan(args)?;
     let dir = &args.out;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let seeds: Vec<u64> = (args.first_seed..args.first_seed.saturating_add(args.seeds)).collect();
+    let parts: Vec<String> = args.parts.iter().map(Part::to_string).collect();
+    let contacts = format!("{:?}", args.contacts).to_lowercase();
     let mut report = format!(
-        "# Bayesian-optimisation experiments (thesis 4.6-4.8)\n\nRegenerated by `graspopt experiment bo --seeds {} --first-seed {} --budget {} --budget-6d {} --steps {} --engine {}`. \
-         Barrett hand, {} contact model, BW score (a trial that touches nothing scores below every grasp, by how far it missed). \
-         Engine settings `{}`; random search is uniform over the same box. Seeds {}-{}. \
-         \"Within p%\" means a best score of at least `max - p |max|`.\n\n",
+        "# Bayesian-optimisation experiments (thesis 4.6-4.8)\n\n\
+         Regenerated by `graspopt experiment bo --seeds {} --first-seed {} --budget {} --budget-6d {} --steps {},{} \
+         --objects {} --parts {} --contacts {contacts} --engine {}`.\n\n\
+         Barrett hand, {contacts} contact model without noise (the thesis's 2D runs used mean-point contacts and noisy \
+         observations: `--contacts mean`), BW score; a trial that touches nothing scores below every grasp, by how \
+         far it missed. Engine settings `{}`; random search is uniform over the same box. Seeds {}-{}: for each seed, \
+         BO's random initial design draws the same first points as random search, so each seed is a paired \
+         comparison. \"Within p%\" of a reference means a best score of at least `reference - p |reference|`.\n",
         args.seeds,
         args.first_seed,
         args.budget,
         args.budget_6d,
-        args.steps,
-        engine.name(),
-        format!("{:?}", args.contacts).to_lowercase(),
-        engine.name(),
-        seeds[0],
-        seeds[seeds.len() - 1]
+        plan.steps[0],
+        plan.steps[1],
+        plan.objects.join(","),
+        parts.join(","),
+        plan.engine.name(),
+        plan.engine.name(),
+        args.first_seed,
+        args.first_seed + (args.seeds - 1),
     );
     let started = std::time::Instant::now();
     if args.parts.contains(&Part::OneD) {
-        one_d(dir, args, engine, &mut report)?;
+        one_d(dir, args, plan.engine, &mut report)?;
     }
     if args.parts.contains(&Part::TwoD) {
-        two_d(dir, args, engine, &objects, &steps, &seeds, &mut report)?;
+        two_d(dir, args, &plan, &mut report)?;
     }
     if args.parts.contains(&Part::SixD) {
-        six_d(dir, args, engine, &objects, &seeds, &mut report)?;
+        six_d(dir, args, &plan, &mut report)?;
     }
     let _ = writeln!(
         report,
@@ -170,11 +259,14 @@ pub(super) fn bo(args: &BoArgs) -> Result<()> {
 }
 
 /// Figures 4.16-4.17: a 1D run on the sphere and on the star prism (two random points, stop
-/// when EI vanishes), the model at four steps.
+/// when EI vanishes), the model that chose each trial, four of them drawn.
 fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Result<()> {
     report.push_str(
-        "## Figures 4.16-4.17: 1D runs along the approach axis (2 random points, stop when EI vanishes)\n\n\
-         | object | trials until the engine stopped | best found | grid maximum (201 points) | files |\n|---|---|---|---|---|\n",
+        "\n## Figures 4.16-4.17: 1D runs along the approach axis (2 random points, stop when EI vanishes)\n\n\
+         Each figure shows the model that chose the next trial (green line): posterior mean and two-sigma band \
+         (red), the samples so far (dots), the score along a 201-point scan (grey, misses left out) and, below, the \
+         expected improvement the engine maximised (its own standardised units).\n\n\
+         | object | trials until the engine stopped | best found | scan maximum | files |\n|---|---|---|---|---|\n",
     );
     for (fig, object) in [("4.16", "sphere"), ("4.17", "star_prism")] {
         let ev = object_evaluator(object, &[ParamKind::Approach], args.contacts)?;
@@ -198,23 +290,34 @@ fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Resu
             }
         }
         let mut files = vec![write(dir, &format!("fig{fig}-{object}-model.csv"), &csv)?];
-        let mut samples_csv = String::from("trial,approach,score\n");
+        let mut samples_csv = String::from("trial,approach,score,ei_when_chosen\n");
         for (i, (p, y)) in trace.params.iter().zip(&trace.scores).enumerate() {
-            let _ = writeln!(samples_csv, "{},{},{y}", i + 1, p[0]);
+            let ei = snaps
+                .iter()
+                .find(|s| s.trials == i)
+                .map_or(String::new(), |s| s.next_ei.to_string());
+            let _ = writeln!(samples_csv, "{},{},{y},{ei}", i + 1, p[0]);
         }
         files.push(write(
             dir,
             &format!("fig{fig}-{object}-samples.csv"),
             &samples_csv,
         )?);
-        let truth_scores: Vec<f64> = truth.iter().map(|p| p.score.score).collect();
+        let truth_scores: Vec<f64> = truth
+            .iter()
+            .map(crate::commands::scan::touched_score)
+            .collect();
         for snap in pick_four(&snaps) {
             let samples: Vec<(f64, f64)> = trace.params[..snap.trials]
                 .iter()
                 .zip(&trace.scores)
                 .map(|(p, y)| (p[0], *y))
                 .collect();
-            let title = format!("Fig. {fig}: {object}, after {} trials", snap.trials);
+            let title = format!(
+                "Fig. {fig}: {}, model after {} trials",
+                display(object),
+                snap.trials
+            );
             files.push(write(
                 dir,
                 &format!("fig{fig}-{object}-after-{:02}.svg", snap.trials),
@@ -227,22 +330,24 @@ fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Resu
                     ei: &snap.ei,
                     truth: Some(&truth_scores),
                     samples: &samples,
-                    next: snap.next,
+                    next: Some(snap.next),
                 }),
             )?);
         }
         let best = trace.best().map_or(f64::NAN, |b| b.1);
+        let top = argmax(&truth);
         let _ = writeln!(
             report,
-            "| {object} | {}{} | {best:.4} | {:.4} at {:.3} | {} |",
+            "| {} | {}{} | {best:.4} | {:.4} at {:.3} m | {} |",
+            display(object),
             trace.scores.len(),
             if trace.ei_stop_at.is_some() {
                 ""
             } else {
                 " (budget)"
             },
-            argmax(&truth).score.score,
-            argmax(&truth).params[0],
+            top.score.score,
+            top.params[0],
             files.join(", ")
         );
     }
@@ -258,7 +363,7 @@ fn pick_four(snaps: &[Snapshot]) -> Vec<&Snapshot> {
     idx.into_iter().filter_map(|i| snaps.get(i)).collect()
 }
 
-/// A median trial count with the seeds that got there ("-" when fewer than half did).
+/// A median trial count with the seeds that got there ("-" unless more than half did).
 fn fmt_median(m: Option<f64>, reached: usize, seeds: usize) -> String {
     match m {
         Some(v) => format!("{v} ({reached}/{seeds})"),
@@ -320,19 +425,14 @@ fn comparison_files(
         .methods
         .iter()
         .map(|m| {
-            let lo = m
-                .mean_best
-                .iter()
-                .zip(&m.std_best)
-                .map(|(a, s)| a - s)
-                .collect();
-            let hi = m
-                .mean_best
-                .iter()
-                .zip(&m.std_best)
-                .map(|(a, s)| a + s)
-                .collect();
-            (lo, hi)
+            let spread = |sign: f64| -> Vec<f64> {
+                m.mean_best
+                    .iter()
+                    .zip(&m.std_best)
+                    .map(|(a, s)| a + sign * s)
+                    .collect()
+            };
+            (spread(-1.0), spread(1.0))
         })
         .collect();
     files.push(write(
@@ -358,61 +458,80 @@ fn summary(cmp: &Comparison, method: Method) -> Result<&MethodSummary> {
         .with_context(|| format!("no runs of {}", method_name(method)))
 }
 
-/// Figures 4.18-4.27 and Table 4.1 on every object in 2D.
-fn two_d(
-    dir: &Path,
-    args: &BoArgs,
+/// Runs BO (with `engine`) and random search over `seeds` on `ev`.
+fn bo_and_random(
+    ev: &Evaluator,
     engine: Engine,
-    objects: &[String],
-    steps: &[usize],
+    budget: usize,
     seeds: &[u64],
-    report: &mut String,
-) -> Result<()> {
-    let grid_size = steps[0] * steps[1];
+    reference: Option<f64>,
+    threads: usize,
+) -> Result<Comparison> {
+    let template = SearchSettings {
+        method: Method::Bo,
+        budget,
+        n_init: None,
+        stop_on_small_ei: false,
+        engine: Some(engine.settings()),
+    };
+    Ok(compare(
+        ev,
+        &[Method::Bo, Method::Random],
+        seeds,
+        &template,
+        reference,
+        threads,
+    )?)
+}
+
+/// Figures 4.18-4.27 and Table 4.1 on every object in 2D.
+fn two_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<()> {
+    let seeds = &plan.seeds;
+    let grid_size = plan.steps[0] * plan.steps[1];
     let mut table = format!(
-        "## Table 4.1: grid size versus BO trials (approach x vertical, medians over {} seeds)\n\n\
-         Total: trials until the engine's stopping rule (EI vanished) fired, within a budget of {}; \
-         a seed that never stopped counts as the budget. 5/10/20%: trials to within that much of the grid maximum \
-         (seeds that got there in brackets; a seed that never did counts as budget + 1).\n\n\
-         | object | grid | grid max | BO total | BO 5% | BO 10% | BO 20% | random 5% | random 10% | random 20% | BO best (median) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "\n## Table 4.1: grid size versus BO trials (approach x vertical, medians over {} seeds)\n\n\
+         BO total: trials until the engine's stopping rule (EI vanished) fired, the seeds where it fired within the \
+         budget of {} in brackets (the others count as the budget). 5/10/20%: trials to within that much of the grid \
+         maximum, the seeds that got there in brackets; a seed that never did counts as budget + 1, and \"-\" means \
+         no more than half got there. The runs go on to the budget after the stop, so a count can exceed the total. \
+         Thesis: its Table 4.1 (one run each, its own simulator).\n\n\
+         | object | grid | grid max | BO total | BO 5% | BO 10% | BO 20% | random 5% | random 10% | random 20% | BO best (median) | thesis total / 5% / 10% / 20% |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
         seeds.len(),
         args.budget
     );
     let mut maps = String::from(
-        "\n## Figures 4.18-4.24: 2D samples of the first seed over the grid scan\n\n| object | samples (until the stop or the budget) | best sample | file |\n|---|---|---|---|\n",
+        "\n## Figures 4.18-4.24: 2D samples of the first seed over the grid scan\n\n\
+         The thesis draws BO's samples as a surface; here they are dots (coloured by score, the best ringed) over \
+         the grid scan, so one sees where BO looked against what was there.\n\n\
+         | object | samples (until the stop or the budget) | best sample | file |\n|---|---|---|---|\n",
     );
     let mut curves = String::from(
-        "\n## Figures 4.25-4.27: best so far versus trial, BO versus random (mean and 1 sd over seeds; every object)\n\n| object | files |\n|---|---|\n",
+        "\n## Figures 4.25-4.27: best so far versus trial, BO versus random (mean and 1 sd over seeds; every object)\n\n\
+         | object | files |\n|---|---|\n",
     );
     let kinds = [ParamKind::Approach, ParamKind::Vertical];
-    for object in objects {
+    for object in &plan.objects {
+        let name = display(object);
         let ev = object_evaluator(object, &kinds, args.contacts)?;
-        let (axes, grid) = scan(&ev, steps, args.threads)?;
-        let best = argmax(&grid);
-        let reference = best.score.score;
-        let method = Method::Bo;
-        let template = SearchSettings {
-            method,
-            budget: args.budget,
-            n_init: None,
-            stop_on_small_ei: false,
-            engine: Some(engine.settings()),
-        };
-        let cmp = compare(
+        let (axes, grid) = scan(&ev, &plan.steps, args.threads)?;
+        let reference = argmax(&grid).score.score;
+        let cmp = bo_and_random(
             &ev,
-            &[method, Method::Random],
+            plan.engine,
+            args.budget,
             seeds,
-            &template,
             Some(reference),
             args.threads,
         )?;
-        let bo = summary(&cmp, method)?;
+        let bo = summary(&cmp, Method::Bo)?;
         let random = summary(&cmp, Method::Random)?;
         let totals: Vec<f64> = bo
             .traces
             .iter()
             .map(|t| t.ei_stop_at.unwrap_or(args.budget) as f64)
             .collect();
+        let stopped = bo.traces.iter().filter(|t| t.ei_stop_at.is_some()).count();
         let finals: Vec<f64> = bo
             .traces
             .iter()
@@ -424,10 +543,17 @@ fn two_d(
                 .collect()
         };
         let (b, r) = (cells(bo), cells(random));
+        let thesis = THESIS_TABLE_4_1
+            .iter()
+            .find(|(o, _)| o == object)
+            .map_or("-".to_string(), |(_, v)| {
+                format!("{} / {} / {} / {}", v[0], v[1], v[2], v[3])
+            });
         let _ = writeln!(
             table,
-            "| {object} | {grid_size} | {reference:.4} | {} | {} | {} | {} | {} | {} | {} | {:.4} |",
+            "| {name} | {grid_size} | {reference:.4} | {} ({stopped}/{}) | {} | {} | {} | {} | {} | {} | {:.4} | {thesis} |",
             median(&totals).unwrap_or(f64::NAN),
+            seeds.len(),
             b[0],
             b[1],
             b[2],
@@ -436,48 +562,43 @@ fn two_d(
             r[2],
             median(&finals).unwrap_or(f64::NAN)
         );
-        // Sample map of seed 0.
-        let first = &bo.traces[0];
+        let first = bo.traces.first().context("no BO run")?;
         let shown = first.ei_stop_at.unwrap_or(first.scores.len());
         let samples: Vec<(f64, f64, f64)> = first.params[..shown]
             .iter()
             .zip(&first.scores)
             .map(|(p, y)| (p[0], p[1], *y))
             .collect();
-        let z: Vec<Vec<f64>> = (0..axes[0].len())
-            .map(|i| {
-                (0..axes[1].len())
-                    .map(|j| crate::commands::scan::touched_score(&grid[i * axes[1].len() + j]))
-                    .collect()
-            })
-            .collect();
         let map = write(
             dir,
             &format!("fig4.18-4.24-{object}-samples.svg"),
             &svg::samples_map(
                 &format!(
-                    "BO samples on the {object} (seed {}, {shown} trials)",
+                    "BO samples on the {name} (seed {}, {shown} trials)",
                     first.seed
                 ),
                 "approach offset (m)",
                 "vertical offset (m)",
-                (&axes[0], &axes[1], &z),
+                (&axes[0], &axes[1], &touched_grid(&axes, &grid)),
                 &samples,
             ),
         )?;
         let top = samples
             .iter()
-            .max_by(|a, b| a.2.total_cmp(&b.2))
-            .map_or(f64::NAN, |s| s.2);
-        let _ = writeln!(maps, "| {object} | {shown} | {top:.4} | {map} |");
+            .map(|s| s.2)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let _ = writeln!(maps, "| {name} | {shown} | {top:.4} | {map} |");
         let files = comparison_files(
             dir,
             &format!("fig4.25-4.27-{object}-bo-vs-random"),
-            &format!("Best so far on the {object}: {} vs random", engine.name()),
+            &format!(
+                "Best so far on the {name}: BO ({}) vs random",
+                plan.engine.name()
+            ),
             &cmp,
             "grid maximum",
         )?;
-        let _ = writeln!(curves, "| {object} | {} |", files.join(", "));
+        let _ = writeln!(curves, "| {name} | {} |", files.join(", "));
         eprintln!("2d {object}: done");
     }
     report.push_str(&table);
@@ -487,32 +608,26 @@ fn two_d(
 }
 
 /// BO versus random in the 6D pose space (three offsets, three rotations) on every object.
-fn six_d(
-    dir: &Path,
-    args: &BoArgs,
-    engine: Engine,
-    objects: &[String],
-    seeds: &[u64],
-    report: &mut String,
-) -> Result<()> {
+fn six_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<()> {
+    let seeds = &plan.seeds;
     let checkpoints: Vec<usize> = [25, 50, args.budget_6d]
         .into_iter()
         .filter(|&n| n <= args.budget_6d)
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
-    let at: Vec<String> = checkpoints.iter().map(|n| format!("@{n}")).collect();
+    let listed: Vec<String> = checkpoints.iter().map(usize::to_string).collect();
+    let columns = listed.join(" / ");
     let _ = writeln!(
         report,
         "\n## 6D pose space: BO versus random (offsets and rotation vector, budget {}, {} seeds)\n\n\
          No grid in 6D: the median over seeds of the best score after {} trials, and the trials to within 20% \
-         of the best score any run of either method found (seeds that got there in brackets).\n\n\
-         | object | best of all runs | BO median best {} | random median best {} | BO 20% | random 20% | files |\n|---|---|---|---|---|---|---|",
+         of the best score any run of either method found (the seeds that got there in brackets).\n\n\
+         | object | best of all runs | BO median best after {columns} | random median best after {columns} | BO 20% | random 20% | files |\n\
+         |---|---|---|---|---|---|---|",
         args.budget_6d,
         seeds.len(),
-        at.join(", "),
-        at.join(" / "),
-        at.join(" / ")
+        listed.join(", ")
     );
     let kinds = [
         ParamKind::Approach,
@@ -522,24 +637,10 @@ fn six_d(
         ParamKind::RotY,
         ParamKind::RotZ,
     ];
-    for object in objects {
+    for object in &plan.objects {
+        let name = display(object);
         let ev = object_evaluator(object, &kinds, args.contacts)?;
-        let method = Method::Bo;
-        let template = SearchSettings {
-            method,
-            budget: args.budget_6d,
-            n_init: None,
-            stop_on_small_ei: false,
-            engine: Some(engine.settings()),
-        };
-        let cmp = compare(
-            &ev,
-            &[method, Method::Random],
-            seeds,
-            &template,
-            None,
-            args.threads,
-        )?;
+        let cmp = bo_and_random(&ev, plan.engine, args.budget_6d, seeds, None, args.threads)?;
         let medians_at = |m: &MethodSummary| -> String {
             checkpoints
                 .iter()
@@ -562,15 +663,15 @@ fn six_d(
             dir,
             &format!("6d-{object}-bo-vs-random"),
             &format!(
-                "6D, best so far on the {object}: {} vs random",
-                engine.name()
+                "6D, best so far on the {name}: BO ({}) vs random",
+                plan.engine.name()
             ),
             &cmp,
             "best of all runs",
         )?;
         let _ = writeln!(
             report,
-            "| {object} | {:.4} | {} | {} | {} | {} | {} |",
+            "| {name} | {:.4} | {} | {} | {} | {} | {} |",
             cmp.reference,
             medians_at(bo),
             medians_at(random),

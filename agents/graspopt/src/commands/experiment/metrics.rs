@@ -18,7 +18,7 @@ use graspopt_sim::{ContactModel, ParamKind};
 use graspopt_trial::scan::ScanPoint;
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
 
-use super::{OBJECTS, argmax, evaluator, scan, write};
+use super::{OBJECTS, argmax, evaluator, scan, touched_grid, write};
 use crate::commands::svg;
 
 #[derive(Args, Debug)]
@@ -257,13 +257,7 @@ fn map_row(
         );
     }
     write(dir, &format!("{stem}.csv"), &csv)?;
-    let z: Vec<Vec<f64>> = (0..axes[0].len())
-        .map(|i| {
-            (0..axes[1].len())
-                .map(|j| crate::commands::scan::touched_score(&points[i * axes[1].len() + j]))
-                .collect()
-        })
-        .collect();
+    let z = touched_grid(&axes, &points);
     let file = write(
         dir,
         &format!("{stem}.svg"),

@@ -83,6 +83,21 @@ fn write(dir: &Path, name: &str, text: &str) -> Result<String> {
     Ok(name.to_string())
 }
 
+/// The scores of a 2D scan as `z[i][j]` (axis 0 index `i`, axis 1 index `j`), NaN where the
+/// hand touched nothing (drawn grey), for the heatmaps.
+fn touched_grid(axes: &[Vec<f64>], points: &[ScanPoint]) -> Vec<Vec<f64>> {
+    let ny = axes.get(1).map_or(1, Vec::len);
+    points
+        .chunks(ny)
+        .map(|column| {
+            column
+                .iter()
+                .map(crate::commands::scan::touched_score)
+                .collect()
+        })
+        .collect()
+}
+
 /// The best-scoring point of a (non-empty) scan.
 fn argmax(points: &[ScanPoint]) -> &ScanPoint {
     let mut best = &points[0];
