@@ -13,7 +13,7 @@ use graspopt_experiment::{SearchSettings, compare};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
 use graspopt_trial::Evaluator;
-use graspopt_trial::scan::{linspace, scan_grid};
+use graspopt_trial::scan::{grid_axes, scan_grid};
 
 fn variant(name: &str) -> Option<Settings> {
     let grasp = Settings::for_grasps();
@@ -71,13 +71,7 @@ fn main() {
             hand_by_name("barrett").expect("the Barrett hand"),
             space,
         );
-        let axes: Vec<Vec<f64>> = ev
-            .space
-            .bounds()
-            .iter()
-            .zip([67, 33])
-            .map(|(&(l, h), n)| linspace(l, h, n))
-            .collect();
+        let axes = grid_axes(&ev.space.bounds(), &[67, 33]);
         let grid = scan_grid(&ev, &axes, 0, &|_| {}).expect("the grid scan");
         let max = grid
             .iter()

@@ -7,7 +7,7 @@ use graspopt_experiment::{Engine, SearchSettings, compare, run, run_with_snapsho
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
 use graspopt_trial::Evaluator;
-use graspopt_trial::scan::{linspace, scan_grid};
+use graspopt_trial::scan::{grid_axes, scan_grid};
 
 fn sphere(two_d: bool) -> Evaluator {
     let object = Object::by_name("sphere").unwrap();
@@ -21,13 +21,7 @@ fn sphere(two_d: bool) -> Evaluator {
 
 /// The maximum of a grid scan with `steps[k]` points on axis `k`.
 fn grid_max(ev: &Evaluator, steps: &[usize]) -> f64 {
-    let axes: Vec<Vec<f64>> = ev
-        .space
-        .bounds()
-        .iter()
-        .zip(steps)
-        .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
-        .collect();
+    let axes = grid_axes(&ev.space.bounds(), steps);
     scan_grid(ev, &axes, 0, &|_| {})
         .unwrap()
         .iter()

@@ -30,6 +30,16 @@ pub fn linspace(lower: f64, upper: f64, n: usize) -> Vec<f64> {
     }
 }
 
+/// The axes of a grid over a box: `steps[k]` evenly spaced values (see [`linspace`]) from
+/// `bounds[k].0` to `bounds[k].1`.
+pub fn grid_axes(bounds: &[(f64, f64)], steps: &[usize]) -> Vec<Vec<f64>> {
+    bounds
+        .iter()
+        .zip(steps)
+        .map(|(&(lower, upper), &n)| linspace(lower, upper, n))
+        .collect()
+}
+
 /// The workers a scan of `points` points uses when `requested` are asked for (0: one per
 /// core), never more than there are points, at least one.
 pub fn worker_count(requested: usize, points: usize) -> usize {

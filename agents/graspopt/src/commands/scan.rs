@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use graspopt_trial::scan::{ScanPoint, linspace, scan_grid, worker_count};
+use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid, worker_count};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::setup::{SimArgs, param_kind, param_name};
@@ -63,13 +63,7 @@ pub fn grid(sim: &SimArgs, axes: &str, steps: &str) -> Result<Grid> {
         n => bail!("--steps has {n} values for {} axes", kinds.len()),
     };
     let ev = sim.evaluator(&kinds)?;
-    let axes: Vec<Vec<f64>> = ev
-        .space
-        .bounds()
-        .iter()
-        .zip(&steps)
-        .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
-        .collect();
+    let axes = grid_axes(&ev.space.bounds(), &steps);
     Ok(Grid {
         ev,
         kinds,

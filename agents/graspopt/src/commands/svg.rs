@@ -32,10 +32,15 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 fn header(out: &mut String, title: &str) {
+    header_sized(out, title, H);
+}
+
+/// The SVG opening, a white background and the title, for a chart `height` pixels high.
+fn header_sized(out: &mut String, title: &str, height: f64) {
     let _ = write!(
         out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">
-<rect width="{W}" height="{H}" fill="white"/>
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{height}" viewBox="0 0 {W} {height}" font-family="sans-serif" font-size="12">
+<rect width="{W}" height="{height}" fill="white"/>
 <text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>
 "#,
         W / 2.0,
@@ -232,15 +237,7 @@ pub fn model_plot(p: &ModelPlot) -> String {
     const HEIGHT: f64 = 560.0;
     let width = W - LEFT - 30.0;
     let mut out = String::new();
-    let _ = write!(
-        out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{HEIGHT}" viewBox="0 0 {W} {HEIGHT}" font-family="sans-serif" font-size="12">
-<rect width="{W}" height="{HEIGHT}" fill="white"/>
-<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>
-"#,
-        W / 2.0,
-        escape(p.title)
-    );
+    header_sized(&mut out, p.title, HEIGHT);
     let xr = range(p.xs.iter().copied());
     let upper: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m + 2.0 * s).collect();
     let lower: Vec<f64> = p.mean.iter().zip(p.sd).map(|(m, s)| m - 2.0 * s).collect();

@@ -14,7 +14,7 @@ use clap::{Args, Subcommand};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, ParamKind};
 use graspopt_trial::Evaluator;
-use graspopt_trial::scan::{ScanPoint, linspace, scan_grid};
+use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid};
 
 use super::setup::space_for;
 
@@ -65,13 +65,7 @@ fn scan(
     steps: &[usize],
     threads: usize,
 ) -> Result<(Vec<Vec<f64>>, Vec<ScanPoint>)> {
-    let axes: Vec<Vec<f64>> = ev
-        .space
-        .bounds()
-        .iter()
-        .zip(steps)
-        .map(|(&(lo, hi), &n)| linspace(lo, hi, n))
-        .collect();
+    let axes = grid_axes(&ev.space.bounds(), steps);
     let points = scan_grid(ev, &axes, threads, &|_| {})?;
     Ok((axes, points))
 }
