@@ -122,35 +122,22 @@ fn scan_2d_writes_a_png_heatmap_too() {
     assert!(width > 4 * 8);
 }
 
-#[test]
-fn experiment_metrics_writes_every_figure_and_a_report() {
-    let dir = tempdir("experiment");
-    let out = graspopt(&[
-        "experiment",
-        "metrics",
-        "--steps",
-        "4",
-        "--steps-2d",
-        "3",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+/// Runs `graspopt experiment ARGS --out DIR`, checks it succeeded and that its report has
+/// every heading and names only files that exist; returns the report and the files named.
+fn experiment_report(dir: &std::path::Path, args: &[&str], headings: &[&str]) -> (String, usize) {
+    let mut all = vec!["experiment"];
+    all.extend(args);
+    all.extend(["--out", dir.to_str().unwrap()]);
+    let out = graspopt(&all);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    for heading in [
-        "4.3-4.5",
-        "Figure 4.6",
-        "Figure 4.7",
-        "Figure 4.8",
-        "4.9-4.15",
-    ] {
+    for heading in headings {
         assert!(report.contains(heading), "report lacks {heading}");
     }
-    // Every file the report names exists.
     let mut named = 0;
     for word in report.split(|c: char| c.is_whitespace() || c == ',' || c == '|') {
         if word.ends_with(".svg") || word.ends_with(".csv") {
@@ -158,6 +145,23 @@ fn experiment_metrics_writes_every_figure_and_a_report() {
             named += 1;
         }
     }
+    (report, named)
+}
+
+#[test]
+fn experiment_metrics_writes_every_figure_and_a_report() {
+    let dir = tempdir("experiment");
+    let (_, named) = experiment_report(
+        &dir,
+        &["metrics", "--steps", "4", "--steps-2d", "3"],
+        &[
+            "4.3-4.5",
+            "Figure 4.6",
+            "Figure 4.7",
+            "Figure 4.8",
+            "4.9-4.15",
+        ],
+    );
     // 4.3-4.5: 3 objects x (CSV + 3 SVG); 4.6: 2; 4.7: 2; 4.8: 1; 4.9-4.15: 7.
     assert_eq!(named, 12 + 2 + 2 + 1 + 7);
     for object in [
@@ -176,48 +180,33 @@ fn experiment_metrics_writes_every_figure_and_a_report() {
 #[test]
 fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
     let dir = tempdir("experiment-bo");
-    let out = graspopt(&[
-        "experiment",
-        "bo",
-        "--seeds",
-        "2",
-        "--budget",
-        "8",
-        "--budget-6d",
-        "12",
-        "--steps",
-        "5,3",
-        "--objects",
-        "sphere,mug,sphere",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let (report, named) = experiment_report(
+        &dir,
+        &[
+            "bo",
+            "--seeds",
+            "2",
+            "--budget",
+            "8",
+            "--budget-6d",
+            "12",
+            "--steps",
+            "5,3",
+            "--objects",
+            "sphere,mug,sphere",
+        ],
+        &[
+            "Figures 4.16-4.17",
+            "Table 4.1",
+            "Figures 4.18-4.24",
+            "Figures 4.25-4.27",
+            "6D pose space",
+        ],
     );
-    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    for heading in [
-        "Figures 4.16-4.17",
-        "Table 4.1",
-        "Figures 4.18-4.24",
-        "Figures 4.25-4.27",
-        "6D pose space",
-    ] {
-        assert!(report.contains(heading), "report lacks {heading}");
-    }
     // Table 4.1 has one row per object (the repeated name runs once) with the 15-point grid
     // and the thesis's figures beside.
     assert_eq!(report.matches("| sphere | 15 |").count(), 1, "{report}");
     assert!(report.contains("| mug | 15 |") && report.contains("331 / 55 / 55 / 1 |"));
-    let mut named = 0;
-    for word in report.split(|c: char| c.is_whitespace() || c == ',' || c == '|') {
-        if word.ends_with(".svg") || word.ends_with(".csv") {
-            assert!(dir.join(word).exists(), "{word} missing");
-            named += 1;
-        }
-    }
     // 1D: 2 objects x (2 CSV + up to 4 SVG); 2D: 2 x (map + 2 CSV + SVG); 6D: 2 x 3.
     assert!(named >= 2 * 4 + 2 * 4 + 2 * 3, "{named} files named");
     // Per-seed counts: two seeds of BO and two of random search, each naming its seed.
