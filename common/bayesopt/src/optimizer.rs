@@ -225,6 +225,17 @@ impl Settings {
     }
 }
 
+/// The model at one point: see [`Optimizer::model_at`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ModelPoint {
+    /// Posterior mean of the objective (raw units, the user's sign convention).
+    pub mean: f64,
+    /// Posterior standard deviation (raw units; linearised through the output transform).
+    pub sd: f64,
+    /// Expected improvement (the model's standardised units).
+    pub ei: f64,
+}
+
 /// Diagnostics of the last proposal round.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct RoundInfo {
@@ -718,10 +729,19 @@ impl Optimizer {
         Ok(gp)
     }
 
-    /// The GP of the current epoch's observations with the last fit's hyperparameters (the
-    /// prior's before the first fit), and the standardisation its outputs went through (its
-    /// `x` moved into the GP). Needs at least one observation.
-    fn current_model(&self) -> Result<(Gp, Standardised)> {
+    /// The current model at each of `points`: posterior mean and standard deviation of the
+    /// objective (raw units, the user's sign convention) and the expected improvement.
+    /// The model is the current epoch's observations, standardised (and transformed), with
+    /// the last fit's hyperparameters (the prior's before the first fit); EI uses `xi` from
+    /// the settings against the best observation, in the model's standardised units, and
+    /// ignores pending points. Called right after a one-point [`Optimizer::suggest`] (before
+    /// its point is observed), the EI is the acquisition that round maximised, without
+    /// restart penalties or diversification. One model for all points. Needs at least one
+    /// observation.
+    pub fn model_at(&self, points: &[Vec<f64>]) -> Result<Vec<ModelPoint>> {
+        for x in points {
+            self.check_point(x)?;
+        }
         if self.xs.is_empty() {
             return Err(BoError::NotEnoughData("no observation yet".into()));
         }
@@ -731,38 +751,46 @@ impl Optimizer {
         });
         let x = std::mem::take(&mut data.x);
         let gp = Gp::new(x, data.y.clone(), h.kernel(self.settings.kernel), h.noise)?;
-        Ok((gp, data))
+        let best = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let xi = self.settings.xi.xi(gp.kernel().signal_variance);
+        let sign = if self.settings.minimize { -1.0 } else { 1.0 };
+        Ok(points
+            .iter()
+            .map(|x| {
+                let (m, v) = gp.predict(&self.to_unit(x));
+                let w = data.mean + data.std * m;
+                let sd = data.std * v.sqrt();
+                let (mean, sd) = match &data.warp {
+                    Some(t) => (sign * t.inverse(w), sd / t.slope_at_image(w)),
+                    None => (sign * w, sd),
+                };
+                ModelPoint {
+                    mean,
+                    sd,
+                    ei: crate::acquisition::expected_improvement(m, v, best, xi),
+                }
+            })
+            .collect())
+    }
+
+    /// The model at one point ([`Optimizer::model_at`]).
+    fn model_at_point(&self, x: &[f64]) -> Result<ModelPoint> {
+        let mut one = self.model_at(&[x.to_vec()])?;
+        one.pop()
+            .ok_or_else(|| BoError::NotEnoughData("no model point".into()))
     }
 
     /// Posterior mean and standard deviation of the objective at `x` (raw units, the user's
     /// sign convention), with the hyperparameters of the last fit (prior ones before the
     /// first). Needs at least one observation.
     pub fn predict(&self, x: &[f64]) -> Result<(f64, f64)> {
-        self.check_point(x)?;
-        let (gp, data) = self.current_model()?;
-        let (m, v) = gp.predict(&self.to_unit(x));
-        let sign = if self.settings.minimize { -1.0 } else { 1.0 };
-        let w = data.mean + data.std * m;
-        let sd = data.std * v.sqrt();
-        Ok(match &data.warp {
-            Some(t) => (sign * t.inverse(w), sd / t.slope_at_image(w)),
-            None => (sign * w, sd),
-        })
+        let p = self.model_at_point(x)?;
+        Ok((p.mean, p.sd))
     }
 
-    /// Expected improvement at `x` under the current model: the current epoch's outputs
-    /// standardised (and transformed), the last fit's hyperparameters, `xi` from the
-    /// settings, against the best observation; pending points are ignored. Called right
-    /// after a one-point [`Optimizer::suggest`] (before its point is observed), this is the
-    /// acquisition that round maximised, without restart penalties or diversification.
-    /// Needs at least one observation.
+    /// Expected improvement at `x` under the current model (see [`Optimizer::model_at`]).
     pub fn expected_improvement(&self, x: &[f64]) -> Result<f64> {
-        self.check_point(x)?;
-        let (gp, data) = self.current_model()?;
-        let best = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let xi = self.settings.xi.xi(gp.kernel().signal_variance);
-        let (m, v) = gp.predict(&self.to_unit(x));
-        Ok(crate::acquisition::expected_improvement(m, v, best, xi))
+        Ok(self.model_at_point(x)?.ei)
     }
 
     /// Propose `q` new points (distinct from each other, from the observations and from the

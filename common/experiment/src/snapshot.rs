@@ -20,8 +20,8 @@ pub struct Snapshot {
     pub mean: Vec<f64>,
     /// Posterior standard deviation.
     pub sd: Vec<f64>,
-    /// Expected improvement as the engine sees it (`Optimizer::expected_improvement`: its
-    /// standardised, transformed units, with its `xi`).
+    /// Expected improvement as the engine sees it (`Optimizer::model_at`: its standardised,
+    /// transformed units, with its `xi`).
     pub ei: Vec<f64>,
     /// The trial it chose next.
     pub next: f64,
@@ -60,21 +60,19 @@ pub fn run_with_snapshots(
         if trace.scores.len() < 2 {
             return Ok(());
         }
-        let mut snap = Snapshot {
+        // One model for the grid and the chosen trial (the last point).
+        let at: Vec<Vec<f64>> = grid.iter().chain([&next]).map(|&x| vec![x]).collect();
+        let mut model = opt.model_at(&at)?;
+        let chosen = model.pop().map_or(0.0, |p| p.ei);
+        let snap = Snapshot {
             trials: trace.scores.len(),
             grid: grid.clone(),
-            mean: Vec::with_capacity(points),
-            sd: Vec::with_capacity(points),
-            ei: Vec::with_capacity(points),
+            mean: model.iter().map(|p| p.mean).collect(),
+            sd: model.iter().map(|p| p.sd).collect(),
+            ei: model.iter().map(|p| p.ei).collect(),
             next,
-            next_ei: opt.expected_improvement(&[next])?,
+            next_ei: chosen,
         };
-        for &x in &grid {
-            let (m, s) = opt.predict(&[x])?;
-            snap.mean.push(m);
-            snap.sd.push(s);
-            snap.ei.push(opt.expected_improvement(&[x])?);
-        }
         snaps.push(snap);
         Ok(())
     };

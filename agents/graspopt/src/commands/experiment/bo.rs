@@ -24,7 +24,7 @@ use graspopt_experiment::{
 use graspopt_sim::ParamKind;
 use graspopt_trial::Evaluator;
 
-use super::{OBJECTS, argmax, evaluator, scan, touched_grid, write};
+use super::{argmax, evaluator, scan, touched_grid, write};
 use crate::commands::setup::Contacts;
 use crate::commands::svg;
 
@@ -188,7 +188,10 @@ fn plan(args: &BoArgs) -> Result<Plan> {
     }
     let mut objects: Vec<String> = Vec::new();
     let named: Vec<String> = if args.objects.is_empty() {
-        OBJECTS.iter().map(|s| s.to_string()).collect()
+        graspopt_sim::Object::names()
+            .into_iter()
+            .map(String::from)
+            .collect()
     } else {
         args.objects.iter().map(|s| s.trim().to_string()).collect()
     };
@@ -642,13 +645,13 @@ fn six_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<
         let ev = object_evaluator(object, &kinds, args.contacts)?;
         let cmp = bo_and_random(&ev, plan.engine, args.budget_6d, seeds, None, args.threads)?;
         let medians_at = |m: &MethodSummary| -> String {
+            let curves: Vec<Vec<f64>> = m.traces.iter().map(|t| t.best_so_far()).collect();
             checkpoints
                 .iter()
                 .map(|&n| {
-                    let v: Vec<f64> = m
-                        .traces
+                    let v: Vec<f64> = curves
                         .iter()
-                        .filter_map(|t| t.best_so_far().get(n - 1).copied())
+                        .filter_map(|c| c.get(n - 1).copied())
                         .collect();
                     format!("{:.4}", median(&v).unwrap_or(f64::NAN))
                 })

@@ -18,7 +18,7 @@ use graspopt_sim::{ContactModel, ParamKind};
 use graspopt_trial::scan::ScanPoint;
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
 
-use super::{OBJECTS, argmax, evaluator, scan, touched_grid, write};
+use super::{argmax, evaluator, scan, touched_grid, write};
 use crate::commands::svg;
 
 #[derive(Args, Debug)]
@@ -217,7 +217,8 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     // 4.9-4.15: 2D maps of the seven objects.
     report.push_str("\n## Figures 4.9-4.15: 2D BW maps (approach x vertical, surface model)\n\n");
     report.push_str(MAP_TABLE);
-    for object in OBJECTS {
+    // The seven objects of the thesis, in its order.
+    for object in graspopt_sim::Object::names() {
         let ev = evaluator(object, &[ParamKind::Approach, ParamKind::Vertical])?;
         report.push_str(&map_row(
             dir,

@@ -41,17 +41,6 @@ pub fn run(args: &ExperimentArgs) -> Result<std::process::ExitCode> {
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-/// The seven objects of the thesis, in its order.
-const OBJECTS: [&str; 7] = [
-    "sphere",
-    "wine_glass",
-    "cylinder",
-    "mug",
-    "cuboid",
-    "rotated_cuboid",
-    "star_prism",
-];
-
 /// The Barrett hand on a built-in object, over the given parameters.
 fn evaluator(object: &str, kinds: &[ParamKind]) -> Result<Evaluator> {
     let object = Object::by_name(object)?;
