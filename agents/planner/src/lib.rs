@@ -121,7 +121,11 @@ impl Planner {
                     .map_err(|e| format!("pending point rejected: {e}"))?;
                 opt.suggest(count).map_err(|e| e.to_string())
             }
-            Engine::Random(r) => r.suggest(count).map_err(|e| e.to_string()),
+            Engine::Random(r) => {
+                // A rebuilt search continues the stream after the points already issued.
+                r.skip_to(req.observations.len() + req.pending.len());
+                r.suggest(count).map_err(|e| e.to_string())
+            }
         }
     }
 }
@@ -230,15 +234,50 @@ mod tests {
             });
         }
         assert_eq!(warm.rebuilds, 1);
-        // A restarted planner sees the same history from scratch.
+        // A planner restarted inside the initial design (3 points) continues that design:
+        // it proposes the warm planner's third point, not the first one again.
+        let mut restarted = Planner::default();
+        let third = restarted
+            .propose(&request(history[..2].to_vec(), vec![], 1))
+            .unwrap();
+        assert_eq!(third, vec![history[2].x.clone()]);
+        // Restarted planners given the same history propose the same points.
         let mut cold = Planner::default();
-        let replay_ok = cold.propose(&request(history.clone(), vec![], 2)).unwrap();
-        assert_eq!(replay_ok.len(), 2);
+        let replay = cold.propose(&request(history.clone(), vec![], 2)).unwrap();
+        assert_eq!(replay.len(), 2);
+        let mut again = Planner::default();
+        assert_eq!(
+            again.propose(&request(history.clone(), vec![], 2)).unwrap(),
+            replay
+        );
         // Different history: rebuild.
         let mut other = history.clone();
         other[0].y += 1.0;
         warm.propose(&request(other, vec![], 1)).unwrap();
         assert_eq!(warm.rebuilds, 2);
+    }
+
+    #[test]
+    fn a_restarted_random_search_continues_its_stream() {
+        let random = |observations: Vec<Observation>, pending: Vec<Vec<f64>>| SuggestRequest {
+            method: PlannerMethod::Random,
+            ..request(observations, pending, 1)
+        };
+        let mut warm = Planner::default();
+        let mut history: Vec<Observation> = Vec::new();
+        for _ in 0..4 {
+            let x = warm
+                .propose(&random(history.clone(), vec![]))
+                .unwrap()
+                .remove(0);
+            history.push(Observation { y: f(&x), x });
+        }
+        // Restarted after two results with the third trial still pending: the fourth point.
+        let mut restarted = Planner::default();
+        let next = restarted
+            .propose(&random(history[..2].to_vec(), vec![history[2].x.clone()]))
+            .unwrap();
+        assert_eq!(next, vec![history[3].x.clone()]);
     }
 
     #[test]

@@ -96,6 +96,10 @@ fn main() {
             tabu_radius: p[3],
         });
     }
+    if let Some(v) = env("BO_LHS").and_then(|v| v.parse::<usize>().ok()) {
+        settings.initial_design =
+            graspopt_bayesopt::InitialDesign::MaximinLatinHypercube { candidates: v };
+    }
     if let Some(b) = env("BO_BATCH") {
         settings.batch = match b.as_str() {
             "clmin" => graspopt_bayesopt::BatchStrategy::ConstantLiarMin,

@@ -77,6 +77,9 @@ impl Record {
 pub struct RandomSearch {
     record: Record,
     rng: Rng,
+    /// Points drawn from the stream so far.
+    #[serde(default)]
+    drawn: usize,
 }
 
 impl RandomSearch {
@@ -85,22 +88,33 @@ impl RandomSearch {
         Ok(RandomSearch {
             record: Record::new(bounds, minimize)?,
             rng: Rng::new(seed),
+            drawn: 0,
         })
+    }
+
+    /// Skips the stream ahead to its `issued`-th point (no-op if it is there already), so a
+    /// search rebuilt from a run's history (observations and points still pending) proposes
+    /// the points the original would have, not the run's first points again.
+    pub fn skip_to(&mut self, issued: usize) {
+        while self.drawn < issued {
+            self.draw();
+        }
+    }
+
+    fn draw(&mut self) -> Vec<f64> {
+        self.drawn += 1;
+        let r = &self.record;
+        r.lower
+            .iter()
+            .zip(&r.upper)
+            .map(|(l, u)| self.rng.uniform_range(*l, *u))
+            .collect()
     }
 }
 
 impl AskTell for RandomSearch {
     fn suggest(&mut self, q: usize) -> Result<Vec<Vec<f64>>> {
-        let r = &self.record;
-        Ok((0..q)
-            .map(|_| {
-                r.lower
-                    .iter()
-                    .zip(&r.upper)
-                    .map(|(l, u)| self.rng.uniform_range(*l, *u))
-                    .collect()
-            })
-            .collect())
+        Ok((0..q).map(|_| self.draw()).collect())
     }
     fn observe(&mut self, x: &[f64], y: f64) -> Result<()> {
         self.record.observe(x, y)

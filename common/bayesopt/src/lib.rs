@@ -30,7 +30,7 @@ pub use fit::{FitSettings, Hyperparameters};
 pub use gp::Gp;
 pub use kernel::{Kernel, KernelKind};
 pub use optimizer::{
-    BatchStrategy, ModelPoint, Optimizer, OutputTransform, RestartRule, RoundInfo, Settings,
-    StopReason, StopRule,
+    BatchStrategy, InitialDesign, ModelPoint, Optimizer, OutputTransform, RestartRule, RoundInfo,
+    Settings, StopReason, StopRule,
 };
 pub use testfunctions::TestFunction;

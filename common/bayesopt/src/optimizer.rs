@@ -40,6 +40,22 @@ pub enum BatchStrategy {
     ConstantLiarMax,
 }
 
+/// How the points of the initial design are placed (the first epoch's; a restarted epoch's
+/// points are always uniform).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum InitialDesign {
+    /// Independent uniform points (the thesis's random initial design).
+    #[default]
+    Random,
+    /// A Latin hypercube (one point in each of `n` equal slices of every axis), the one with
+    /// the largest smallest pairwise distance among `candidates` random ones, so a small design
+    /// leaves no large region unsampled.
+    MaximinLatinHypercube {
+        /// Random Latin hypercubes compared (>= 1).
+        candidates: usize,
+    },
+}
+
 /// When to stop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StopRule {
@@ -103,6 +119,9 @@ pub struct Settings {
     /// Size of the random initial design (None: `max(5, ceil(5 d / 3))`, i.e. 5 in 2D, 10 in
     /// 6D).
     pub n_init: Option<usize>,
+    /// Placement of the initial design.
+    #[serde(default)]
+    pub initial_design: InitialDesign,
     /// Acquisition function.
     pub acquisition: AcquisitionKind,
     /// EI exploration margin rule (thesis default `sigma_f^2 / 100`).
@@ -149,6 +168,7 @@ impl Default for Settings {
             minimize: false,
             kernel: KernelKind::Matern32,
             n_init: None,
+            initial_design: InitialDesign::Random,
             acquisition: AcquisitionKind::ExpectedImprovement,
             xi: XiRule::ThesisSignalVariance,
             fit: FitSettings::default(),
@@ -170,13 +190,15 @@ impl Default for Settings {
 
 impl Settings {
     /// Settings for grasp scores: the thesis's (the defaults) with the bad tail of the
-    /// outputs compressed ([`OutputTransform::TailLog`]). A trial that misses the object
-    /// scores far below every grasp; without the compression those few values set the
+    /// outputs compressed ([`OutputTransform::TailLog`]) and a space-filling initial design
+    /// ([`InitialDesign::MaximinLatinHypercube`] of 50 candidates). A trial that misses the
+    /// object scores far below every grasp; without the compression those few values set the
     /// model's scale. The best of the settings measured on the simulator's seven objects
     /// (`graspopt experiment bo`, docs/benchmarks.md); maximising.
     pub fn for_grasps() -> Self {
         Settings {
             output_transform: OutputTransform::TailLog,
+            initial_design: InitialDesign::MaximinLatinHypercube { candidates: 50 },
             ..Settings::default()
         }
     }
@@ -214,6 +236,11 @@ impl Settings {
         {
             return Err(BoError::InvalidSetting(
                 "restart tol and tabu_radius must be finite and >= 0".into(),
+            ));
+        }
+        if let InitialDesign::MaximinLatinHypercube { candidates: 0 } = self.initial_design {
+            return Err(BoError::InvalidSetting(
+                "a Latin hypercube design needs candidates >= 1".into(),
             ));
         }
         if self.stop.relative_ei_threshold.is_nan() || self.stop.relative_ei_threshold < 0.0 {
@@ -273,6 +300,9 @@ pub struct Optimizer {
     /// Incumbents (unit cube) of earlier epochs.
     #[serde(default)]
     tabu: Vec<Vec<f64>>,
+    /// The first epoch's initial design (unit cube), drawn whole when first needed.
+    #[serde(default)]
+    design: Vec<Vec<f64>>,
 }
 
 struct Standardised {
@@ -281,6 +311,42 @@ struct Standardised {
     mean: f64,
     std: f64,
     warp: Option<Warp>,
+}
+
+/// The Latin hypercube of `n` points in `[0, 1]^d` with the largest smallest pairwise distance
+/// among `candidates` random ones (each point uniform inside its cell).
+fn maximin_latin_hypercube(rng: &mut Rng, n: usize, d: usize, candidates: usize) -> Vec<Vec<f64>> {
+    let mut best: Vec<Vec<f64>> = Vec::new();
+    let mut best_gap = f64::NEG_INFINITY;
+    for _ in 0..candidates.max(1) {
+        let mut pts = vec![vec![0.0; d]; n];
+        for j in 0..d {
+            let mut cells: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                let k = (rng.uniform() * (i + 1) as f64) as usize;
+                cells.swap(i, k.min(i));
+            }
+            for (p, c) in pts.iter_mut().zip(&cells) {
+                p[j] = (*c as f64 + rng.uniform()) / n as f64;
+            }
+        }
+        let mut gap = f64::INFINITY;
+        for a in 0..n {
+            for b in a + 1..n {
+                let d2: f64 = pts[a]
+                    .iter()
+                    .zip(&pts[b])
+                    .map(|(x, y)| (x - y) * (x - y))
+                    .sum();
+                gap = gap.min(d2);
+            }
+        }
+        if gap > best_gap {
+            best_gap = gap;
+            best = pts;
+        }
+    }
+    best
 }
 
 /// Monotone output transform applied (to the maximisation-direction values) before
@@ -465,6 +531,7 @@ impl Optimizer {
             last_round: RoundInfo::default(),
             epoch_start: 0,
             tabu: Vec::new(),
+            design: Vec::new(),
         })
     }
 
@@ -824,7 +891,22 @@ impl Optimizer {
         while out.len() < q
             && (epoch_len + self.pending.len() + out.len() < epoch_init || epoch_len < 2)
         {
-            let u = self.rng.unit_point(d);
+            // The first epoch's design is drawn whole when first needed, so an engine rebuilt
+            // from the first k observations of a run hands out the same design's next point.
+            let issued = epoch_len + self.pending.len() + out.len();
+            if self.epoch_start == 0 && self.design.is_empty() {
+                let n = epoch_init.max(2);
+                self.design = match self.settings.initial_design {
+                    InitialDesign::Random => (0..n).map(|_| self.rng.unit_point(d)).collect(),
+                    InitialDesign::MaximinLatinHypercube { candidates } => {
+                        maximin_latin_hypercube(&mut self.rng, n, d, candidates)
+                    }
+                };
+            }
+            let u = match self.design.get(issued) {
+                Some(u) if self.epoch_start == 0 => u.clone(),
+                _ => self.rng.unit_point(d),
+            };
             out.push(self.unit_to_box(&u));
             info.random_points += 1;
         }
@@ -1121,6 +1203,72 @@ impl AskTell for Optimizer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Smallest squared distance between two points of `pts`.
+    fn smallest_gap(pts: &[Vec<f64>]) -> f64 {
+        let mut gap = f64::INFINITY;
+        for (a, p) in pts.iter().enumerate() {
+            for q in &pts[a + 1..] {
+                gap = gap.min(p.iter().zip(q).map(|(x, y)| (x - y) * (x - y)).sum());
+            }
+        }
+        gap
+    }
+
+    #[test]
+    fn latin_hypercube_has_one_point_per_slice_and_maximin_spreads_them() {
+        let (n, d) = (10, 6);
+        let mut rng = Rng::new(5);
+        let one = maximin_latin_hypercube(&mut rng, n, d, 1);
+        let best = maximin_latin_hypercube(&mut Rng::new(5), n, d, 200);
+        for pts in [&one, &best] {
+            assert_eq!(pts.len(), n);
+            for j in 0..d {
+                let mut slices: Vec<usize> =
+                    pts.iter().map(|p| (p[j] * n as f64) as usize).collect();
+                slices.sort_unstable();
+                assert_eq!(slices, (0..n).collect::<Vec<_>>(), "axis {j}: {pts:?}");
+            }
+        }
+        // the first candidate of the maximin search is the single hypercube drawn from the
+        // same stream, so the best of 200 is at least as spread, and here strictly more
+        assert!(smallest_gap(&best) > smallest_gap(&one));
+    }
+
+    #[test]
+    fn the_initial_design_is_handed_out_in_order_across_batches_and_pending_points() {
+        let settings = Settings {
+            n_init: Some(5),
+            initial_design: InitialDesign::MaximinLatinHypercube { candidates: 20 },
+            ..Settings::default()
+        };
+        let mut opt = Optimizer::new(&[(0.0, 10.0), (-1.0, 1.0)], settings, 3).unwrap();
+        let mut pts = opt.suggest(2).unwrap();
+        pts.extend(opt.suggest(1).unwrap());
+        opt.observe(&pts[0], 1.0).unwrap();
+        pts.extend(opt.suggest(2).unwrap());
+        assert_eq!(opt.last_round().random_points, 2);
+        let units: Vec<Vec<f64>> = pts.iter().map(|p| opt.to_unit(p)).collect();
+        assert_eq!(units.len(), 5);
+        for (u, v) in units.iter().zip(&opt.design) {
+            for (a, b) in u.iter().zip(v) {
+                assert!((a - b).abs() < 1e-12, "{units:?} against {:?}", opt.design);
+            }
+        }
+        for j in 0..2 {
+            let mut slices: Vec<usize> = units.iter().map(|u| (u[j] * 5.0) as usize).collect();
+            slices.sort_unstable();
+            assert_eq!(slices, vec![0, 1, 2, 3, 4]);
+        }
+        let bad = Settings {
+            initial_design: InitialDesign::MaximinLatinHypercube { candidates: 0 },
+            ..Settings::default()
+        };
+        assert!(matches!(
+            Optimizer::new(&[(0.0, 1.0)], bad, 0),
+            Err(BoError::InvalidSetting(_))
+        ));
+    }
 
     #[test]
     fn warps_are_monotone_and_invertible() {

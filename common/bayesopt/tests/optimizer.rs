@@ -73,6 +73,24 @@ fn serde_round_trip_continues_identically() {
 }
 
 #[test]
+fn a_latin_hypercube_design_round_trips_halfway() {
+    let s = Settings {
+        initial_design: graspopt_bayesopt::InitialDesign::MaximinLatinHypercube { candidates: 30 },
+        ..fast_settings()
+    };
+    let mut a = Optimizer::new(&branin_bounds(), s, 9).unwrap();
+    step(&mut a, 2);
+    let json = serde_json::to_string(&a).unwrap();
+    let mut b: Optimizer = serde_json::from_str(&json).unwrap();
+    assert_eq!(a, b);
+    // the rest of the design (3 points), then model-based proposals
+    for _ in 0..5 {
+        assert_eq!(step(&mut a, 1), step(&mut b, 1));
+    }
+    assert_eq!(a, b);
+}
+
+#[test]
 fn restarts_round_trip_and_continue_identically() {
     let s = Settings {
         restart: Some(graspopt_bayesopt::RestartRule {

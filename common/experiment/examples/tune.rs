@@ -5,10 +5,12 @@
 //! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
 //! with variants `random`, `thesis`, `benchmark`, `grasp` and `grasp-` followed by one change:
 //! `rank`, `xi0`, `init3`, `init8`, `m52`, `pm` (pessimistic prior mean), `m52-pm`, `noise`
-//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`.
+//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`, `lhs` (maximin Latin hypercube initial design).
 
 use graspopt_bayesopt::benchmark::recommended_settings;
-use graspopt_bayesopt::{AcquisitionKind, KernelKind, Method, OutputTransform, Settings, XiRule};
+use graspopt_bayesopt::{
+    AcquisitionKind, InitialDesign, KernelKind, Method, OutputTransform, Settings, XiRule,
+};
 use graspopt_experiment::{SearchSettings, compare};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
@@ -39,6 +41,7 @@ fn variant(name: &str) -> Option<Settings> {
         "ucb" => s.acquisition = AcquisitionKind::Ucb { beta: 4.0 },
         "explore" => s.explore_below_ei = Some(1e-3),
         "restart" => s.restart = recommended_settings().restart,
+        "lhs" => s.initial_design = InitialDesign::MaximinLatinHypercube { candidates: 50 },
         _ => return None,
     }
     Some(s)

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use graspopt_bayesopt::{Method, Settings};
+use graspopt_bayesopt::{InitialDesign, Method, Settings};
 use graspopt_experiment::{
     Comparison, Engine, MethodSummary, SearchSettings, Snapshot, TARGET_FRACTIONS, compare, median,
     run_with_snapshots,
@@ -212,6 +212,20 @@ fn plan(args: &BoArgs) -> Result<Plan> {
     })
 }
 
+/// How BO's initial design relates to random search's points, for the report.
+fn pairing(settings: &Settings) -> &'static str {
+    match settings.initial_design {
+        InitialDesign::Random => {
+            "for each seed, BO's random initial design draws the same first points as random \
+             search, so each seed is a paired comparison."
+        }
+        InitialDesign::MaximinLatinHypercube { .. } => {
+            "BO's initial design is a maximin Latin hypercube (one point in each slice of every \
+             axis), random search's points are independent and uniform."
+        }
+    }
+}
+
 pub(super) fn bo(args: &BoArgs) -> Result<()> {
     let plan = plan(args)?;
     let dir = &args.out;
@@ -224,9 +238,8 @@ pub(super) fn bo(args: &BoArgs) -> Result<()> {
          --objects {} --parts {} --contacts {contacts} --engine {}`.\n\n\
          Barrett hand, {contacts} contact model without noise (the thesis's 2D runs used mean-point contacts and noisy \
          observations: `--contacts mean`), BW score; a trial that touches nothing scores below every grasp, by how \
-         far it missed. Engine settings `{}`; random search is uniform over the same box. Seeds {}-{}: for each seed, \
-         BO's random initial design draws the same first points as random search, so each seed is a paired \
-         comparison. \"Within p%\" of a reference means a best score of at least `reference - p |reference|`.\n",
+         far it missed. Engine settings `{}`; random search is uniform over the same box. Seeds {}-{}: {} \
+         \"Within p%\" of a reference means a best score of at least `reference - p |reference|`.\n",
         args.seeds,
         args.first_seed,
         args.budget,
@@ -239,6 +252,7 @@ pub(super) fn bo(args: &BoArgs) -> Result<()> {
         plan.engine.name(),
         args.first_seed,
         args.first_seed + (args.seeds - 1),
+        pairing(&plan.engine.settings()),
     );
     let started = std::time::Instant::now();
     if args.parts.contains(&Part::OneD) {
