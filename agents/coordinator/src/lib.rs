@@ -45,7 +45,7 @@ pub struct RunSpec {
     pub trials: u64,
     pub seed: u64,
     pub method: PlannerMethod,
-    /// Size of the random initial design (`None`: the engine's default).
+    /// Size of the initial design (space-filling, not model-based) (`None`: the engine's default).
     pub initial: Option<u32>,
 }
 

@@ -256,11 +256,11 @@ fn experiment_bo_bad_input_is_named() {
         ),
         (
             vec!["--parts", "2d", "--budget", "5"],
-            "--budget must be more than the engine's 5 random initial trials in 2D",
+            "--budget must be more than the engine's 5 initial-design trials in 2D",
         ),
         (
             vec!["--parts", "6d", "--budget-6d", "10"],
-            "--budget-6d must be more than the engine's 10 random initial trials in 6D",
+            "--budget-6d must be more than the engine's 10 initial-design trials in 6D",
         ),
     ] {
         let mut all = vec!["experiment", "bo", "--out", dir.to_str().unwrap()];

@@ -123,7 +123,13 @@ impl Planner {
             }
             Engine::Random(r) => {
                 // A rebuilt search continues the stream after the points already issued.
-                r.skip_to(req.observations.len() + req.pending.len());
+                let known: Vec<Vec<f64>> = req
+                    .observations
+                    .iter()
+                    .map(|o| o.x.clone())
+                    .chain(req.pending.iter().cloned())
+                    .collect();
+                r.resume_after(&known);
                 r.suggest(count).map_err(|e| e.to_string())
             }
         }
@@ -222,7 +228,7 @@ mod tests {
     }
 
     #[test]
-    fn a_warm_planner_and_a_rebuilt_one_propose_the_same() {
+    fn a_restarted_planner_continues_the_design_and_rebuilds_deterministically() {
         let mut warm = Planner::default();
         let mut history: Vec<Observation> = Vec::new();
         for _ in 0..8 {
@@ -276,6 +282,13 @@ mod tests {
         let mut restarted = Planner::default();
         let next = restarted
             .propose(&random(history[..2].to_vec(), vec![history[2].x.clone()]))
+            .unwrap();
+        assert_eq!(next, vec![history[3].x.clone()]);
+        // The second trial failed (it left the history): still the fourth point, not the
+        // pending third one.
+        let mut restarted = Planner::default();
+        let next = restarted
+            .propose(&random(history[..1].to_vec(), vec![history[2].x.clone()]))
             .unwrap();
         assert_eq!(next, vec![history[3].x.clone()]);
     }

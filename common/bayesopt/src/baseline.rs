@@ -92,12 +92,35 @@ impl RandomSearch {
         })
     }
 
-    /// Skips the stream ahead to its `issued`-th point (no-op if it is there already), so a
-    /// search rebuilt from a run's history (observations and points still pending) proposes
-    /// the points the original would have, not the run's first points again.
-    pub fn skip_to(&mut self, issued: usize) {
-        while self.drawn < issued {
-            self.draw();
+    /// Continues the stream after the points a run already issued (`known`: its
+    /// observations and pending points), so a search rebuilt from the run's history proposes
+    /// what the original would have, not the run's first points again. Only a fresh search
+    /// moves: it skips to just after the last of its first `4 n + 64` stream points that is in
+    /// `known` (points that failed and left the history are skipped with the others); with no
+    /// such point it stays where it is.
+    pub fn resume_after(&mut self, known: &[Vec<f64>]) {
+        if self.drawn > 0 || known.is_empty() {
+            return;
+        }
+        let r = &self.record;
+        let same = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .zip(r.lower.iter().zip(&r.upper))
+                .all(|((x, y), (lo, hi))| (x - y).abs() <= 1e-9 * (hi - lo))
+        };
+        let mut probe = self.clone();
+        let mut last = None;
+        for i in 0..4 * known.len() + 64 {
+            let p = probe.draw();
+            if known.iter().any(|k| same(k, &p)) {
+                last = Some(i);
+            }
+        }
+        if let Some(i) = last {
+            for _ in 0..=i {
+                self.draw();
+            }
         }
     }
 

@@ -116,8 +116,7 @@ pub struct Settings {
     pub minimize: bool,
     /// Kernel family.
     pub kernel: KernelKind,
-    /// Size of the random initial design (None: `max(5, ceil(5 d / 3))`, i.e. 5 in 2D, 10 in
-    /// 6D).
+    /// Size of the initial design (None: `max(5, ceil(5 d / 3))`, i.e. 5 in 2D, 10 in 6D).
     pub n_init: Option<usize>,
     /// Placement of the initial design.
     #[serde(default)]
@@ -303,6 +302,9 @@ pub struct Optimizer {
     /// The first epoch's initial design (unit cube), drawn whole when first needed.
     #[serde(default)]
     design: Vec<Vec<f64>>,
+    /// Index in `design` of the next point to consider.
+    #[serde(default)]
+    design_next: usize,
 }
 
 struct Standardised {
@@ -532,6 +534,7 @@ impl Optimizer {
             epoch_start: 0,
             tabu: Vec::new(),
             design: Vec::new(),
+            design_next: 0,
         })
     }
 
@@ -669,6 +672,15 @@ impl Optimizer {
             .zip(self.lower.iter().zip(&self.upper))
             .map(|(v, (l, h))| (l + v * (h - l)).clamp(*l, *h))
             .collect()
+    }
+
+    /// Whether two points of the box are the same up to rounding (1e-9 of each side), as a
+    /// point that went through a journal and back is.
+    fn same_point(&self, a: &[f64], b: &[f64]) -> bool {
+        a.iter()
+            .zip(b)
+            .zip(self.lower.iter().zip(&self.upper))
+            .all(|((x, y), (lo, hi))| (x - y).abs() <= 1e-9 * (hi - lo))
     }
 
     fn check_point(&self, x: &[f64]) -> Result<()> {
@@ -891,21 +903,38 @@ impl Optimizer {
         while out.len() < q
             && (epoch_len + self.pending.len() + out.len() < epoch_init || epoch_len < 2)
         {
-            // The first epoch's design is drawn whole when first needed, so an engine rebuilt
-            // from the first k observations of a run hands out the same design's next point.
-            let issued = epoch_len + self.pending.len() + out.len();
-            if self.epoch_start == 0 && self.design.is_empty() {
-                let n = epoch_init.max(2);
-                self.design = match self.settings.initial_design {
-                    InitialDesign::Random => (0..n).map(|_| self.rng.unit_point(d)).collect(),
-                    InitialDesign::MaximinLatinHypercube { candidates } => {
-                        maximin_latin_hypercube(&mut self.rng, n, d, candidates)
+            // The first epoch's design is drawn whole when first needed and handed out in
+            // order, skipping its points already observed or pending: an engine rebuilt from a
+            // run's history continues the same design, and a design point whose trial failed
+            // (dropped from both) is not followed by a point still pending.
+            let u = if self.epoch_start == 0 {
+                if self.design.is_empty() {
+                    let n = epoch_init.max(2);
+                    self.design = match self.settings.initial_design {
+                        InitialDesign::Random => (0..n).map(|_| self.rng.unit_point(d)).collect(),
+                        InitialDesign::MaximinLatinHypercube { candidates } => {
+                            maximin_latin_hypercube(&mut self.rng, n, d, candidates)
+                        }
+                    };
+                }
+                let next = (self.design_next..self.design.len()).find(|&i| {
+                    let x = self.unit_to_box(&self.design[i]);
+                    !self
+                        .xs
+                        .iter()
+                        .chain(&self.pending)
+                        .chain(&out)
+                        .any(|p| self.same_point(p, &x))
+                });
+                match next {
+                    Some(i) => {
+                        self.design_next = i + 1;
+                        self.design[i].clone()
                     }
-                };
-            }
-            let u = match self.design.get(issued) {
-                Some(u) if self.epoch_start == 0 => u.clone(),
-                _ => self.rng.unit_point(d),
+                    None => self.rng.unit_point(d),
+                }
+            } else {
+                self.rng.unit_point(d)
             };
             out.push(self.unit_to_box(&u));
             info.random_points += 1;
@@ -1260,6 +1289,24 @@ mod tests {
             slices.sort_unstable();
             assert_eq!(slices, vec![0, 1, 2, 3, 4]);
         }
+        // The trial of a design point failed (dropped from observations and pending): the
+        // next point is the design's next one, never a point still pending.
+        let settings = Settings {
+            n_init: Some(4),
+            ..Settings::default()
+        };
+        let mut warm = Optimizer::new(&[(0.0, 1.0), (0.0, 1.0)], settings.clone(), 8).unwrap();
+        let first = warm.suggest(2).unwrap();
+        warm.set_pending(vec![first[1].clone()]).unwrap();
+        let third = warm.suggest(1).unwrap();
+        assert_eq!(third[0], warm.unit_to_box(&warm.design[2]));
+        // rebuilt with the same history: the failed point again, not the pending one
+        let mut rebuilt = Optimizer::new(&[(0.0, 1.0), (0.0, 1.0)], settings, 8).unwrap();
+        rebuilt.set_pending(vec![first[1].clone()]).unwrap();
+        assert_eq!(
+            rebuilt.suggest(2).unwrap(),
+            vec![first[0].clone(), third[0].clone()]
+        );
         let bad = Settings {
             initial_design: InitialDesign::MaximinLatinHypercube { candidates: 0 },
             ..Settings::default()

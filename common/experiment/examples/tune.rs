@@ -5,7 +5,7 @@
 //! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
 //! with variants `random`, `thesis`, `benchmark`, `grasp` and `grasp-` followed by one change:
 //! `rank`, `xi0`, `init3`, `init8`, `m52`, `pm` (pessimistic prior mean), `m52-pm`, `noise`
-//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`, `lhs` (maximin Latin hypercube initial design).
+//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`, `uniform` (uniform initial design instead of the Latin hypercube).
 
 use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::{
@@ -41,7 +41,7 @@ fn variant(name: &str) -> Option<Settings> {
         "ucb" => s.acquisition = AcquisitionKind::Ucb { beta: 4.0 },
         "explore" => s.explore_below_ei = Some(1e-3),
         "restart" => s.restart = recommended_settings().restart,
-        "lhs" => s.initial_design = InitialDesign::MaximinLatinHypercube { candidates: 50 },
+        "uniform" => s.initial_design = InitialDesign::Random,
         _ => return None,
     }
     Some(s)

@@ -16,7 +16,7 @@ pub struct SearchSettings {
     pub method: Method,
     /// Trials at most.
     pub budget: usize,
-    /// Size of the engine's random initial design (None: the engine's default, 5 in 2D).
+    /// Size of the engine's initial design (None: the engine's default, 5 in 2D).
     pub n_init: Option<usize>,
     /// Stop before the budget once the engine says the expected improvement has vanished
     /// (thesis 3.4); otherwise the run goes on and [`Trace::ei_stop_at`] records when the

@@ -325,7 +325,7 @@ pub struct SuggestRequest {
     /// `[lower, upper]` per parameter.
     pub bounds: Vec<[f64; 2]>,
     pub seed: u64,
-    /// Size of the random initial design (`None`: the engine's default).
+    /// Size of the initial design (space-filling, not model-based) (`None`: the engine's default).
     pub initial: Option<u32>,
     /// Every completed trial, in completion order.
     pub observations: Vec<Observation>,

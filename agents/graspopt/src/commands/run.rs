@@ -54,7 +54,7 @@ pub struct RunArgs {
     /// How trials are proposed.
     #[arg(long, value_enum, default_value_t = Method::Bo)]
     pub method: Method,
-    /// Size of the random initial design (default: the engine's).
+    /// Size of the initial design (space-filling, not model-based) (default: the engine's).
     #[arg(long)]
     pub initial: Option<u32>,
     #[arg(long, default_value_t = 0)]

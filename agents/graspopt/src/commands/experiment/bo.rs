@@ -174,7 +174,7 @@ fn plan(args: &BoArgs) -> Result<Plan> {
             args.steps
         );
     }
-    // A run no longer than the engine's random initial design is random search.
+    // A run no longer than the engine's initial design never uses the model.
     for (flag, budget, dim, part) in [
         ("--budget", args.budget, 2, Part::TwoD),
         ("--budget-6d", args.budget_6d, 6, Part::SixD),
@@ -182,7 +182,7 @@ fn plan(args: &BoArgs) -> Result<Plan> {
         let init = Settings::default_n_init(dim);
         if args.parts.contains(&part) && !(init < budget && budget <= MAX_BUDGET) {
             bail!(
-                "{flag} must be more than the engine's {init} random initial trials in {dim}D and at most {MAX_BUDGET}, got {budget}"
+                "{flag} must be more than the engine's {init} initial-design trials in {dim}D and at most {MAX_BUDGET}, got {budget}"
             );
         }
     }
