@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::direct::check_bounds;
+use crate::direct::{check_bounds, same_point};
 use crate::error::{BoError, Result};
 use crate::rng::Rng;
 
@@ -102,18 +102,12 @@ impl RandomSearch {
         if self.drawn > 0 || known.is_empty() {
             return;
         }
-        let r = &self.record;
-        let same = |a: &[f64], b: &[f64]| {
-            a.iter()
-                .zip(b)
-                .zip(r.lower.iter().zip(&r.upper))
-                .all(|((x, y), (lo, hi))| (x - y).abs() <= 1e-9 * (hi - lo))
-        };
+        let (lower, upper) = (&self.record.lower, &self.record.upper);
         let mut probe = self.clone();
         let mut last = None;
         for i in 0..4 * known.len() + 64 {
             let p = probe.draw();
-            if known.iter().any(|k| same(k, &p)) {
+            if known.iter().any(|k| same_point(k, &p, lower, upper)) {
                 last = Some(i);
             }
         }

@@ -116,6 +116,15 @@ fn rect_size(levels: &[u32]) -> f64 {
 /// The two new centres along one side: (side, c+, f(c+), c-, f(c-)).
 type Trial = (usize, Vec<f64>, f64, Vec<f64>, f64);
 
+/// Whether two points of the box `[lower, upper]` are the same up to rounding (1e-9 of each
+/// side), as a point that went through a journal and back is.
+pub(crate) fn same_point(a: &[f64], b: &[f64], lower: &[f64], upper: &[f64]) -> bool {
+    a.iter()
+        .zip(b)
+        .zip(lower.iter().zip(upper))
+        .all(|((x, y), (lo, hi))| (x - y).abs() <= 1e-9 * (hi - lo))
+}
+
 /// Check bounds of a box.
 pub fn check_bounds(lower: &[f64], upper: &[f64]) -> Result<()> {
     if lower.is_empty() {

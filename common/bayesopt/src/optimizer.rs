@@ -19,7 +19,7 @@ use crate::acquisition::{
     self, AcquisitionKind, LOG_EI_FLOOR, XiRule, expected_improvement, log_expected_improvement,
 };
 use crate::baseline::AskTell;
-use crate::direct::{self, DirectSettings};
+use crate::direct::{self, DirectSettings, same_point};
 use crate::error::{BoError, Result};
 use crate::fit::{FitSettings, Hyperparameters, fit_map};
 use crate::gp::Gp;
@@ -674,15 +674,6 @@ impl Optimizer {
             .collect()
     }
 
-    /// Whether two points of the box are the same up to rounding (1e-9 of each side), as a
-    /// point that went through a journal and back is.
-    fn same_point(&self, a: &[f64], b: &[f64]) -> bool {
-        a.iter()
-            .zip(b)
-            .zip(self.lower.iter().zip(&self.upper))
-            .all(|((x, y), (lo, hi))| (x - y).abs() <= 1e-9 * (hi - lo))
-    }
-
     fn check_point(&self, x: &[f64]) -> Result<()> {
         if x.len() != self.dim() {
             return Err(BoError::DimensionMismatch {
@@ -924,7 +915,7 @@ impl Optimizer {
                         .iter()
                         .chain(&self.pending)
                         .chain(&out)
-                        .any(|p| self.same_point(p, &x))
+                        .any(|p| same_point(p, &x, &self.lower, &self.upper))
                 });
                 match next {
                     Some(i) => {
