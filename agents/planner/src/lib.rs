@@ -123,11 +123,11 @@ impl Planner {
             }
             Engine::Random(r) => {
                 // A rebuilt search continues the stream after the points already issued.
-                let known: Vec<Vec<f64>> = req
+                let known: Vec<&[f64]> = req
                     .observations
                     .iter()
-                    .map(|o| o.x.clone())
-                    .chain(req.pending.iter().cloned())
+                    .map(|o| o.x.as_slice())
+                    .chain(req.pending.iter().map(Vec::as_slice))
                     .collect();
                 r.resume_after(&known);
                 r.suggest(count).map_err(|e| e.to_string())

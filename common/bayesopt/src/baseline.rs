@@ -98,7 +98,7 @@ impl RandomSearch {
     /// moves: it skips to just after the last of its first `4 n + 64` stream points that is in
     /// `known` (points that failed and left the history are skipped with the others); with no
     /// such point it stays where it is.
-    pub fn resume_after(&mut self, known: &[Vec<f64>]) {
+    pub fn resume_after(&mut self, known: &[&[f64]]) {
         if self.drawn > 0 || known.is_empty() {
             return;
         }

@@ -43,6 +43,33 @@ fn span(xs: &[f64], points: &[ScanPoint], pred: impl Fn(&ScanPoint) -> bool) -> 
     points.iter().filter(|p| pred(p)).count() as f64 * step
 }
 
+/// A variant's name, its approach axis and its scan.
+type Scanned<'a> = (&'a str, Vec<f64>, Vec<ScanPoint>);
+
+/// Scans every variant along its approach axis (`steps` points) and plots their BW together
+/// into `dir/file`; returns the scans and the file's name.
+fn approach_plot<'a>(
+    dir: &Path,
+    file: &str,
+    title: &str,
+    variants: Vec<(&'a str, Evaluator)>,
+    steps: usize,
+    threads: usize,
+) -> Result<(Vec<Scanned<'a>>, String)> {
+    let mut scans = Vec::new();
+    for (name, ev) in variants {
+        let (axes, points) = scan(&ev, &[steps], threads)?;
+        scans.push((name, axes.into_iter().next().unwrap_or_default(), points));
+    }
+    let xs = scans.last().map(|s| s.1.clone()).unwrap_or_default();
+    let series: Vec<(&str, Vec<f64>)> = scans
+        .iter()
+        .map(|(name, _, points)| (*name, points.iter().map(|p| p.score.score).collect()))
+        .collect();
+    let plot = svg::lines_plot(title, "approach offset (m)", "bw", &xs, &series);
+    Ok((scans, write(dir, file, &plot)?))
+}
+
 pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     let dir = &args.out;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -110,8 +137,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     // 4.6: contact models.
     report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n\n| object | model | BW max | force-closure range |\n|---|---|---|---|\n");
     for object in ["cuboid", "sphere"] {
-        let mut series = Vec::new();
-        let mut xs = Vec::new();
+        let mut variants = Vec::new();
         for (name, model) in [
             ("mean point", ContactModel::MeanPoint),
             ("circular patch", ContactModel::CircularPatch),
@@ -119,33 +145,27 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
         ] {
             let mut ev = evaluator(object, &[ParamKind::Approach])?;
             ev.score.contacts = model;
-            let (axes, points) = scan(&ev, &[steps], args.threads)?;
-            let fc = span(&axes[0], &points, |p| {
+            variants.push((name, ev));
+        }
+        let (scans, file) = approach_plot(
+            dir,
+            &format!("fig4.6-{object}-contact-models.svg"),
+            &format!("Fig. 4.6: BW on the {object} by contact model"),
+            variants,
+            steps,
+            args.threads,
+        )?;
+        for (name, xs, points) in &scans {
+            let fc = span(xs, points, |p| {
                 p.score.metrics.is_some_and(|m| m.force_closure)
             });
             let _ = writeln!(
                 report,
                 "| {object} | {name} | {:.4} | {:.0} mm |",
-                argmax(&points).score.score,
+                argmax(points).score.score,
                 fc * 1e3
             );
-            series.push((
-                name,
-                points.iter().map(|p| p.score.score).collect::<Vec<_>>(),
-            ));
-            xs = axes[0].clone();
         }
-        let file = write(
-            dir,
-            &format!("fig4.6-{object}-contact-models.svg"),
-            &svg::lines_plot(
-                &format!("Fig. 4.6: BW on the {object} by contact model"),
-                "approach offset (m)",
-                "bw",
-                &xs,
-                &series,
-            ),
-        )?;
         let _ = writeln!(report, "\nFile: {file}\n");
     }
 
@@ -170,13 +190,12 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
 
     // 4.8: reference frames with the torque scale fixed.
     report.push_str("\n## Figure 4.8: reference-frame independence (sphere, approach axis, torque scale 0.05 m)\n\n| frame | BW max | at approach |\n|---|---|---|\n");
-    let mut series = Vec::new();
-    let mut xs = Vec::new();
     let reference = evaluator("sphere", &[ParamKind::Approach])?
         .space
         .reference
         .translation
         .vector;
+    let mut variants = Vec::new();
     for (name, frame) in [
         ("object", ReferenceFrame::Object),
         ("world", ReferenceFrame::World),
@@ -188,30 +207,24 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
         let mut ev = evaluator("sphere", &[ParamKind::Approach])?;
         ev.score.frame = frame;
         ev.score.torque_scale = Some(0.05);
-        let (axes, points) = scan(&ev, &[steps], args.threads)?;
-        let best = argmax(&points);
+        variants.push((name, ev));
+    }
+    let (scans, file) = approach_plot(
+        dir,
+        "fig4.8-sphere-frames.svg",
+        "Fig. 4.8: BW on the sphere in three frames",
+        variants,
+        steps,
+        args.threads,
+    )?;
+    for (name, _, points) in &scans {
+        let best = argmax(points);
         let _ = writeln!(
             report,
             "| {name} | {:.4} | {:.4} |",
             best.score.score, best.params[0]
         );
-        series.push((
-            name,
-            points.iter().map(|p| p.score.score).collect::<Vec<_>>(),
-        ));
-        xs = axes[0].clone();
     }
-    let file = write(
-        dir,
-        "fig4.8-sphere-frames.svg",
-        &svg::lines_plot(
-            "Fig. 4.8: BW on the sphere in three frames",
-            "approach offset (m)",
-            "bw",
-            &xs,
-            &series,
-        ),
-    )?;
     let _ = writeln!(report, "\nFile: {file}");
 
     // 4.9-4.15: 2D maps of the seven objects.
