@@ -115,9 +115,10 @@ fn the_journal_survives_kill_9_at_any_point() {
     let _hands = c.hands(2, &["--trial-cost-ms", "250"]);
     let flags = ["--lease-ms", "20000", "--resume", "--method", "random"];
     let mut kept = BTreeMap::new();
-    // Delays after each start, scattered: the first kill likely before the journal exists,
-    // the others mid-run (asserted: each coordinator still running when killed).
-    let delays_ms = [150u64, 900, 1300, 450, 1700, 2100, 700, 1100];
+    // Delays after each start, scattered: the first kill likely before the journal exists
+    // (a coordinator first checks for a second or so that no other one holds the run), the
+    // others mid-run (asserted: each coordinator still running when killed).
+    let delays_ms = [150u64, 1900, 2300, 1450, 2700, 3100, 1700, 2100];
     let mut checks = 0;
     for (k, delay) in delays_ms.iter().enumerate() {
         let mut coordinator =

@@ -47,6 +47,111 @@ pub struct RunSpec {
     pub method: PlannerMethod,
     /// Size of the initial design (space-filling, not model-based) (`None`: the engine's default).
     pub initial: Option<u32>,
+    /// How the tool that created the run set up the other agents (the object's mesh, the
+    /// scoring, perception's noise), kept so that resuming the run restores them. Opaque to
+    /// the coordinator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settings: Option<serde_json::Value>,
+}
+
+/// The run's recorded spec in the journal at `path`, if the file and the run exist.
+pub fn recorded_spec(path: &std::path::Path, run: &RunId) -> anyhow::Result<Option<RunSpec>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let journal = Journal::open(path)
+        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    let Some(record) = journal.run(run.as_str())? else {
+        return Ok(None);
+    };
+    let spec = serde_json::from_str::<RunSpec>(&record.config_json)
+        .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?;
+    Ok(Some(spec))
+}
+
+/// Flags given on the command line that contradict the record of a run being resumed,
+/// each described as `--flag given (the run has recorded)`.
+#[derive(Debug, Default, Clone, PartialEq, Eq)]
+pub struct Conflicts(pub Vec<String>);
+
+impl Conflicts {
+    /// Notes `--flag` (underscores written as dashes) if it was given (`explicit(flag)`)
+    /// with a value other than the recorded one.
+    pub fn check<T: PartialEq + std::fmt::Display>(
+        &mut self,
+        explicit: &dyn Fn(&str) -> bool,
+        flag: &str,
+        given: T,
+        recorded: T,
+    ) {
+        if explicit(flag) && given != recorded {
+            let flag = flag.replace('_', "-");
+            self.0
+                .push(format!("--{flag} {given} (the run has {recorded})"));
+        }
+    }
+}
+
+/// The flags given on the command line (`explicit(name)`: `--name` was given; `object`,
+/// `hand`, `params`, `trials`, `seed`, `method`, `initial`) whose values in `given`
+/// contradict the recorded spec of a run being resumed. A larger budget is not a
+/// contradiction: resuming may raise it.
+pub fn resume_conflicts(
+    recorded: &RunSpec,
+    given: &RunSpec,
+    explicit: &dyn Fn(&str) -> bool,
+) -> Conflicts {
+    let mut c = Conflicts::default();
+    c.check(explicit, "object", &given.object, &recorded.object);
+    c.check(explicit, "hand", &given.hand, &recorded.hand);
+    let params = |s: &RunSpec| param_names(s).join(",");
+    c.check(explicit, "params", params(given), params(recorded));
+    c.check(explicit, "seed", given.seed, recorded.seed);
+    let method = |s: &RunSpec| format!("{:?}", s.method).to_lowercase();
+    c.check(explicit, "method", method(given), method(recorded));
+    let initial = |s: &RunSpec| {
+        s.initial
+            .map_or("the engine's default".to_string(), |n| n.to_string())
+    };
+    c.check(explicit, "initial", initial(given), initial(recorded));
+    if explicit("trials") && given.trials < recorded.trials {
+        c.0.push(format!(
+            "--trials {} (the run has a budget of {}; resuming can raise it, not lower it)",
+            given.trials, recorded.trials
+        ));
+    }
+    c
+}
+
+impl Conflicts {
+    /// The error for a resumed run whose flags contradict its record (`None`: none do).
+    pub fn into_error(self, run: &RunId) -> Option<anyhow::Error> {
+        (!self.0.is_empty()).then(|| {
+            anyhow::anyhow!(
+                "run {run} was recorded with other settings: {}. Drop these flags to resume it, or start a new run (another --run id)",
+                self.0.join("; ")
+            )
+        })
+    }
+}
+
+/// The spec a resumed run continues with: the recorded one, with the budget raised when
+/// `--trials` asks for more. Contradicting flags (see [`resume_conflicts`]) are an error
+/// naming them, since the run's trials were made with the recorded values.
+pub fn reconcile(
+    run: &RunId,
+    recorded: &RunSpec,
+    given: &RunSpec,
+    explicit: &dyn Fn(&str) -> bool,
+) -> anyhow::Result<RunSpec> {
+    if let Some(e) = resume_conflicts(recorded, given, explicit).into_error(run) {
+        return Err(e);
+    }
+    let mut spec = recorded.clone();
+    if explicit("trials") {
+        spec.trials = spec.trials.max(given.trials);
+    }
+    Ok(spec)
 }
 
 /// Coordinator settings.
@@ -54,7 +159,8 @@ pub struct RunSpec {
 #[serde(default, deny_unknown_fields)]
 pub struct CoordinatorConfig {
     pub id: String,
-    /// The journal file.
+    /// The journal file (empty: `results/<run>/journal.sqlite`, where `graspopt run` and
+    /// `graspopt export` look by default).
     pub journal: PathBuf,
     /// A trial without a result after this long is issued again.
     pub lease_ms: u64,
@@ -68,10 +174,23 @@ impl Default for CoordinatorConfig {
     fn default() -> Self {
         CoordinatorConfig {
             id: "coordinator".into(),
-            journal: PathBuf::from("journal.sqlite"),
+            journal: PathBuf::new(),
             lease_ms: 30_000,
             planner_timeout_ms: 30_000,
             status_period_ms: 500,
+        }
+    }
+}
+
+impl CoordinatorConfig {
+    /// The journal file of `run` (see [`CoordinatorConfig::journal`]).
+    pub fn journal_path(&self, run: &RunId) -> PathBuf {
+        if self.journal.as_os_str().is_empty() {
+            PathBuf::from("results")
+                .join(run.as_str())
+                .join("journal.sqlite")
+        } else {
+            self.journal.clone()
         }
     }
 }
@@ -124,7 +243,9 @@ pub fn param_names(spec: &RunSpec) -> Vec<String> {
         .collect()
 }
 
-/// Opens (or creates) the run in the journal and rebuilds the state from it.
+/// Opens (or creates) the run in the journal and rebuilds the state from it. Resuming needs
+/// the run in the journal; its recorded spec is used, with the budget raised if `spec` asks
+/// for more trials (pass the result of [`reconcile`]).
 pub fn open_run(
     journal: &mut Journal,
     run: &RunId,
@@ -139,10 +260,38 @@ pub fn open_run(
                     "run {run} already exists in the journal: resume it (--resume) or choose another run id"
                 );
             }
-            serde_json::from_str::<RunSpec>(&record.config_json)
-                .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?
+            let recorded = serde_json::from_str::<RunSpec>(&record.config_json)
+                .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?;
+            // A resumed run keeps its record; only its budget may grow (see `reconcile`).
+            let spec = if spec.trials > recorded.trials {
+                let before = recorded.trials;
+                let raised = RunSpec {
+                    trials: spec.trials,
+                    ..recorded
+                };
+                journal.set_run_config(run.as_str(), &serde_json::to_string(&raised)?)?;
+                tracing::warn!(
+                    "coordinator: run {run}: budget raised from {before} to {} trials",
+                    raised.trials
+                );
+                raised
+            } else {
+                recorded
+            };
+            if record.status != JournalStatus::Running {
+                journal.set_run_status(run.as_str(), JournalStatus::Running, now_ms())?;
+            }
+            spec
         }
         None => {
+            if resume {
+                // A supervised coordinator is restarted with the same command line, so
+                // `--resume` also starts a run that was never recorded; it says so.
+                let place = journal
+                    .path()
+                    .map_or_else(|| "the journal".to_string(), |p| p.display().to_string());
+                tracing::warn!("coordinator: run {run} is not in {place} yet: --resume starts it");
+            }
             journal.create_run(&RunRecord {
                 run_id: run.as_str().to_string(),
                 created_ms: now_ms(),
@@ -261,6 +410,10 @@ struct Ctx<'a> {
     scorers: std::collections::HashSet<String>,
     /// Trials running when the last metric agent vanished.
     orphaned: Vec<u64>,
+    /// When the planner stopped giving proposals (`None`: it gives them).
+    planner_down_since: Option<i64>,
+    /// When that was last logged.
+    planner_warned_ms: i64,
 }
 
 impl Ctx<'_> {
@@ -314,18 +467,15 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    /// Asks the planner for proposals when workers are idle. Returns false when the planner
-    /// did not answer (the caller waits and tries again).
-    async fn plan(&mut self) -> anyhow::Result<bool> {
+    /// The request for proposals when workers are idle (`None`: nothing to ask).
+    fn plan_request(&mut self) -> Option<SuggestRequest> {
         let n = self.state.proposals_needed();
-        let Some((_, bounds)) = &self.space else {
-            return Ok(true);
-        };
+        let (_, bounds) = self.space.as_ref()?;
         if n == 0 {
-            return Ok(true);
+            return None;
         }
         self.request_id += 1;
-        let request = SuggestRequest {
+        Some(SuggestRequest {
             run_id: self.run.clone(),
             request_id: self.request_id,
             method: self.spec.method,
@@ -335,31 +485,68 @@ impl Ctx<'_> {
             observations: self.state.observations.clone(),
             pending: self.state.pending_points(),
             count: n as u32,
-        };
-        let timeout = Duration::from_millis(self.config.planner_timeout_ms);
-        let reply: SuggestReply = match self
-            .bus
-            .query(&self.run.suggest_key(), &request, timeout)
-            .await
-        {
+        })
+    }
+
+    /// Queues the planner's proposals (as many as are still needed: the run may have moved
+    /// on while the planner thought). Returns false when the planner gave none (the caller
+    /// waits and asks again).
+    fn take_proposals(&mut self, reply: Result<SuggestReply, graspopt_bus::BusError>) -> bool {
+        let reply = match reply {
             Ok(r) => r,
             Err(e) => {
-                tracing::warn!("coordinator: planner not available: {e}");
-                return Ok(false);
+                self.planner_down(&match e {
+                    graspopt_bus::BusError::NoResponder { .. } => {
+                        format!("no planner is running ({e})")
+                    }
+                    e => e.to_string(),
+                });
+                return false;
             }
         };
         if let Some(e) = reply.error {
-            tracing::warn!("coordinator: planner could not propose: {e}");
-            return Ok(false);
+            self.planner_down(&format!("the planner could not propose: {e}"));
+            return false;
         }
+        if let Some(since) = self.planner_down_since.take() {
+            tracing::warn!(
+                "coordinator: the planner answers again (after {:.1} s)",
+                (now_ms() - since) as f64 / 1000.0
+            );
+        }
+        let Some((_, bounds)) = &self.space else {
+            return true;
+        };
+        let dim = bounds.len();
+        let n = self.state.proposals_needed();
         for p in reply.points.into_iter().take(n) {
-            if p.len() != bounds.len() {
+            if p.len() != dim {
                 self.state.errors.bad_messages += 1;
                 continue;
             }
             self.state.add_trial(p);
         }
-        Ok(true)
+        true
+    }
+
+    /// Logs that no proposal came: once when it starts, then at most every 10 s.
+    fn planner_down(&mut self, why: &str) {
+        let now = now_ms();
+        match self.planner_down_since {
+            None => {
+                self.planner_down_since = Some(now);
+                self.planner_warned_ms = now;
+                tracing::warn!("coordinator: no proposals: {why}; asking again every 0.5 s");
+            }
+            Some(since) if now - self.planner_warned_ms >= 10_000 => {
+                self.planner_warned_ms = now;
+                tracing::warn!(
+                    "coordinator: still no proposals after {:.0} s: {why}",
+                    (now - since) as f64 / 1000.0
+                );
+            }
+            Some(_) => {}
+        }
     }
 
     fn on_result(&mut self, result: &TrialResult) -> anyhow::Result<Disposition> {
@@ -398,6 +585,11 @@ impl Ctx<'_> {
     }
 }
 
+/// A proposal request on its way to the planner.
+type PlannerCall<'a> = std::pin::Pin<
+    Box<dyn std::future::Future<Output = Result<SuggestReply, graspopt_bus::BusError>> + Send + 'a>,
+>;
+
 /// Runs the coordinator until the run finishes; returns the final status. `progress`
 /// receives every status published.
 pub async fn run(
@@ -408,8 +600,38 @@ pub async fn run(
     resume: bool,
     progress: Option<watch::Sender<RunStatus>>,
 ) -> anyhow::Result<RunStatus> {
-    let mut journal = Journal::open(&config.journal)
-        .with_context(|| format!("cannot open the journal {}", config.journal.display()))?;
+    run_until(
+        bus,
+        run,
+        spec,
+        config,
+        resume,
+        progress,
+        std::future::pending(),
+    )
+    .await
+}
+
+/// [`run`], stopping early when `stop` resolves (Ctrl-C, say): the journal then records the
+/// run as stopped (every result already in stays; `--resume` continues it) and the status
+/// returned has the phase it had.
+pub async fn run_until(
+    bus: &Bus,
+    run: &RunId,
+    spec: &RunSpec,
+    config: &CoordinatorConfig,
+    resume: bool,
+    progress: Option<watch::Sender<RunStatus>>,
+    stop: impl std::future::Future<Output = ()>,
+) -> anyhow::Result<RunStatus> {
+    tokio::pin!(stop);
+    let mut stopped = false;
+    // Two coordinators on one run would issue each trial twice and fight over the journal.
+    bus.wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
+        .await?;
+    let journal_path = config.journal_path(run);
+    let mut journal = Journal::open(&journal_path)
+        .with_context(|| format!("cannot open the journal {}", journal_path.display()))?;
     let (spec, mut state) = open_run(&mut journal, run, spec, resume)?;
     state.grace_ms = config.lease_ms as i64;
     let results = bus.subscribe::<TrialResult>(&run.result_key()).await?;
@@ -439,10 +661,17 @@ pub async fn run(
         encodings: Default::default(),
         scorers: Default::default(),
         orphaned: Vec::new(),
+        planner_down_since: None,
+        planner_warned_ms: 0,
     };
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
     let mut planner_retry_at = tokio::time::Instant::now();
+    // The planner's answer is awaited beside everything else, so results, leases and
+    // workers are still handled while it thinks or while the bus cannot reach it.
+    let mut planning: Option<PlannerCall> = None;
+    let planner_timeout = Duration::from_millis(config.planner_timeout_ms);
+    let suggest_key = run.suggest_key();
     let status_key = run.status_key();
     loop {
         if ctx.state.finished() {
@@ -450,15 +679,30 @@ pub async fn run(
         }
         if ctx.space.is_some() && !ctx.scorers.is_empty() {
             ctx.issue_queued().await?;
-            if tokio::time::Instant::now() >= planner_retry_at {
-                if ctx.plan().await? {
+            if planning.is_none()
+                && tokio::time::Instant::now() >= planner_retry_at
+                && let Some(request) = ctx.plan_request()
+            {
+                let key = suggest_key.clone();
+                planning = Some(Box::pin(async move {
+                    bus.query(&key, &request, planner_timeout).await
+                }));
+            }
+        }
+        tokio::select! {
+            reply = async {
+                match planning.as_mut() {
+                    Some(call) => call.await,
+                    None => std::future::pending().await,
+                }
+            }, if planning.is_some() => {
+                planning = None;
+                if ctx.take_proposals(reply) {
                     ctx.issue_queued().await?;
                 } else {
                     planner_retry_at = tokio::time::Instant::now() + Duration::from_millis(500);
                 }
-            }
-        }
-        tokio::select! {
+            },
             Some(r) = results.recv() => match r.message {
                 Ok(result) if result.run_id == *run => {
                     match ctx.on_result(&result)? {
@@ -535,6 +779,10 @@ pub async fn run(
                     tracing::warn!("coordinator: lease of trial {t} expired: re-issuing");
                 }
             },
+            _ = &mut stop => {
+                stopped = true;
+                break;
+            },
             _ = tick.tick() => {
                 let phase = if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting };
                 let s = status(run, &spec, &ctx.state, phase);
@@ -542,6 +790,25 @@ pub async fn run(
                 if let Some(p) = &progress { let _ = p.send(s); }
             },
         }
+    }
+    if stopped {
+        ctx.journal
+            .set_run_status(run.as_str(), JournalStatus::Stopped, now_ms())?;
+        let phase = if ctx.space.is_some() {
+            RunPhase::Running
+        } else {
+            RunPhase::Waiting
+        };
+        let s = status(run, &spec, &ctx.state, phase);
+        tracing::warn!(
+            "coordinator: run {run} stopped with {} of {} trials completed ({} failed, {} running); every result is in {}; resume with --resume",
+            s.completed,
+            s.budget,
+            s.failed,
+            s.running,
+            journal_path.display()
+        );
+        return Ok(s);
     }
     ctx.journal
         .set_run_status(run.as_str(), JournalStatus::Finished, now_ms())?;
@@ -557,22 +824,89 @@ pub async fn run(
 mod tests {
     use super::*;
 
+    fn spec(trials: u64) -> RunSpec {
+        RunSpec {
+            object: "sphere".into(),
+            hand: "barrett".into(),
+            params: vec![ParamKind::Approach],
+            bounds: None,
+            trials,
+            seed: 1,
+            method: PlannerMethod::Random,
+            initial: None,
+            settings: None,
+        }
+    }
+
+    #[test]
+    fn resuming_keeps_the_record_names_contradicting_flags_and_may_raise_the_budget() {
+        let run = RunId::new("r").unwrap();
+        let recorded = spec(20);
+        let given = RunSpec {
+            object: "mug".into(),
+            seed: 4,
+            ..spec(10)
+        };
+        // Flags left at their defaults are not contradictions: the record wins.
+        let none = |_: &str| false;
+        assert_eq!(reconcile(&run, &recorded, &given, &none).unwrap(), recorded);
+        // Given explicitly, they are, each named with both values.
+        let all = |_: &str| true;
+        let e = reconcile(&run, &recorded, &given, &all)
+            .unwrap_err()
+            .to_string();
+        for part in [
+            "--object mug (the run has sphere)",
+            "--seed 4 (the run has 1)",
+            "--trials 10 (the run has a budget of 20",
+        ] {
+            assert!(e.contains(part), "{part:?} not in {e}");
+        }
+        assert!(!e.contains("--hand"), "{e}");
+        // A larger budget is taken; the rest stays recorded.
+        let trials_only = |f: &str| f == "trials";
+        let raised = reconcile(&run, &recorded, &spec(35), &trials_only).unwrap();
+        assert_eq!(raised.trials, 35);
+        assert_eq!(
+            RunSpec {
+                trials: 20,
+                ..raised
+            },
+            recorded
+        );
+    }
+
+    #[test]
+    fn open_run_raises_a_finished_runs_budget() {
+        let mut journal = Journal::open_in_memory().unwrap();
+        let run = RunId::new("r").unwrap();
+        // Resuming a run never recorded starts it (a supervised restart's command line).
+        let (started, _) = open_run(&mut journal, &run, &spec(5), true).unwrap();
+        assert_eq!(started.trials, 5);
+        let e = open_run(&mut journal, &run, &spec(5), false).unwrap_err();
+        assert!(e.to_string().contains("already exists"), "{e}");
+        journal
+            .set_run_status("r", JournalStatus::Finished, 10)
+            .unwrap();
+        let (resumed, state) = open_run(&mut journal, &run, &spec(8), true).unwrap();
+        assert_eq!(resumed.trials, 8);
+        assert!(!state.finished());
+        let record = journal.run("r").unwrap().unwrap();
+        assert_eq!(record.status, JournalStatus::Running);
+        let stored: RunSpec = serde_json::from_str(&record.config_json).unwrap();
+        assert_eq!(stored.trials, 8);
+        // The same budget again (or less) leaves the record as it is.
+        let (again, _) = open_run(&mut journal, &run, &spec(3), true).unwrap();
+        assert_eq!(again.trials, 8);
+    }
+
     /// A coordinator restarted with `--resume` still accepts the late result of an attempt
     /// issued before the restart (who got each attempt comes back from the journal's events).
     #[test]
     fn a_resumed_run_accepts_results_of_attempts_issued_before_the_restart() {
         let mut journal = Journal::open_in_memory().unwrap();
         let run = RunId::new("r").unwrap();
-        let spec = RunSpec {
-            object: "sphere".into(),
-            hand: "barrett".into(),
-            params: vec![ParamKind::Approach],
-            bounds: None,
-            trials: 2,
-            seed: 1,
-            method: PlannerMethod::Random,
-            initial: None,
-        };
+        let spec = spec(2);
         open_run(&mut journal, &run, &spec, false).unwrap();
         for (attempt, worker) in [(1, "a"), (2, "b")] {
             journal

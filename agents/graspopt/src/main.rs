@@ -3,7 +3,8 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
 mod export;
@@ -31,7 +32,8 @@ enum Command {
     Scan(commands::scan::ScanArgs),
     /// Record a grid of simulated grasps' contact clouds (for `agent hand --replay`).
     Record(commands::record::RecordArgs),
-    /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15).
+    /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15; `bo`: figures
+    /// 4.16-4.27 and Table 4.1).
     Experiment(commands::experiment::ExperimentArgs),
     /// Run the BO engine (or random search) on a standard test function.
     OptimizeFunction(commands::optimize_function::OptimizeFunctionArgs),
@@ -53,8 +55,25 @@ enum Command {
     Bench(commands::bench::BenchArgs),
 }
 
+/// Whether the flag with id `name` (a field name: `trials`, `torque_scale`) was given on
+/// the command line rather than left at its default.
+fn given(matches: Option<&ArgMatches>, name: &str) -> bool {
+    matches.is_some_and(|m| {
+        m.try_get_raw(name).is_ok_and(|v| v.is_some())
+            && m.value_source(name) == Some(ValueSource::CommandLine)
+    })
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    let run_matches = matches.subcommand_matches("run");
+    let coordinator_matches = matches
+        .subcommand_matches("agent")
+        .and_then(|m| m.subcommand_matches("coordinator"));
     // Logs go to stderr; RUST_LOG overrides the default level (warnings).
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -62,6 +81,8 @@ fn main() -> ExitCode {
                 .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
         )
         .with_writer(std::io::stderr)
+        // Colours only on a terminal: logs redirected to files stay plain text.
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     let result = match &cli.command {
         Command::Quality(args) => commands::quality::run(args),
@@ -72,8 +93,10 @@ fn main() -> ExitCode {
         Command::OptimizeFunction(args) => {
             commands::optimize_function::run(args).map(|()| ExitCode::SUCCESS)
         }
-        Command::Run(args) => commands::run::run(args),
-        Command::Agent(args) => commands::agent::run(args),
+        Command::Run(args) => commands::run::run(args, &|name| given(run_matches, name)),
+        Command::Agent(args) => {
+            commands::agent::run(args, &|name| given(coordinator_matches, name))
+        }
         Command::Router(args) => commands::router::run(args),
         Command::Launch(args) => commands::launch::run(args),
         Command::Topic(args) => commands::topic::run(args),

@@ -199,3 +199,209 @@ fn unreadable_input_is_a_clear_error() {
         String::from_utf8_lossy(&out.stderr).contains("expected an object with a `cases` array")
     );
 }
+
+/// Writes `cases` (JSON objects) as a quality input file in a fresh folder.
+fn case_file(name: &str, cases: &[&str]) -> PathBuf {
+    let file = tempdir(name).join("cases.json");
+    std::fs::write(&file, format!("{{\"cases\": [{}]}}", cases.join(","))).unwrap();
+    file
+}
+
+/// Runs `graspopt quality` on `file` with extra arguments: exit code, JSON rows, stderr.
+fn quality(file: &std::path::Path, extra: &[&str]) -> (Option<i32>, Vec<Value>, String) {
+    let mut args = vec!["quality", "--input", file.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let out = graspopt(&args);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let rows = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    (
+        out.status.code(),
+        rows,
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+const TRIANGLE: &str = r#"[{"position": [1,0,0], "normal": [-1,0,0]},
+    {"position": [-0.5,0.8660254037844386,0], "normal": [0.5,-0.8660254037844386,0]},
+    {"position": [-0.5,-0.8660254037844386,0], "normal": [0.5,0.8660254037844386,0]}]"#;
+
+#[test]
+fn huge_counts_and_magnitudes_are_errors_with_both_solvers() {
+    let edges = format!(
+        r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 100000000}}, "contacts": {TRIANGLE}}}"#
+    );
+    let mu = format!(
+        r#"{{"params": {{"model": "point_friction", "mu": 1e308, "edges": 8}}, "contacts": {TRIANGLE}}}"#
+    );
+    let soft = format!(
+        r#"{{"params": {{"model": "soft_finger", "mu": 0.5, "edges": 5000, "gamma": 0.1}}, "contacts": {TRIANGLE}}}"#
+    );
+    let rho = format!(
+        r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 8, "torque_scale": 1e-300}}, "contacts": {TRIANGLE}}}"#
+    );
+    let good = format!(
+        r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 8}}, "contacts": {TRIANGLE}}}"#
+    );
+    let file = case_file(
+        "huge",
+        &[
+            &edges,
+            &mu,
+            r#"{"wrenches": [[1e308,0,0,0,0,0],[-1e308,0,0,0,0,0],[0,1,0,0,0,0],[0,-1,0,0,0,0]]}"#,
+            &soft,
+            &rho,
+            &good,
+        ],
+    );
+    let expect = [
+        "case 0: params: edges = 100000000 is invalid: the friction cone needs at least 3 and at most 4096 edges",
+        "case 1: params: mu = 1e308 is invalid: the friction coefficient must be finite, >= 0 and <= 1e6",
+        "case 2: wrenches: wrench 0: component 0 = 1e308 is out of range: each component must be at most 1e12 in absolute value",
+        "case 3: params: edges = 5000 is invalid",
+        "case 4: contacts: contact 0: its wrench component",
+    ];
+    for solver in ["min-norm", "clarabel"] {
+        let (code, rows, stderr) = quality(&file, &["--solver", solver]);
+        assert_eq!(code, Some(1), "{solver}: {stderr}");
+        assert_eq!(rows.len(), 6);
+        for (i, text) in expect.iter().enumerate() {
+            let message = rows[i]["error"].as_str().unwrap_or_default();
+            assert!(message.starts_with(text), "{solver} row {i}: {message}");
+            assert!(stderr.contains(text), "{solver}: {stderr}");
+        }
+        // The good case is evaluated (the 8-edge equator grasp, mu 0.5) and nothing
+        // prints as null.
+        assert!((rows[5]["epsilon"].as_f64().unwrap() - 0.275925156).abs() < 1e-8);
+        for row in &rows {
+            let nulls = row.as_object().unwrap().values().filter(|v| v.is_null());
+            assert_eq!(nulls.count(), 0, "{solver}: {row}");
+        }
+        assert!(stderr.contains("5 of 6 cases failed"), "{stderr}");
+    }
+}
+
+#[test]
+fn unknown_fields_are_errors_and_descriptive_keys_are_accepted() {
+    let contact = r#"{"position": [1,0,0], "normal": [-1,0,0]}"#;
+    let file = case_file(
+        "unknown",
+        &[
+            &format!(
+                r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 8, "torque_scal": 5}}, "contacts": [{contact}]}}"#
+            ),
+            &format!(
+                r#"{{"params": {{"model": "frictionless"}}, "contacts": [{contact}], "wrench": [[1,0,0,0,0,0]]}}"#
+            ),
+            r#"{"params": {"model": "frictionless"}, "contacts": [{"position": [1,0,0], "normal": [-1,0,0], "force": 2}]}"#,
+            r#"{"params": {"model": "frictionless", "edge": 8}, "wrenches": [[1,0,0,0,0,0]]}"#,
+            // Descriptive keys (as in the reference file: kind, expected) and keys the
+            // model does not use (gamma of a point contact) are accepted.
+            &format!(
+                r#"{{"kind": "one_contact", "name": "one", "description": "d", "notes": "n", "comment": "c",
+                    "expected": {{"bw": -1}},
+                    "params": {{"model": "point_friction", "mu": 0.5, "edges": 8, "gamma": 0.2,
+                                "reference_point": [0,0,0], "torque_scale": 2}},
+                    "contacts": [{contact}]}}"#
+            ),
+        ],
+    );
+    let (code, rows, stderr) = quality(&file, &[]);
+    assert_eq!(code, Some(1));
+    let expect = [
+        r#"case 0: params: unknown field "torque_scal" (expected one of: model, mu, edges, gamma, reference_point, torque_scale)"#,
+        r#"case 1: unknown field "wrench" (expected one of: params, contacts, wrenches, kind, name, description, notes, comment, expected)"#,
+        r#"case 2: contacts[0]: unknown field "force" (expected one of: position, normal)"#,
+        r#"case 3: params: unknown field "edge""#,
+    ];
+    for (i, text) in expect.iter().enumerate() {
+        let message = rows[i]["error"].as_str().unwrap_or_default();
+        assert!(message.starts_with(text), "row {i}: {message}");
+        assert!(stderr.contains(text), "{stderr}");
+    }
+    // One contact at distance 1 from the reference point; torque_scale 2 was used.
+    assert!(
+        (rows[4]["bw"].as_f64().unwrap() + 1.0).abs() < 1e-12,
+        "{}",
+        rows[4]
+    );
+    assert!(stderr.contains("4 of 5 cases failed"), "{stderr}");
+}
+
+#[test]
+fn zero_is_printed_without_a_sign_and_solvers_agree_at_large_scale() {
+    let file = case_file(
+        "zero",
+        &[
+            // Antipodal frictionless contacts: the origin is on the hull, bw = 0.
+            r#"{"params": {"model": "frictionless"}, "contacts": [
+                {"position": [1,0,0], "normal": [-1,0,0]}, {"position": [-1,0,0], "normal": [1,0,0]}]}"#,
+            // +-1e12 e_x, +-e_y: the origin is inside the hull (distance 0).
+            r#"{"wrenches": [[1e12,0,0,0,0,0],[-1e12,0,0,0,0,0],[0,1,0,0,0,0],[0,-1,0,0,0,0]]}"#,
+        ],
+    );
+    for solver in ["min-norm", "clarabel"] {
+        let out = graspopt(&[
+            "quality",
+            "--input",
+            file.to_str().unwrap(),
+            "--solver",
+            solver,
+        ]);
+        assert!(out.status.success(), "{solver}");
+        let stdout = String::from_utf8(out.stdout).unwrap();
+        assert!(!stdout.contains("-0.0"), "{solver}: {stdout}");
+        let rows: Vec<Value> = stdout
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert!(
+            stdout
+                .lines()
+                .next()
+                .unwrap()
+                .ends_with(r#""distance":0.0,"bw":0.0}"#),
+            "{solver}: {stdout}"
+        );
+        let d = rows[1]["distance"].as_f64().unwrap();
+        assert!(d < 1e-3, "{solver}: distance {d}");
+        assert_eq!(rows[1]["force_closure"], false);
+        let out = graspopt(&[
+            "quality",
+            "--input",
+            file.to_str().unwrap(),
+            "--solver",
+            solver,
+            "--format",
+            "table",
+        ]);
+        let table = String::from_utf8(out.stdout).unwrap();
+        assert!(!table.contains("-0.000"), "{solver}: {table}");
+    }
+}
+
+#[test]
+fn a_hull_too_large_for_memory_is_refused_with_a_hint() {
+    // 3 contacts x 256 edges: the full hull for the volume needs more than 5 million
+    // facets (the old code used 2 GB here, and 24 GB at 1,024 edges).
+    let case = format!(
+        r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 256}}, "contacts": {TRIANGLE}}}"#
+    );
+    let file = case_file("dense", &[&case]);
+    let (code, rows, stderr) = quality(&file, &[]);
+    assert_eq!(code, Some(1));
+    let message = rows[0]["error"].as_str().unwrap_or_default();
+    assert!(
+        message.starts_with(
+            "case 0: the volume of 768 wrenches needs a hull of more than 5000000 facets"
+        ) && message.ends_with("or pass --no-volume"),
+        "{message}"
+    );
+    assert!(stderr.contains("more than 5000000 facets"), "{stderr}");
+    let (code, rows, _) = quality(&file, &["--no-volume"]);
+    assert_eq!(code, Some(0));
+    assert!((rows[0]["epsilon"].as_f64().unwrap() - 0.287_685_384).abs() < 1e-8);
+    assert!(rows[0]["volume"].is_null());
+}

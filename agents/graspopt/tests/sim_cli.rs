@@ -43,7 +43,7 @@ fn trial_bad_input_is_named() {
         (vec!["trial", "--at", "x=abc"], "x is not a number"),
         (
             vec!["trial", "--at", "x=NaN"],
-            "non-finite value in trial parameter vector",
+            "--at: x (approach) = NaN is not a finite number",
         ),
         (vec!["trial", "--at", "x=5"], "outside"),
         (vec!["trial", "--metric", "area"], "unknown metric \"area\""),

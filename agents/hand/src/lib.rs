@@ -163,8 +163,16 @@ fn estimate_of_run(
     }
 }
 
-/// Serves trial commands until the task is cancelled.
+/// How long a starting hand waits for a predecessor with its id to vanish (a worker killed
+/// and restarted at once) before refusing to start.
+pub const UNIQUE_WAIT: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// Serves trial commands until the task is cancelled. Refuses to start while another hand
+/// with the same id is alive on the run (see [`UNIQUE_WAIT`]).
 pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
+    // Two hands with one id would both execute every trial sent to that id.
+    bus.wait_until_unique(run, AgentKind::Hand, Some(&config.id), UNIQUE_WAIT)
+        .await?;
     if let Some(path) = &config.replay {
         let recording = replay::Recording::load(path)?;
         return run_replay(bus, run, config, recording).await;

@@ -50,6 +50,24 @@ impl Default for PerceptionConfig {
     }
 }
 
+impl PerceptionConfig {
+    /// Checks the settings: the noise levels must be finite and non-negative (an infinite
+    /// one would put the object nowhere).
+    pub fn validate(&self) -> anyhow::Result<()> {
+        for (name, v) in [
+            ("position_noise", self.position_noise),
+            ("rotation_noise", self.rotation_noise),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                anyhow::bail!(
+                    "perception: {name} must be a finite standard deviation >= 0, got {v}"
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The scene's object (at its true pose).
 pub fn scene_object(config: &PerceptionConfig) -> anyhow::Result<Object> {
     match &config.mesh {
@@ -76,9 +94,7 @@ pub fn noisy_pose(truth: &Isometry3<f64>, config: &PerceptionConfig) -> Isometry
 
 /// The estimate to publish.
 pub fn estimate(run: &RunId, config: &PerceptionConfig) -> anyhow::Result<ObjectEstimate> {
-    if !(config.position_noise >= 0.0 && config.rotation_noise >= 0.0) {
-        anyhow::bail!("perception: noise standard deviations must be >= 0");
-    }
+    config.validate()?;
     let object = scene_object(config)?;
     let pose = noisy_pose(object.pose(), config);
     Ok(ObjectEstimate {
@@ -134,5 +150,25 @@ mod tests {
         assert_eq!(exact, truth);
         let other = noisy_pose(&truth, &PerceptionConfig { seed: 8, ..config });
         assert_ne!(a, other);
+    }
+
+    #[test]
+    fn infinite_or_negative_noise_is_refused_by_name() {
+        let run = RunId::new("r").unwrap();
+        for (position_noise, rotation_noise, name) in [
+            (f64::INFINITY, 0.0, "position_noise"),
+            (0.0, f64::NAN, "rotation_noise"),
+            (0.0, -0.1, "rotation_noise"),
+            (0.0, f64::MAX * 2.0, "rotation_noise"),
+        ] {
+            let config = PerceptionConfig {
+                position_noise,
+                rotation_noise,
+                ..PerceptionConfig::default()
+            };
+            let e = estimate(&run, &config).unwrap_err().to_string();
+            assert!(e.contains(name), "{e}");
+        }
+        assert!(PerceptionConfig::default().validate().is_ok());
     }
 }

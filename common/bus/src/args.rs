@@ -79,6 +79,15 @@ impl BusArgs {
                 .map_err(|e| BusError::Config(format!("{key} = {value}: {e}")))
         };
         if let Some(mode) = self.mode {
+            // A client talks only through routers: without one to connect to (or a
+            // configuration file that names one) it could only fail later, obscurely.
+            if mode == BusMode::Client && self.connect.is_empty() && self.zenoh_config.is_none() {
+                return Err(BusError::Config(
+                    "--mode client needs a router to talk through: give it with --connect \
+                     (e.g. --connect tcp/192.168.1.10:7447)"
+                        .into(),
+                ));
+            }
             set("mode", format!("\"{}\"", mode.as_str()))?;
         }
         let list = |v: &[String]| -> Result<String, BusError> {

@@ -16,6 +16,13 @@ pub enum BusError {
     Shm(#[from] graspopt_shm::ShmError),
     #[error("no reply from {key} within {timeout_ms} ms")]
     NoReply { key: String, timeout_ms: u64 },
+    /// Another agent already holds this agent's place in the run (its id, or the run's one
+    /// coordinator).
+    #[error("{0}")]
+    Taken(String),
+    /// The query ended at once, without a reply: nothing on the bus answers on `key`.
+    #[error("nothing answers on {key}")]
+    NoResponder { key: String },
     #[error("{key} replied with an error: {detail}")]
     ReplyError { key: String, detail: String },
 }

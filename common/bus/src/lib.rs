@@ -1,5 +1,5 @@
-//! graspopt on the network. This crate and `graspopt-protocol` are the only common crates that
-//! know there is a network:
+//! graspopt on the network. This is the only common crate that knows there is a network
+//! (`graspopt-protocol` defines what is said, not how it travels):
 //!
 //! - [`args`]: one flag set for every tool and agent (`--connect`, `--listen`, `--mode`,
 //!   `--zenoh-config`, `--no-multicast-scouting`, `--shm-prefix`, `--no-shm`).

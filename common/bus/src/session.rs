@@ -33,6 +33,10 @@ pub struct Bus {
     session: Session,
     host: String,
     shm: Option<graspopt_shm::ShmConfig>,
+    /// Whether other processes can be found from here without them connecting to us first
+    /// (`--connect` endpoints, multicast scouting or a configuration file): a session that
+    /// only listens (the embedded run) was just made and holds no other agents yet.
+    reaches_out: bool,
 }
 
 impl std::fmt::Debug for Bus {
@@ -61,6 +65,19 @@ impl Bus {
         let session = zenoh::open(config)
             .await
             .map_err(|e| BusError::zenoh("opening the session", e))?;
+        // A peer does not fail when its `--connect` endpoints are unreachable: it keeps
+        // trying in the background. Say so, or the agent just waits in silence.
+        if !args.connect.is_empty() {
+            let info = session.info();
+            let routers = info.routers_zid().await.count();
+            let peers = info.peers_zid().await.count();
+            if routers == 0 && peers == 0 {
+                tracing::warn!(
+                    "cannot reach {} yet (is the router running?): still trying in the background",
+                    args.connect.join(", ")
+                );
+            }
+        }
         let shm = if args.no_shm {
             None
         } else {
@@ -82,11 +99,20 @@ impl Bus {
             session,
             host: host_name(),
             shm,
+            reaches_out: !args.connect.is_empty()
+                || !args.no_multicast_scouting
+                || args.zenoh_config.is_some(),
         })
     }
 
     pub fn session(&self) -> &Session {
         &self.session
+    }
+
+    /// Whether this session can meet agents it did not start with (see
+    /// [`Bus::wait_until_unique`]).
+    pub fn reaches_out(&self) -> bool {
+        self.reaches_out
     }
 
     /// This host's name (a key chunk).
@@ -201,27 +227,34 @@ impl Bus {
         timeout: Duration,
     ) -> Result<R, BusError> {
         let bytes = encode(request, Encoding::Bincode)?;
+        let started = std::time::Instant::now();
         let replies = self
             .session
             .get(key)
             .payload(bytes)
             .encoding(zenoh_encoding(Encoding::Bincode))
+            // The first reply is wanted as soon as it arrives: consolidation would hold it
+            // until every responder has finished, and a responder cut off by a network
+            // fault would then delay it to the timeout.
+            .consolidation(zenoh::query::ConsolidationMode::None)
             .timeout(timeout)
             .await
             .map_err(|e| BusError::zenoh(format!("query on {key}"), e))?;
-        first_reply(key, &replies, timeout).await
+        first_reply(key, &replies, timeout, started).await
     }
 
     /// Sends a query without a payload (the coordinator's state, say) and decodes the first
     /// reply.
     pub async fn get<R: Message>(&self, key: &str, timeout: Duration) -> Result<R, BusError> {
+        let started = std::time::Instant::now();
         let replies = self
             .session
             .get(key)
+            .consolidation(zenoh::query::ConsolidationMode::None)
             .timeout(timeout)
             .await
             .map_err(|e| BusError::zenoh(format!("query on {key}"), e))?;
-        first_reply(key, &replies, timeout).await
+        first_reply(key, &replies, timeout, started).await
     }
 
     /// Answers queries on `key`.
@@ -278,10 +311,13 @@ impl<T: Message> Subscription<T> {
     }
 }
 
+/// The first reply of a query sent at `started`. A query that ends without a reply well
+/// before its timeout found nothing that answers on `key` ([`BusError::NoResponder`]).
 async fn first_reply<R: Message>(
     key: &str,
     replies: &FifoChannelHandler<zenoh::query::Reply>,
     timeout: Duration,
+    started: std::time::Instant,
 ) -> Result<R, BusError> {
     match replies.recv_async().await {
         Ok(reply) => match reply.result() {
@@ -294,6 +330,9 @@ async fn first_reply<R: Message>(
                 detail: String::from_utf8_lossy(&err.payload().to_bytes()).into_owned(),
             }),
         },
+        Err(_) if started.elapsed() < timeout / 2 => Err(BusError::NoResponder {
+            key: key.to_string(),
+        }),
         Err(_) => Err(BusError::NoReply {
             key: key.to_string(),
             timeout_ms: timeout.as_millis() as u64,

@@ -167,6 +167,21 @@ impl Journal {
         Ok(())
     }
 
+    /// Replaces a run's recorded config (a resumed run whose budget was raised, say);
+    /// [`JournalError::UnknownRun`] if there is no such run. The parameter names stay.
+    pub fn set_run_config(&mut self, run_id: &str, config_json: &str) -> Result<()> {
+        let tx = self.write_tx()?;
+        let n = tx.execute(
+            "UPDATE runs SET config_json = ?2 WHERE run_id = ?1",
+            params![run_id, config_json],
+        )?;
+        if n == 0 {
+            return Err(JournalError::UnknownRun(run_id.to_string()));
+        }
+        tx.commit()?;
+        Ok(())
+    }
+
     // --------------------------------------------------------------- trials
 
     /// A trial issued to a worker (attempt 1: inserts the trial row, event

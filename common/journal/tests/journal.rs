@@ -698,6 +698,15 @@ fn create_run_idempotent_and_config_mismatch() {
         "{err}"
     );
     assert_eq!(j.run("ghost").unwrap(), None);
+
+    j.set_run_config("a-late", r#"{"trials":90}"#).unwrap();
+    let late = j.run("a-late").unwrap().unwrap();
+    assert_eq!(late.config_json, r#"{"trials":90}"#);
+    assert_eq!(late.status, RunStatus::Stopped);
+    assert!(matches!(
+        j.set_run_config("ghost", "{}").unwrap_err(),
+        JournalError::UnknownRun(r) if r == "ghost"
+    ));
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! Contacts and contact models (thesis section 2.2, conventions in
-//! `shared/spec/metric-conventions.md`).
+//! `docs/metric-conventions.md`).
 //!
 //! A contact is a position and a unit normal that points **into** the object: the
 //! direction in which the finger pushes. A contact model turns a contact into the set
@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::error::QualityError;
+use crate::limits::{MAX_COORDINATE, MAX_EDGES, MAX_MU};
 use crate::wrench::{Wrench, wrench};
 
 /// How far a normal's length may be from 1 before it is rejected.
@@ -56,10 +57,12 @@ impl Contact {
         Ok(())
     }
 
-    /// Checks that the coordinates are finite and the normal has unit length;
-    /// `index` is the contact's position in its list, used in the error.
+    /// Checks that the coordinates are finite, the position within
+    /// [`MAX_COORDINATE`] and the normal of unit length; `index` is the contact's
+    /// position in its list, used in the error.
     pub fn validate(&self, index: usize) -> Result<(), QualityError> {
         self.check_finite(index)?;
+        check_range("contact", index, "position", &self.position)?;
         let norm = self.normal.norm();
         if norm <= f64::MIN_POSITIVE {
             return Err(QualityError::ZeroNormal { index });
@@ -88,8 +91,31 @@ pub fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (t1, t2)
 }
 
+/// Errors when a coordinate of `v` exceeds [`MAX_COORDINATE`] in absolute value.
+fn check_range(
+    what: &'static str,
+    index: usize,
+    field: &'static str,
+    v: &Vector3<f64>,
+) -> Result<(), QualityError> {
+    if v.iter().all(|x| x.abs() <= MAX_COORDINATE) {
+        Ok(())
+    } else {
+        Err(QualityError::OutOfRange {
+            what,
+            index,
+            field,
+            value: [v.x, v.y, v.z],
+            limit: MAX_COORDINATE,
+        })
+    }
+}
+
 /// A contact model (thesis section 2.2). The friction cone is sampled on its boundary
 /// with `edges` generators `f_j = n + mu (cos th_j t1 + sin th_j t2)`, `th_j = 2 pi j / edges`.
+///
+/// Parameter ranges (see [`crate::limits`]): `0 <= mu <= 1e6` ([`MAX_MU`]),
+/// `3 <= edges <= 4096` ([`MAX_EDGES`]), `0 <= gamma <= 1e12` ([`MAX_COORDINATE`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum ContactModel {
@@ -103,36 +129,38 @@ pub enum ContactModel {
 }
 
 impl ContactModel {
-    /// The number of wrenches one contact produces.
+    /// The number of wrenches one contact produces (saturating: an unvalidated edge
+    /// count cannot overflow it).
     pub fn wrenches_per_contact(&self) -> usize {
         match *self {
             ContactModel::Frictionless => 1,
             ContactModel::PointFriction { edges, .. } => edges,
-            ContactModel::SoftFinger { edges, .. } => 2 * edges,
+            ContactModel::SoftFinger { edges, .. } => edges.saturating_mul(2),
         }
     }
 
-    /// Checks the parameters: `mu >= 0`, `edges >= 3`, `gamma >= 0`, all finite.
+    /// Checks the parameters: `0 <= mu <= `[`MAX_MU`], `3 <= edges <= `[`MAX_EDGES`],
+    /// `0 <= gamma <= `[`MAX_COORDINATE`].
     pub fn validate(&self) -> Result<(), QualityError> {
         let check_mu = |mu: f64| {
-            if mu.is_finite() && mu >= 0.0 {
+            if (0.0..=MAX_MU).contains(&mu) {
                 Ok(())
             } else {
                 Err(QualityError::Parameter {
                     name: "mu",
                     value: mu,
-                    expected: "the friction coefficient must be finite and >= 0",
+                    expected: "the friction coefficient must be finite, >= 0 and <= 1e6",
                 })
             }
         };
         let check_edges = |edges: usize| {
-            if edges >= 3 {
+            if (3..=MAX_EDGES).contains(&edges) {
                 Ok(())
             } else {
                 Err(QualityError::Parameter {
                     name: "edges",
                     value: edges as f64,
-                    expected: "the friction cone needs at least 3 edges",
+                    expected: "the friction cone needs at least 3 and at most 4096 edges",
                 })
             }
         };
@@ -145,13 +173,13 @@ impl ContactModel {
             ContactModel::SoftFinger { mu, edges, gamma } => {
                 check_mu(mu)?;
                 check_edges(edges)?;
-                if gamma.is_finite() && gamma >= 0.0 {
+                if (0.0..=MAX_COORDINATE).contains(&gamma) {
                     Ok(())
                 } else {
                     Err(QualityError::Parameter {
                         name: "gamma",
                         value: gamma,
-                        expected: "the torsional coefficient must be finite and >= 0",
+                        expected: "the torsional coefficient must be finite, >= 0 and <= 1e12",
                     })
                 }
             }
@@ -190,7 +218,8 @@ impl GraspModel {
         self
     }
 
-    /// Checks the contact model, the reference point and `rho`.
+    /// Checks the contact model, the reference point (finite, within
+    /// [`MAX_COORDINATE`]) and `rho` (finite, > 0).
     pub fn validate(&self) -> Result<(), QualityError> {
         self.contact.validate()?;
         let c = &self.reference_point;
@@ -202,6 +231,7 @@ impl GraspModel {
                 value: [c.x, c.y, c.z],
             });
         }
+        check_range("model", 0, "reference_point", c)?;
         if !(self.torque_scale.is_finite() && self.torque_scale > 0.0) {
             return Err(QualityError::Parameter {
                 name: "torque_scale",

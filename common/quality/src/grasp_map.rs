@@ -6,6 +6,7 @@ use nalgebra::{Dyn, OMatrix, U6};
 
 use crate::contact::{Contact, GraspModel};
 use crate::error::QualityError;
+use crate::limits::{MAX_COORDINATE, MAX_WRENCHES};
 use crate::wrench::Wrench;
 
 /// The set of contact wrenches of a grasp, the columns of `G`.
@@ -16,16 +17,37 @@ pub struct GraspMap {
 
 impl GraspMap {
     /// The grasp map of a list of contacts under a model. Errors name the contact.
+    ///
+    /// The number of wrenches is bounded by [`MAX_WRENCHES`] (checked before anything
+    /// is allocated) and every generated wrench component by [`MAX_COORDINATE`].
     pub fn from_contacts(contacts: &[Contact], model: &GraspModel) -> Result<Self, QualityError> {
         if contacts.is_empty() {
             return Err(QualityError::Empty("contacts"));
         }
         model.validate()?;
-        let mut wrenches =
-            Vec::with_capacity(contacts.len() * model.contact.wrenches_per_contact());
+        let per_contact = model.contact.wrenches_per_contact();
+        let count = contacts.len() as u128 * per_contact as u128;
+        if count > MAX_WRENCHES as u128 {
+            return Err(QualityError::TooManyContactWrenches {
+                contacts: contacts.len(),
+                per_contact,
+                count,
+                limit: MAX_WRENCHES,
+            });
+        }
+        let mut wrenches = Vec::with_capacity(contacts.len() * per_contact);
         for (i, c) in contacts.iter().enumerate() {
             c.validate(i)?;
+            let first = wrenches.len();
             model.push_wrenches(c, &mut wrenches);
+            if let Some((component, value)) = first_out_of_range(&wrenches[first..]) {
+                return Err(QualityError::ContactWrenchOutOfRange {
+                    index: i,
+                    component,
+                    value,
+                    limit: MAX_COORDINATE,
+                });
+            }
         }
         Ok(Self { wrenches })
     }
@@ -40,7 +62,8 @@ impl GraspMap {
         Self::from_contacts(&all, model)
     }
 
-    /// A grasp map given directly as wrenches; errors on an empty or non-finite set.
+    /// A grasp map given directly as wrenches; errors on an empty set, a non-finite or
+    /// out-of-range wrench, or more than [`MAX_WRENCHES`].
     pub fn from_wrenches(wrenches: Vec<Wrench>) -> Result<Self, QualityError> {
         check_wrenches(&wrenches)?;
         Ok(Self { wrenches })
@@ -57,10 +80,17 @@ impl GraspMap {
     }
 }
 
-/// Errors on an empty wrench set or a wrench with a NaN or infinite component.
+/// Errors on an empty wrench set, more than [`MAX_WRENCHES`] wrenches, or a wrench
+/// with a NaN or infinite component or one beyond [`MAX_COORDINATE`] in absolute value.
 pub fn check_wrenches(wrenches: &[Wrench]) -> Result<(), QualityError> {
     if wrenches.is_empty() {
         return Err(QualityError::Empty("wrenches"));
+    }
+    if wrenches.len() > MAX_WRENCHES {
+        return Err(QualityError::TooManyWrenches {
+            count: wrenches.len(),
+            limit: MAX_WRENCHES,
+        });
     }
     for (index, w) in wrenches.iter().enumerate() {
         if !w.iter().all(|x| x.is_finite()) {
@@ -69,8 +99,27 @@ pub fn check_wrenches(wrenches: &[Wrench]) -> Result<(), QualityError> {
                 value: [w[0], w[1], w[2], w[3], w[4], w[5]],
             });
         }
+        if let Some((component, value)) = first_out_of_range(std::slice::from_ref(w)) {
+            return Err(QualityError::WrenchOutOfRange {
+                index,
+                component,
+                value,
+                limit: MAX_COORDINATE,
+            });
+        }
     }
     Ok(())
+}
+
+/// The first component (index within its wrench, value) of `wrenches` that is NaN,
+/// infinite or beyond [`MAX_COORDINATE`] in absolute value.
+fn first_out_of_range(wrenches: &[Wrench]) -> Option<(usize, f64)> {
+    wrenches.iter().find_map(|w| {
+        w.iter()
+            .enumerate()
+            .find(|(_, x)| !x.is_finite() || x.abs() > MAX_COORDINATE)
+            .map(|(k, &x)| (k, x))
+    })
 }
 
 #[cfg(test)]

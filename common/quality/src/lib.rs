@@ -12,6 +12,8 @@
 //! - [`grasp_map`]: the grasp map, the set of all contact wrenches (eq. 2.13-2.14).
 //! - [`hull`]: convex-hull queries in wrench space (affine rank, minimum-norm point,
 //!   expanding polytope, full hull).
+//! - [`limits`]: bounds on edge counts, wrench counts and magnitudes, so bad input is an
+//!   error naming the field rather than an allocation failure or an overflowed metric.
 //! - [`metrics`]: force closure, Largest Sphere, Grasp Wrench Volume, distance and the
 //!   Bimodal Wrench metric (section 2.6).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -21,6 +23,7 @@ pub mod contact;
 pub mod error;
 pub mod grasp_map;
 pub mod hull;
+pub mod limits;
 pub mod metrics;
 pub mod wrench;
 

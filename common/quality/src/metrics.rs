@@ -1,5 +1,5 @@
 //! Metrics of a grasp's wrench set (thesis sections 2.5-2.6, conventions in
-//! `shared/spec/metric-conventions.md`):
+//! `docs/metric-conventions.md`):
 //!
 //! - `rank`: affine rank of the wrenches; below 6 there is no force closure.
 //! - `distance`: distance from the origin to the wrench hull (0 when inside).
@@ -8,7 +8,10 @@
 //! - `epsilon`: the Largest Sphere (Ferrari-Canny) radius, 0 without force closure.
 //! - `volume`: the Grasp Wrench Volume, the 6-volume of the hull.
 //! - `bw`: the Bimodal Wrench metric, `epsilon` with force closure, else `-distance`;
-//!   continuous across the boundary, where both are zero.
+//!   continuous across the boundary, where both are zero (a positive zero, never `-0.0`).
+//!
+//! Every metric returned is finite: a NaN or infinite value is reported as
+//! [`QualityError::NotFiniteMetric`] instead. Inputs are bounded by [`crate::limits`].
 
 use serde::{Deserialize, Serialize};
 
@@ -88,32 +91,54 @@ pub fn evaluate_contacts(
     evaluate(&GraspMap::from_contacts(contacts, model)?, options)
 }
 
-/// All metrics of a wrench set; errors on an empty set or a non-finite wrench.
+/// All metrics of a wrench set; errors on an empty set, a non-finite or out-of-range
+/// wrench, too many wrenches (see [`crate::limits`]), or a metric that is not finite.
 pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metrics, QualityError> {
     check_wrenches(w)?;
     let basis = affine::affine_basis(w);
     let rank = basis.rank;
-    let distance = distance_to_hull(w, options.distance_solver)?;
+    let distance = finite("distance", distance_to_hull(w, options.distance_solver)?)?;
     let epsilon = if rank == 6 && distance <= INSIDE_TOLERANCE * coordinate_scale(w) {
-        epa::inner_distance_with_basis(w, &basis).map_or(0.0, |r| r.offset.max(0.0))
+        epa::try_inner_distance_with_basis(w, &basis)
+            .map_err(|_| QualityError::HullTooLarge {
+                metric: "Largest Sphere radius (epsilon)",
+                points: w.len(),
+                limit: quickhull::FACET_LIMIT,
+            })?
+            .map_or(0.0, |r| r.offset.max(0.0))
     } else {
         0.0
     };
     let force_closure = epsilon > FORCE_CLOSURE_MARGIN;
     let epsilon = if force_closure { epsilon } else { 0.0 };
     let volume = if options.volume {
-        Some(grasp_wrench_volume(w)?)
+        Some(finite("volume", grasp_wrench_volume(w)?)?)
     } else {
         None
     };
+    let epsilon = finite("epsilon", epsilon)?;
     Ok(Metrics {
         rank,
         force_closure,
-        epsilon,
-        volume,
-        distance,
-        bw: if force_closure { epsilon } else { -distance },
+        epsilon: positive_zero(epsilon),
+        volume: volume.map(positive_zero),
+        distance: positive_zero(distance),
+        bw: positive_zero(if force_closure { epsilon } else { -distance }),
     })
+}
+
+/// `value` if it is finite, else a [`QualityError::NotFiniteMetric`] naming `metric`.
+fn finite(metric: &'static str, value: f64) -> Result<f64, QualityError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(QualityError::NotFiniteMetric { metric, value })
+    }
+}
+
+/// `x` with a negative zero turned into a positive one (`-0.0 + 0.0 == +0.0`).
+fn positive_zero(x: f64) -> f64 {
+    x + 0.0
 }
 
 /// The distance from the origin to the hull of `w`.
@@ -125,12 +150,18 @@ pub fn distance_to_hull(w: &[Wrench], solver: DistanceSolver) -> Result<f64, Qua
 }
 
 /// The Grasp Wrench Volume: the 6-volume of the hull of `w` (0 below rank 6); an error
-/// when the hull cannot be built.
+/// when the hull cannot be built or would need more than
+/// [`FACET_LIMIT`](quickhull::FACET_LIMIT) facets.
 pub fn grasp_wrench_volume(w: &[Wrench]) -> Result<f64, QualityError> {
     match quickhull::Hull::new(w) {
         Ok(h) => Ok(h.volume()),
         Err(quickhull::HullError::LowerDimensional { .. }) => Ok(0.0),
         Err(quickhull::HullError::Degenerate) => Err(QualityError::HullFailed { points: w.len() }),
+        Err(quickhull::HullError::TooManyFacets) => Err(QualityError::HullTooLarge {
+            metric: "volume",
+            points: w.len(),
+            limit: quickhull::FACET_LIMIT,
+        }),
     }
 }
 

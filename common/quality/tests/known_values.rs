@@ -1,4 +1,4 @@
-//! The known values of `shared/spec/metric-conventions.md`.
+//! The known values of `docs/metric-conventions.md`.
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts, evaluate_wrenches};
 use graspopt_quality::{Contact, ContactModel, GraspModel, Wrench};

@@ -316,11 +316,13 @@ pub fn run_prefix(run: &str) -> String {
     format!("{PREFIX_BASE}{body}_")
 }
 
-/// Sets iceoryx2's log level once: `IOX2_LOG_LEVEL` if set, otherwise
-/// warnings and errors only (its default, info, is noisy on stderr).
+/// Sets iceoryx2's log level once: `IOX2_LOG_LEVEL` if set, otherwise errors
+/// only. Its default, info, is noisy on stderr, and its warnings include a
+/// long dump each time the ports of a dead process are found, which is what
+/// [`clean_stale`] is for (a killed worker is an event the coordinator reports).
 fn init_logging() {
     static ONCE: Once = Once::new();
-    ONCE.call_once(|| set_log_level_from_env_or(LogLevel::Warn));
+    ONCE.call_once(|| set_log_level_from_env_or(LogLevel::Error));
 }
 
 fn port_name(service: &str, name: &str) -> Result<PortName> {

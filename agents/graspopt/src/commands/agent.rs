@@ -86,9 +86,11 @@ pub enum Kind {
         common: Common,
         #[command(flatten)]
         sim: SimArgs,
-        /// The journal file.
+        /// The journal file (default: results/<run>/journal.sqlite, where `graspopt export`
+        /// looks).
         #[arg(long)]
         journal: Option<PathBuf>,
+        /// Number of trials (with --resume: raises the recorded budget).
         #[arg(long, default_value_t = 60)]
         trials: u64,
         #[arg(long, default_value = "x,y", value_delimiter = ',')]
@@ -101,7 +103,7 @@ pub enum Kind {
         seed: u64,
         #[arg(long)]
         lease_ms: Option<u64>,
-        /// Continue the run recorded in the journal.
+        /// Continue the run recorded in the journal, with its recorded settings.
         #[arg(long)]
         resume: bool,
     },
@@ -143,13 +145,13 @@ async fn until_signal<F: std::future::Future<Output = Result<()>>>(agent: F) -> 
     }
 }
 
-pub fn run(args: &AgentArgs) -> Result<ExitCode> {
+/// `graspopt agent`; `explicit(name)` says whether `--name` was given on the command line.
+pub fn run(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> {
     let runtime = tokio::runtime::Runtime::new()?;
-    runtime.block_on(run_async(args))?;
-    Ok(ExitCode::SUCCESS)
+    runtime.block_on(run_async(args, explicit))
 }
 
-async fn run_async(args: &AgentArgs) -> Result<()> {
+async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> {
     match &args.kind {
         Kind::Perception {
             common,
@@ -173,7 +175,8 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
             c.rotation_noise = rotation_noise.unwrap_or(c.rotation_noise);
             c.seed = seed.unwrap_or(c.seed);
             let (bus, run) = join(common).await?;
-            until_signal(graspopt_perception::run(&bus, &run, &c)).await
+            until_signal(graspopt_perception::run(&bus, &run, &c)).await?;
+            Ok(ExitCode::SUCCESS)
         }
         Kind::Hand {
             common,
@@ -193,7 +196,8 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 c.replay = replay.clone();
             }
             let (bus, run) = join(common).await?;
-            until_signal(graspopt_hand::run(&bus, &run, &c)).await
+            until_signal(graspopt_hand::run(&bus, &run, &c)).await?;
+            Ok(ExitCode::SUCCESS)
         }
         Kind::Metric { common } => {
             let mut c: graspopt_metric::MetricConfig = load(common.config.as_deref())?;
@@ -201,7 +205,8 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 c.id = v.clone();
             }
             let (bus, run) = join(common).await?;
-            until_signal(graspopt_metric::run(&bus, &run, &c)).await
+            until_signal(graspopt_metric::run(&bus, &run, &c)).await?;
+            Ok(ExitCode::SUCCESS)
         }
         Kind::Planner { common } => {
             let mut c: graspopt_planner::PlannerConfig = load(common.config.as_deref())?;
@@ -209,7 +214,8 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 c.id = v.clone();
             }
             let (bus, run) = join(common).await?;
-            until_signal(graspopt_planner::run(&bus, &run, &c)).await
+            until_signal(graspopt_planner::run(&bus, &run, &c)).await?;
+            Ok(ExitCode::SUCCESS)
         }
         Kind::Coordinator {
             common,
@@ -235,9 +241,10 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 .iter()
                 .map(|p| param_kind(p))
                 .collect::<Result<Vec<_>>>()?;
-            let object = sim.object()?;
-            let spec = RunSpec {
-                object: object.name().to_string(),
+            anyhow::ensure!(*trials >= 1, "--trials must be at least 1");
+            let run_id = RunId::new(&common.run)?;
+            let given = RunSpec {
+                object: sim.object()?.name().to_string(),
                 hand: sim.hand.clone(),
                 params: kinds,
                 bounds: None,
@@ -245,16 +252,42 @@ async fn run_async(args: &AgentArgs) -> Result<()> {
                 seed: *seed,
                 method: method.planner(),
                 initial: *initial,
+                settings: None,
             };
-            if let Some(dir) = c.journal.parent()
+            let journal_path = c.journal_path(&run_id);
+            // With --resume, the recorded run's settings win (flags that contradict them are
+            // refused); a run not recorded yet is started, so that a supervised coordinator
+            // can be restarted with one command line.
+            let spec = match graspopt_coordinator::recorded_spec(&journal_path, &run_id)? {
+                Some(recorded) if *resume => {
+                    graspopt_coordinator::reconcile(&run_id, &recorded, &given, explicit)?
+                }
+                _ => given,
+            };
+            if let Some(dir) = journal_path.parent()
                 && !dir.as_os_str().is_empty()
             {
-                std::fs::create_dir_all(dir)?;
+                std::fs::create_dir_all(dir)
+                    .with_context(|| format!("cannot create the folder {}", dir.display()))?;
             }
             let (bus, run) = join(common).await?;
-            let status = graspopt_coordinator::run(&bus, &run, &spec, &c, *resume, None).await?;
+            let status = graspopt_coordinator::run_until(
+                &bus,
+                &run,
+                &spec,
+                &c,
+                *resume,
+                None,
+                shutdown_signal(),
+            )
+            .await?;
             println!("{}", serde_json::to_string(&status)?);
-            Ok(())
+            // 130: the shell's code for a command stopped by Ctrl-C.
+            Ok(if status.phase == graspopt_protocol::RunPhase::Finished {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(130)
+            })
         }
     }
 }

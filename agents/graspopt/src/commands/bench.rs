@@ -11,7 +11,7 @@
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs, CloudPath, CloudReceiver, CloudSender, free_loopback_port};
 use graspopt_protocol::{CloudPoint, ContactClouds, FingerCloud, Pose, RunId, RunStatus};
@@ -19,6 +19,13 @@ use tokio::sync::watch;
 
 use super::run::{Embedded, Method, RunArgs, placeholder, run_embedded};
 use super::setup::SimArgs;
+
+/// The most hand workers of one throughput run.
+pub const MAX_WORKERS: usize = 256;
+/// The most points of one contact-cloud message.
+pub const MAX_POINTS: usize = 1_000_000;
+/// The most messages per path, or trials per run.
+pub const MAX_MESSAGES: usize = 100_000;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -30,16 +37,16 @@ pub struct BenchArgs {
 pub enum What {
     /// Throughput versus workers, and overhead per trial.
     Pipeline {
-        /// Simulated trial cost for the throughput runs (milliseconds).
+        /// Simulated trial cost for the throughput runs (milliseconds, at most 60000).
         #[arg(long, default_value_t = 200)]
         trial_cost_ms: u64,
-        /// Trials per worker in the throughput runs.
+        /// Trials per worker in the throughput runs (at least 1).
         #[arg(long, default_value_t = 10)]
         trials_per_worker: u64,
-        /// Worker counts.
+        /// Worker counts, each 1 to 256.
         #[arg(long, default_value = "1,2,4", value_delimiter = ',')]
         workers: Vec<usize>,
-        /// Trials of the overhead run.
+        /// Trials of the overhead run (at least 2: a cycle is the time between two).
         #[arg(long, default_value_t = 100)]
         overhead_trials: u64,
         /// How the throughput runs propose trials.
@@ -48,16 +55,64 @@ pub enum What {
     },
     /// Contact-cloud latency, shared memory versus Zenoh.
     Clouds {
-        /// Points per message.
+        /// Points per message (at most 1000000).
         #[arg(long, default_value_t = 10_000)]
         points: usize,
-        /// Messages per path.
+        /// Messages per path (1 to 100000).
         #[arg(long, default_value_t = 300)]
         messages: usize,
     },
 }
 
+/// Checks every argument before anything runs.
+fn validate(what: &What) -> Result<()> {
+    match what {
+        What::Pipeline {
+            trial_cost_ms,
+            trials_per_worker,
+            workers,
+            overhead_trials,
+            ..
+        } => {
+            if workers.is_empty() {
+                bail!("--workers: give at least one worker count");
+            }
+            if let Some(w) = workers.iter().find(|w| !(1..=MAX_WORKERS).contains(*w)) {
+                bail!("--workers: each count must be between 1 and {MAX_WORKERS}, got {w}");
+            }
+            if *trials_per_worker < 1 {
+                bail!("--trials-per-worker must be at least 1, got {trials_per_worker}");
+            }
+            let max_workers = workers.iter().copied().max().unwrap_or(1) as u64;
+            if trials_per_worker.saturating_mul(max_workers) > MAX_MESSAGES as u64 {
+                bail!(
+                    "--trials-per-worker {trials_per_worker} with {max_workers} workers is more than \
+                     {MAX_MESSAGES} trials in one run"
+                );
+            }
+            if !(2..=MAX_MESSAGES as u64).contains(overhead_trials) {
+                bail!(
+                    "--overhead-trials must be between 2 and {MAX_MESSAGES}, got {overhead_trials}"
+                );
+            }
+            if *trial_cost_ms > 60_000 {
+                bail!("--trial-cost-ms must be at most 60000 (one minute), got {trial_cost_ms}");
+            }
+        }
+        What::Clouds { points, messages } => {
+            if *points > MAX_POINTS {
+                bail!("--points must be at most {MAX_POINTS}, got {points}");
+            }
+            if !(1..=MAX_MESSAGES).contains(messages) {
+                bail!("--messages must be between 1 and {MAX_MESSAGES}, got {messages}");
+            }
+        }
+    }
+    Ok(())
+}
+
 pub fn run(args: &BenchArgs) -> Result<ExitCode> {
+    validate(&args.what)?;
     let runtime = tokio::runtime::Runtime::new()?;
     match &args.what {
         What::Pipeline {
@@ -310,7 +365,10 @@ async fn clouds(points: usize, messages: usize) -> Result<()> {
     for shm in [true, false] {
         let (path, mut lat) = cloud_latency(shm, points, messages).await?;
         let med = median(&mut lat);
-        let p90 = lat[(lat.len() * 9 / 10).min(lat.len() - 1)];
+        let p90 = lat
+            .get((lat.len() * 9 / 10).min(lat.len().saturating_sub(1)))
+            .copied()
+            .unwrap_or(f64::NAN);
         println!(
             "| {} | {med:.0} | {p90:.0} | {:.0} |",
             path.as_str(),

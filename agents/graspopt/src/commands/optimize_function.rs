@@ -10,6 +10,11 @@ use graspopt_bayesopt::benchmark::{
 };
 use serde_json::json;
 
+/// The most seeds one command runs.
+pub const MAX_SEEDS: u64 = 1000;
+/// The most evaluations per seed.
+pub const MAX_BUDGET: usize = 100_000;
+
 /// Method to run.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MethodArg {
@@ -35,14 +40,15 @@ pub enum FormatArg {
 pub struct OptimizeFunctionArgs {
     /// Test function: branin, hartmann3, hartmann6 or rosenbrock.
     pub function: String,
-    /// Number of seeds (0..N).
+    /// Number of seeds, 1 to 1000 (seeds 0..N).
     #[arg(long, default_value_t = 10)]
     pub seeds: u64,
-    /// Evaluations per seed (default: 50 in 2D, 100 otherwise).
+    /// Evaluations per seed, 1 to 100000 (default: 50 in 2D, 100 otherwise).
     #[arg(long)]
     pub budget: Option<usize>,
-    /// Random initial points (default: 5 in 2D, 10 in 6D, otherwise 2 d).
-    #[arg(long)]
+    /// Random initial points, at most the budget (default: 5 in 2D, 10 in 6D, otherwise 2 d;
+    /// capped at the budget).
+    #[arg(long = "initial", alias = "init", value_name = "N")]
     pub init: Option<usize>,
     /// Points proposed per round (parallel workers).
     #[arg(long, default_value_t = 1)]
@@ -68,13 +74,32 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
     let function = TestFunction::from_name(&args.function)?;
     let d = function.dim();
     let budget = args.budget.unwrap_or(if d <= 2 { 50 } else { 100 });
-    let n_init = args.init.unwrap_or(match d {
-        2 => 5,
-        6 => 10,
-        _ => 2 * d,
-    });
+    anyhow::ensure!(
+        (1..=MAX_SEEDS).contains(&args.seeds),
+        "--seeds must be between 1 and {MAX_SEEDS}, got {}",
+        args.seeds
+    );
+    anyhow::ensure!(
+        (1..=MAX_BUDGET).contains(&budget),
+        "--budget must be between 1 and {MAX_BUDGET}, got {budget}"
+    );
     anyhow::ensure!(args.batch >= 1, "--batch must be at least 1");
-    anyhow::ensure!(budget >= 1, "--budget must be at least 1");
+    let n_init = match args.init {
+        Some(n) => {
+            anyhow::ensure!(
+                n <= budget,
+                "--initial {n} is more than --budget {budget}: the initial design is part of the budget"
+            );
+            n
+        }
+        // The default design never exceeds a small explicit budget.
+        None => match d {
+            2 => 5,
+            6 => 10,
+            _ => 2 * d,
+        }
+        .min(budget),
+    };
     let method = match args.method {
         MethodArg::Bo => Method::Bo,
         MethodArg::BoThesis => Method::BoThesis,

@@ -1,10 +1,25 @@
 //! `graspopt quality --input FILE [--format json|table] [--timing]`: the metrics of
-//! every case of a JSON file shaped like `shared/reference/metric-cases.json`: an object
+//! every case of a JSON file shaped like `tests/data/metric-cases.json`: an object
 //! with `cases`, each with `params` + `contacts`, or `wrenches`, or both (contacts win).
 //!
 //! One output row per case, in order. A bad case prints an error naming the case index
 //! and the field (on stderr, and as `{"error": ...}` in its JSON row) and the others are
-//! still evaluated; the exit status is then 1.
+//! still evaluated; the exit status is then 1. A metric is never printed as `null`
+//! (only `volume`, with `--no-volume`) nor as `-0.0`.
+//!
+//! Keys (any other key is an error naming it, so a misspelling is not silently replaced
+//! by a default):
+//! - case: [`CASE_KEYS`]: `params`, `contacts`, `wrenches`, and the descriptive keys
+//!   `kind`, `name`, `description`, `notes`, `comment`, `expected`, which are ignored.
+//! - `params`: [`PARAM_KEYS`]: `model` (`frictionless`, `point_friction` or
+//!   `soft_finger`), `mu` (`0..=1e6`), `edges` (`3..=4096`), `gamma` (`0..=1e12`),
+//!   `reference_point` (default the origin), `torque_scale` (default 1, `> 0`). A key
+//!   the model does not use (`gamma` of a point contact) is accepted and ignored.
+//! - each contact: [`CONTACT_KEYS`]: `position`, `normal` (unit length).
+//!
+//! Limits (`graspopt_quality::limits`): at most 2,000,000 wrenches per case (contacts x
+//! wrenches per contact, or given), every coordinate and every wrench component (given
+//! or generated) at most 1e12 in absolute value.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -14,7 +29,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use graspopt_quality::metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, Wrench};
+use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, QualityError, Wrench};
 use nalgebra::Vector3;
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -81,7 +96,13 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
         for (i, case) in cases.iter().enumerate() {
             let row = parse_case(case)
                 .and_then(|grasp| {
-                    let metrics = evaluate(&grasp, &options)?;
+                    let metrics = evaluate(&grasp, &options).map_err(|e| match e {
+                        QualityError::HullTooLarge {
+                            metric: "volume", ..
+                        } => anyhow::anyhow!("{e}, or pass --no-volume"),
+                        e => e.into(),
+                    })?;
+                    let metrics = printable(metrics)?;
                     let micros = args.timing.then(|| median_micros(&grasp, &options));
                     Ok((metrics, micros))
                 })
@@ -111,6 +132,30 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
     })
 }
 
+/// The keys a case may have: its data, then descriptive keys that are ignored.
+pub const CASE_KEYS: [&str; 9] = [
+    "params",
+    "contacts",
+    "wrenches",
+    "kind",
+    "name",
+    "description",
+    "notes",
+    "comment",
+    "expected",
+];
+/// The keys of a case's `params`.
+pub const PARAM_KEYS: [&str; 6] = [
+    "model",
+    "mu",
+    "edges",
+    "gamma",
+    "reference_point",
+    "torque_scale",
+];
+/// The keys of a contact.
+pub const CONTACT_KEYS: [&str; 2] = ["position", "normal"];
+
 type Row = std::result::Result<(Metrics, Option<f64>), String>;
 
 /// One JSON output row, keys in the documented order.
@@ -124,6 +169,31 @@ struct JsonRow {
     bw: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     micros: Option<f64>,
+}
+
+/// The metrics as printed: an error if one is not finite (it would print as `null`),
+/// and `-0.0` turned into `0.0`.
+fn printable(m: Metrics) -> Result<Metrics> {
+    for (name, value) in [
+        ("epsilon", Some(m.epsilon)),
+        ("volume", m.volume),
+        ("distance", Some(m.distance)),
+        ("bw", Some(m.bw)),
+    ] {
+        if let Some(v) = value
+            && !v.is_finite()
+        {
+            bail!("the {name} came out as {v}: numerical failure");
+        }
+    }
+    let zero = |x: f64| x + 0.0; // -0.0 + 0.0 == +0.0
+    Ok(Metrics {
+        epsilon: zero(m.epsilon),
+        volume: m.volume.map(zero),
+        distance: zero(m.distance),
+        bw: zero(m.bw),
+        ..m
+    })
 }
 
 fn json_row(row: &Row) -> String {
@@ -157,6 +227,7 @@ fn write_table_header(out: &mut impl Write, timing: bool) -> std::io::Result<()>
 fn write_table_row(out: &mut impl Write, i: usize, row: &Row) -> std::io::Result<()> {
     match row {
         Ok((m, micros)) => {
+            // Rows carry `printable` metrics: finite, no negative zero.
             let volume = m.volume.map_or("-".to_string(), |v| format!("{v:.9e}"));
             write!(
                 out,
@@ -194,10 +265,14 @@ fn parse_case(case: &Value) -> Result<GraspMap> {
     let Some(obj) = case.as_object() else {
         bail!("expected an object");
     };
+    known_keys(obj, &CASE_KEYS)?;
+    let params = obj.get("params");
+    if let Some(params) = params {
+        let map = params.as_object().context("params: expected an object")?;
+        known_keys(map, &PARAM_KEYS).context("params")?;
+    }
     if let Some(contacts) = obj.get("contacts") {
-        let params = obj
-            .get("params")
-            .context("`contacts` given without `params`")?;
+        let params = params.context("`contacts` given without `params`")?;
         let model = parse_params(params)?;
         let contacts = parse_contacts(contacts)?;
         return GraspMap::from_contacts(&contacts, &model)
@@ -216,6 +291,17 @@ fn parse_case(case: &Value) -> Result<GraspMap> {
         return GraspMap::from_wrenches(parsed).map_err(|e| anyhow::anyhow!("wrenches: {e}"));
     }
     bail!("neither `contacts` (with `params`) nor `wrenches` given")
+}
+
+/// Errors on the first key of `obj` that is not in `allowed`, naming it.
+fn known_keys(obj: &serde_json::Map<String, Value>, allowed: &[&str]) -> Result<()> {
+    match obj.keys().find(|k| !allowed.contains(&k.as_str())) {
+        Some(key) => bail!(
+            "unknown field {key:?} (expected one of: {})",
+            allowed.join(", ")
+        ),
+        None => Ok(()),
+    }
 }
 
 fn parse_params(params: &Value) -> Result<GraspModel> {
@@ -275,6 +361,10 @@ fn parse_contacts(contacts: &Value) -> Result<Vec<Contact>> {
     list.iter()
         .enumerate()
         .map(|(k, c)| {
+            let map = c
+                .as_object()
+                .with_context(|| format!("contacts[{k}]: expected an object"))?;
+            known_keys(map, &CONTACT_KEYS).with_context(|| format!("contacts[{k}]"))?;
             let position = c
                 .get("position")
                 .with_context(|| format!("contacts[{k}].position: missing"))

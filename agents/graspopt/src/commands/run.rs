@@ -7,15 +7,16 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use graspopt_bus::{Bus, BusArgs, free_loopback_port};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
-use graspopt_protocol::{PlannerMethod, RunId, RunStatus};
+use graspopt_protocol::{PlannerMethod, RunId, RunPhase, RunStatus};
 use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 
-use super::setup::{SimArgs, param_kind};
+use super::setup::{Contacts, Frame, SimArgs, param_kind, param_name};
 use super::svg;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -35,7 +36,7 @@ impl Method {
     }
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RunArgs {
     #[command(flatten)]
     pub sim: SimArgs,
@@ -62,7 +63,8 @@ pub struct RunArgs {
     /// Results folder (default: results/<run>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Continue the run recorded in the results folder's journal.
+    /// Continue the run recorded in the results folder's journal, with its recorded
+    /// settings (a larger --trials raises its budget).
     #[arg(long)]
     pub resume: bool,
     /// Minimum duration of a simulated trial, to model a robot (milliseconds).
@@ -98,9 +100,201 @@ pub struct Embedded {
     pub bus: BusArgs,
 }
 
+/// The settings of an embedded run beyond its spec (the object's mesh, the scoring,
+/// perception's noise), recorded in the run's spec so that `--resume` restores them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct EmbeddedSettings {
+    mesh: Option<PathBuf>,
+    contacts: String,
+    metric: String,
+    frame: String,
+    torque_scale: Option<f64>,
+    position_noise: f64,
+    rotation_noise: f64,
+}
+
+fn value_name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value()
+        .map_or_else(String::new, |p| p.get_name().to_string())
+}
+
+impl EmbeddedSettings {
+    fn of(args: &RunArgs) -> EmbeddedSettings {
+        EmbeddedSettings {
+            mesh: args
+                .sim
+                .mesh
+                .as_ref()
+                .map(|m| std::fs::canonicalize(m).unwrap_or_else(|_| m.clone())),
+            contacts: value_name(&args.sim.contacts),
+            metric: args.sim.metric.clone(),
+            frame: value_name(&args.sim.frame),
+            torque_scale: args.sim.torque_scale,
+            position_noise: args.position_noise,
+            rotation_noise: args.rotation_noise,
+        }
+    }
+}
+
+/// `args` with the recorded settings of the run they resume (see [`graspopt_coordinator::reconcile`]):
+/// a flag given on the command line (`explicit`) that contradicts the record is an error.
+fn resumed_args(args: &RunArgs, out: &Path, explicit: &dyn Fn(&str) -> bool) -> Result<RunArgs> {
+    let run = RunId::new(&args.run)?;
+    let journal = out.join("journal.sqlite");
+    if !journal.exists() {
+        bail!(
+            "no journal at {}: there is nothing to resume (start the run without --resume)",
+            journal.display()
+        );
+    }
+    let recorded = graspopt_coordinator::recorded_spec(&journal, &run)?.with_context(|| {
+        format!(
+            "run {run} is not in {}: there is nothing to resume (start it without --resume)",
+            journal.display()
+        )
+    })?;
+    let given = RunSpec {
+        object: args.sim.object.clone(),
+        hand: args.sim.hand.clone(),
+        params: args
+            .params
+            .iter()
+            .map(|p| param_kind(p))
+            .collect::<Result<Vec<_>>>()?,
+        bounds: recorded.bounds.clone(),
+        trials: args.trials,
+        seed: args.seed,
+        method: args.method.planner(),
+        initial: args.initial,
+        settings: None,
+    };
+    let mut conflicts = graspopt_coordinator::resume_conflicts(&recorded, &given, explicit);
+    let recorded_settings = recorded
+        .settings
+        .as_ref()
+        .and_then(|v| serde_json::from_value::<EmbeddedSettings>(v.clone()).ok());
+    if let Some(recorded) = &recorded_settings {
+        settings_conflicts(
+            &mut conflicts,
+            recorded,
+            &EmbeddedSettings::of(args),
+            explicit,
+        );
+    }
+    if let Some(e) = conflicts.into_error(&run) {
+        return Err(e);
+    }
+    let spec = graspopt_coordinator::reconcile(&run, &recorded, &given, explicit)?;
+    let mut out_args = args.clone();
+    out_args.sim.hand = spec.hand.clone();
+    out_args.params = spec
+        .params
+        .iter()
+        .map(|k| param_name(*k).to_string())
+        .collect();
+    out_args.trials = spec.trials;
+    out_args.seed = spec.seed;
+    out_args.method = match spec.method {
+        PlannerMethod::Bo => Method::Bo,
+        PlannerMethod::Random => Method::Random,
+    };
+    out_args.initial = spec.initial;
+    let Some(recorded_settings) = recorded_settings else {
+        // Created by a standalone coordinator: only the spec is on record.
+        if args.sim.mesh.is_none() {
+            out_args.sim.object = spec.object.clone();
+        }
+        return Ok(out_args);
+    };
+    out_args.sim.mesh = recorded_settings.mesh.clone();
+    if out_args.sim.mesh.is_none() {
+        out_args.sim.object = spec.object.clone();
+    }
+    out_args.sim.contacts = Contacts::from_str(&recorded_settings.contacts, true)
+        .map_err(|e| anyhow::anyhow!("run {run}: recorded contact model: {e}"))?;
+    out_args.sim.metric = recorded_settings.metric.clone();
+    out_args.sim.frame = Frame::from_str(&recorded_settings.frame, true)
+        .map_err(|e| anyhow::anyhow!("run {run}: recorded frame: {e}"))?;
+    out_args.sim.torque_scale = recorded_settings.torque_scale;
+    out_args.position_noise = recorded_settings.position_noise;
+    out_args.rotation_noise = recorded_settings.rotation_noise;
+    Ok(out_args)
+}
+
+/// Notes the scoring and perception flags given on the command line that contradict the
+/// record.
+fn settings_conflicts(
+    c: &mut graspopt_coordinator::Conflicts,
+    recorded: &EmbeddedSettings,
+    given: &EmbeddedSettings,
+    explicit: &dyn Fn(&str) -> bool,
+) {
+    let path = |m: &Option<PathBuf>| {
+        m.as_ref()
+            .map_or("none".into(), |p| p.display().to_string())
+    };
+    c.check(explicit, "mesh", path(&given.mesh), path(&recorded.mesh));
+    c.check(explicit, "contacts", &given.contacts, &recorded.contacts);
+    c.check(explicit, "metric", &given.metric, &recorded.metric);
+    c.check(explicit, "frame", &given.frame, &recorded.frame);
+    let scale = |t: Option<f64>| t.map_or("the object's radius".into(), |v| v.to_string());
+    let (given_scale, recorded_scale) = (scale(given.torque_scale), scale(recorded.torque_scale));
+    c.check(explicit, "torque_scale", given_scale, recorded_scale);
+    let (p, r) = (given.position_noise, recorded.position_noise);
+    c.check(explicit, "position_noise", p, r);
+    let (p, r) = (given.rotation_noise, recorded.rotation_noise);
+    c.check(explicit, "rotation_noise", p, r);
+}
+
+/// Refuses a new run in a results folder whose journal holds other runs: their
+/// `trials.csv`, `trials.json` and `best.svg` would be overwritten.
+fn check_folder_is_free(out: &Path, run: &RunId) -> Result<()> {
+    let path = out.join("journal.sqlite");
+    if !path.exists() {
+        return Ok(());
+    }
+    let journal = graspopt_journal::Journal::open(&path)
+        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    let others: Vec<String> = journal
+        .runs()?
+        .into_iter()
+        .map(|r| r.run_id)
+        .filter(|id| id != run.as_str())
+        .collect();
+    if !others.is_empty() {
+        bail!(
+            "the results folder {} holds run {} already (its trials.csv, trials.json and best.svg would be overwritten): choose another --out, or resume that run with --run {} --resume",
+            out.display(),
+            others.join(", "),
+            others[0]
+        );
+    }
+    Ok(())
+}
+
 impl Embedded {
+    /// The run the flags describe, nothing taken as given explicitly (see
+    /// [`Embedded::from_args_with`]).
     pub fn from_args(args: &RunArgs) -> Result<Embedded> {
+        Embedded::from_args_with(args, &|_| false)
+    }
+
+    /// The run the flags describe. With `--resume`, the run's recorded settings replace the
+    /// flags' defaults; `explicit(name)` says whether `--name` was given on the command line.
+    pub fn from_args_with(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<Embedded> {
         let run = RunId::new(&args.run)?;
+        let out = args
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new("results").join(run.as_str()));
+        let resumed;
+        let args = if args.resume {
+            resumed = resumed_args(args, &out, explicit)?;
+            &resumed
+        } else {
+            check_folder_is_free(&out, &run)?;
+            args
+        };
         anyhow::ensure!(args.workers >= 1, "--workers must be at least 1");
         anyhow::ensure!(args.trials >= 1, "--trials must be at least 1");
         let kinds = args
@@ -110,10 +304,6 @@ impl Embedded {
             .collect::<Result<Vec<_>>>()?;
         let evaluator = args.sim.evaluator(&kinds)?;
         let object_name = evaluator.object.name().to_string();
-        let out = args
-            .out
-            .clone()
-            .unwrap_or_else(|| Path::new("results").join(run.as_str()));
         let mut bus = args.bus.clone();
         if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
             bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
@@ -126,6 +316,19 @@ impl Embedded {
                 std::process::id()
             )));
         }
+        let perception = graspopt_perception::PerceptionConfig {
+            object: object_name.clone(),
+            mesh: args.sim.mesh.clone(),
+            position_noise: args.position_noise,
+            rotation_noise: args.rotation_noise,
+            seed: args.seed,
+            period_ms: 500,
+            ..Default::default()
+        };
+        // Checked before anything is written, so a refused run leaves no trace.
+        perception
+            .validate()
+            .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
         Ok(Embedded {
             spec: RunSpec {
                 object: object_name.clone(),
@@ -136,18 +339,11 @@ impl Embedded {
                 seed: args.seed,
                 method: args.method.planner(),
                 initial: args.initial,
+                settings: Some(serde_json::to_value(EmbeddedSettings::of(args))?),
             },
             workers: args.workers,
             resume: args.resume,
-            perception: graspopt_perception::PerceptionConfig {
-                object: object_name,
-                mesh: args.sim.mesh.clone(),
-                position_noise: args.position_noise,
-                rotation_noise: args.rotation_noise,
-                seed: args.seed,
-                period_ms: 500,
-                ..Default::default()
-            },
+            perception,
             metric: graspopt_metric::MetricConfig {
                 score: evaluator.score,
                 contacts: evaluator.contacts,
@@ -170,7 +366,8 @@ impl Embedded {
     }
 }
 
-/// Runs every agent in this process until the coordinator finishes.
+/// Runs every agent in this process until the coordinator finishes (or Ctrl-C stops it:
+/// the status returned is then not [`RunPhase::Finished`]).
 pub async fn run_embedded(
     e: &Embedded,
     progress: Option<watch::Sender<RunStatus>>,
@@ -201,8 +398,16 @@ pub async fn run_embedded(
         };
         tasks.spawn(async move { graspopt_hand::run(&b, &r, &c).await });
     }
-    let coordinator =
-        graspopt_coordinator::run(&bus, &e.run, &e.spec, &e.coordinator, e.resume, progress);
+    // Ctrl-C (or SIGTERM) stops the run cleanly: the journal records it as stopped.
+    let coordinator = graspopt_coordinator::run_until(
+        &bus,
+        &e.run,
+        &e.spec,
+        &e.coordinator,
+        e.resume,
+        progress,
+        super::agent::shutdown_signal(),
+    );
     let status = tokio::select! {
         s = coordinator => s,
         Some(agent) = tasks.join_next() => {
@@ -241,8 +446,9 @@ pub fn write_results(e: &Embedded, status: &RunStatus) -> Result<()> {
     Ok(())
 }
 
-pub fn run(args: &RunArgs) -> Result<ExitCode> {
-    let e = Embedded::from_args(args)?;
+/// `graspopt run`; `explicit(name)` says whether `--name` was given on the command line.
+pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> {
+    let e = Embedded::from_args_with(args, explicit)?;
     let runtime = tokio::runtime::Runtime::new()?;
     let (status_tx, mut status_rx) = watch::channel(placeholder(&e));
     let bar = if args.quiet {
@@ -290,9 +496,20 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     })?;
     bar.finish_and_clear();
     write_results(&e, &status)?;
+    let stopped = status.phase != RunPhase::Finished;
     println!(
-        "run {}: {} trials completed, {} failed",
-        status.run_id, status.completed, status.failed
+        "run {}: {} trials completed, {} failed{}",
+        status.run_id,
+        status.completed,
+        status.failed,
+        if stopped {
+            format!(
+                " (stopped; continue with --resume --out {})",
+                e.out.display()
+            )
+        } else {
+            String::new()
+        }
     );
     if let Some(b) = &status.best {
         println!(
@@ -303,7 +520,12 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         );
     }
     println!("results: {}", e.out.display());
-    Ok(ExitCode::SUCCESS)
+    // 130: the shell's code for a command stopped by Ctrl-C.
+    Ok(if stopped {
+        ExitCode::from(130)
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 /// `name=value` for each parameter (5 decimals), joined by `sep`.

@@ -1,7 +1,8 @@
 //! `graspopt scan --object sphere --axes x,y --steps 41,41`: a grid scan of a metric over
 //! one or two trial parameters (any number for the CSV), in parallel over cores, with a
-//! progress bar. Writes `<out>/<object>-<metric>-<axes>.csv` and `.svg` (a line plot for
-//! one axis, a heatmap for two).
+//! progress bar. Writes `<out>/<object>-<metric>-<axes>.csv`, and images for one axis (an
+//! SVG line plot) or two (an SVG and a PNG heatmap); three or more axes write the CSV only,
+//! with a note. Grids hold at most [`MAX_GRID_POINTS`] points.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -15,14 +16,24 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::setup::{SimArgs, param_kind, param_name};
 use super::svg;
 
+/// The most points a grid (`--steps` multiplied over the axes) may hold.
+pub const MAX_GRID_POINTS: usize = 10_000_000;
+
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Writes <out>/<object>-<metric>-<axes>.csv for any number of axes, and images for \
+                  1 axis (an SVG line plot) or 2 axes (an SVG and a PNG heatmap); 3 or more axes \
+                  write the CSV only. A grid holds at most 10,000,000 points."
+)]
 pub struct ScanArgs {
     #[command(flatten)]
     pub sim: SimArgs,
-    /// Parameters to scan, comma separated: x (approach), y (vertical), lateral, rx, ry, rz.
+    /// Parameters to scan, comma separated: x (approach), y (vertical), lateral, rx, ry, rz
+    /// (images for 1 or 2 axes only; more axes write the CSV alone).
     #[arg(long, default_value = "x")]
     pub axes: String,
-    /// Grid points per axis, comma separated (one value applies to every axis).
+    /// Grid points per axis, comma separated (one value applies to every axis); at most
+    /// 10,000,000 points in all.
     #[arg(long, default_value = "41")]
     pub steps: String,
     /// Output folder.
@@ -43,6 +54,7 @@ pub struct Grid {
 
 /// The grid of `--axes` and `--steps` (shared with `graspopt record`).
 pub fn grid(sim: &SimArgs, axes: &str, steps: &str) -> Result<Grid> {
+    let steps_text = steps;
     let kinds = axes
         .split(',')
         .map(param_kind)
@@ -62,6 +74,14 @@ pub fn grid(sim: &SimArgs, axes: &str, steps: &str) -> Result<Grid> {
         n if n == kinds.len() => steps,
         n => bail!("--steps has {n} values for {} axes", kinds.len()),
     };
+    let total = grid_points(&steps)?;
+    if total > MAX_GRID_POINTS {
+        bail!(
+            "--steps {}: a grid of {total} points is more than the {MAX_GRID_POINTS} allowed; \
+             use fewer steps or axes",
+            steps_text.trim()
+        );
+    }
     let ev = sim.evaluator(&kinds)?;
     let axes = grid_axes(&ev.space.bounds(), &steps);
     Ok(Grid {
@@ -70,6 +90,21 @@ pub fn grid(sim: &SimArgs, axes: &str, steps: &str) -> Result<Grid> {
         steps,
         axes,
     })
+}
+
+/// Points of a grid with `steps[k]` points on axis `k`; errors (naming `--steps`) when the
+/// product does not fit in a `usize`.
+pub fn grid_points(steps: &[usize]) -> Result<usize> {
+    steps
+        .iter()
+        .try_fold(1usize, |acc, &n| acc.checked_mul(n))
+        .with_context(|| {
+            let list: Vec<String> = steps.iter().map(usize::to_string).collect();
+            format!(
+                "--steps {}: the grid has more points than can be counted (at most {MAX_GRID_POINTS} allowed)",
+                list.join(",")
+            )
+        })
 }
 
 pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
@@ -137,7 +172,12 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
                 &z,
             ))
         }
-        _ => None,
+        n => {
+            eprintln!(
+                "note: no image for a {n}-axis scan (images are drawn for 1 or 2 axes); the CSV holds every point"
+            );
+            None
+        }
     };
     let mut written = vec![csv_path.display().to_string()];
     if let Some(chart) = chart {

@@ -28,11 +28,12 @@ pub struct TrialArgs {
     #[arg(long, value_enum, default_value_t = TrialFormat::Text)]
     pub format: TrialFormat,
     /// Write the scene (object, hand links, contact points and normals) for any 3D viewer:
-    /// glTF 2.0 if FILE ends in `.gltf`, else a Wavefront OBJ with its colours in an MTL next
-    /// to it.
+    /// glTF 2.0 if FILE ends in `.gltf`, a Wavefront OBJ (with its colours in an MTL next to
+    /// it) if it ends in `.obj`; other extensions are refused.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
-    /// Draw the grasp from two viewpoints (along the approach axis, from the side) into a PNG.
+    /// Draw the grasp from two viewpoints (along the approach axis, from the side) into a PNG
+    /// (FILE must end in `.png`).
     #[arg(long, value_name = "FILE.png")]
     pub preview: Option<PathBuf>,
 }
@@ -43,7 +44,71 @@ pub enum TrialFormat {
     Json,
 }
 
+/// Extensions `--scene` writes (glTF 2.0 JSON, Wavefront OBJ).
+const SCENE_EXTENSIONS: [&str; 2] = ["gltf", "obj"];
+
+/// A value for a message: as given when that is short, else `1.0000e300`.
+fn compact(v: f64) -> String {
+    let plain = format!("{v}");
+    if plain.len() <= 12 {
+        plain
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+/// A bound for a message: at most 4 decimals (`-0.7854`), or `1.0000e-6` when tiny or huge.
+fn compact_bound(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+        let s = format!("{v:.4}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" { "0".into() } else { s.into() }
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+/// A parameter as the user named it, with its full name when that differs: `x (approach)`.
+fn described(name: &str, kind: graspopt_sim::ParamKind) -> String {
+    let full = param_name(kind);
+    if name == full {
+        name.to_string()
+    } else {
+        format!("{name} ({full})")
+    }
+}
+
+/// Checks the extensions of `--scene` and `--preview` before any work.
+fn check_outputs(args: &TrialArgs) -> Result<()> {
+    if let Some(path) = &args.scene
+        && !SCENE_EXTENSIONS.iter().any(|e| has_extension(path, e))
+    {
+        let note = if has_extension(path, "glb") {
+            " (binary glTF is not supported)"
+        } else {
+            ""
+        };
+        bail!(
+            "--scene {}: unsupported file type{note}; the supported extensions are .gltf (glTF 2.0) \
+             and .obj (Wavefront OBJ with an MTL)",
+            path.display()
+        );
+    }
+    if let Some(path) = &args.preview
+        && !has_extension(path, "png")
+    {
+        bail!(
+            "--preview {}: unsupported file type; previews are PNG pictures, the supported \
+             extension is .png",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
+    check_outputs(args)?;
+    let mut names = Vec::new();
     let mut kinds = Vec::new();
     let mut values = Vec::new();
     for part in args.at.split(',').filter(|p| !p.trim().is_empty()) {
@@ -58,10 +123,38 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
             .trim()
             .parse()
             .with_context(|| format!("--at: {name} is not a number: {value:?}"))?;
+        if !value.is_finite() {
+            bail!(
+                "--at: {} = {value} is not a finite number",
+                described(name.trim(), kind)
+            );
+        }
+        names.push(name.trim());
         kinds.push(kind);
         values.push(value);
     }
     let ev = args.sim.evaluator(&kinds)?;
+    for (((name, kind), value), (lo, hi)) in
+        names.iter().zip(&kinds).zip(&values).zip(ev.space.bounds())
+    {
+        // The simulator's own slack, so exact bounds pass.
+        if *value < lo - 1e-9 || *value > hi + 1e-9 {
+            let unit = match kind {
+                graspopt_sim::ParamKind::RotX
+                | graspopt_sim::ParamKind::RotY
+                | graspopt_sim::ParamKind::RotZ => "rad",
+                _ => "m",
+            };
+            bail!(
+                "--at: {} = {} is outside [{}, {}] {unit} for the {}",
+                described(name, *kind),
+                compact(*value),
+                compact_bound(lo),
+                compact_bound(hi),
+                ev.object.name()
+            );
+        }
+    }
     let e = ev.evaluate(&values)?;
     let written = write_pictures(args, &ev, &e)?;
     match args.format {
@@ -144,16 +237,11 @@ fn write_pictures(args: &TrialArgs, ev: &Evaluator, e: &Evaluation) -> Result<Ve
     if let Some(path) = &args.scene {
         let (lo, hi) = ev.object.aabb();
         let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
-        if has_extension(path, "glb") {
-            bail!(
-                "--scene {}: binary glTF (.glb) is not supported; write .gltf or .obj",
-                path.display()
-            );
-        }
         if has_extension(path, "gltf") {
             export::write_gltf(path, &meshes, &contacts, normal_length)?;
             written.push(path.clone());
         } else {
+            // `.obj`, checked by `check_outputs`.
             export::write_obj(path, &meshes, &contacts, normal_length)?;
             written.push(path.clone());
             written.push(export::mtl_path(path));
@@ -181,4 +269,20 @@ fn write_pictures(args: &TrialArgs, ev: &Evaluator, e: &Evaluation) -> Result<Ve
 fn has_extension(path: &Path, ext: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case(ext))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(compact(1e300), "1.0000e300");
+        assert_eq!(compact(-0.08), "-0.08");
+        assert_eq!(compact(0.020_000_1), "0.0200001");
+        assert_eq!(compact_bound(-std::f64::consts::FRAC_PI_4), "-0.7854");
+        assert_eq!(compact_bound(0.02), "0.02");
+        assert_eq!(compact_bound(0.0), "0");
+        assert_eq!(compact_bound(1e-7), "1.0000e-7");
+    }
 }

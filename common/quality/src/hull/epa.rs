@@ -17,7 +17,7 @@ use nalgebra::SVector;
 
 use super::affine::{AffineBasis, affine_basis};
 use super::coordinate_scale;
-use super::polytope::{Degenerate, FacetId, Polytope};
+use super::polytope::{FacetId, Polytope, PolytopeError};
 use super::quickhull;
 
 /// Relative tolerance (times the coordinate scale) at which a support point no longer
@@ -46,29 +46,50 @@ pub fn inner_distance<const D: usize>(points: &[SVector<f64, D>]) -> Option<Inne
     inner_distance_with_basis(points, &affine_basis(points))
 }
 
-/// As [`inner_distance`], with the affine basis of `points` already computed.
+/// As [`inner_distance`], with the affine basis of `points` already computed; `None`
+/// also when no polytope could be grown (see [`try_inner_distance_with_basis`]).
 pub fn inner_distance_with_basis<const D: usize>(
     points: &[SVector<f64, D>],
     basis: &AffineBasis,
 ) -> Option<InnerDistance> {
+    try_inner_distance_with_basis(points, basis).ok().flatten()
+}
+
+/// As [`inner_distance_with_basis`], but a search that would need more than
+/// [`quickhull::FACET_LIMIT`] facets is an error rather than `None`. Degenerate
+/// geometry that neither the joggled points nor the full hull overcome is still `None`.
+pub fn try_inner_distance_with_basis<const D: usize>(
+    points: &[SVector<f64, D>],
+    basis: &AffineBasis,
+) -> Result<Option<InnerDistance>, quickhull::HullError> {
     if basis.rank < D {
-        return None;
+        return Ok(None);
     }
     let scale = coordinate_scale(points);
-    if let Ok(r) = expand(points, &basis.indices, scale) {
-        return Some(r);
+    match expand(points, &basis.indices, scale) {
+        Ok(r) => return Ok(Some(r)),
+        Err(PolytopeError::TooManyFacets) => return Err(quickhull::HullError::TooManyFacets),
+        Err(PolytopeError::Degenerate) => {}
     }
     // Floating-point degeneracy (near-coplanar contact grids): retry on slightly
     // joggled copies, then fall back to the full hull, which has its own recovery.
     for joggle in quickhull::JOGGLES {
-        if let Ok(r) = expand(&quickhull::joggled(points, joggle), &basis.indices, scale) {
-            return Some(r);
+        match expand(&quickhull::joggled(points, joggle), &basis.indices, scale) {
+            Ok(r) => return Ok(Some(r)),
+            Err(PolytopeError::TooManyFacets) => {
+                return Err(quickhull::HullError::TooManyFacets);
+            }
+            Err(PolytopeError::Degenerate) => {}
         }
     }
-    quickhull::Hull::new(points).ok().map(|h| InnerDistance {
-        offset: h.min_offset(),
-        iterations: h.added(),
-    })
+    match quickhull::Hull::new(points) {
+        Ok(h) => Ok(Some(InnerDistance {
+            offset: h.min_offset(),
+            iterations: h.added(),
+        })),
+        Err(quickhull::HullError::TooManyFacets) => Err(quickhull::HullError::TooManyFacets),
+        Err(_) => Ok(None),
+    }
 }
 
 #[derive(PartialEq, PartialOrd)]
@@ -85,7 +106,7 @@ fn expand<const D: usize>(
     points: &[SVector<f64, D>],
     simplex: &[usize],
     scale: f64,
-) -> Result<InnerDistance, Degenerate> {
+) -> Result<InnerDistance, PolytopeError> {
     let mut poly = Polytope::simplex(points, simplex, VISIBILITY_TOLERANCE * scale)?;
     let tolerance = SUPPORT_TOLERANCE * scale;
     let mut heap: BinaryHeap<Reverse<(Key, FacetId)>> = poly
@@ -114,7 +135,7 @@ fn expand<const D: usize>(
             .enumerate()
             .map(|(i, p)| (i, normal.dot(p)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .ok_or(Degenerate)?;
+            .ok_or(PolytopeError::Degenerate)?;
         if height - offset <= tolerance {
             return Ok(InnerDistance { offset, iterations });
         }
@@ -122,7 +143,7 @@ fn expand<const D: usize>(
         // A point is added at most once; asked for again, the polytope has gone
         // non-convex in rounding: give up on it (the caller falls back to the full hull).
         if std::mem::replace(&mut used[best], true) {
-            return Err(Degenerate);
+            return Err(PolytopeError::Degenerate);
         }
         let new = poly.add_point(best, f)?;
         iterations += 1;
@@ -133,7 +154,7 @@ fn expand<const D: usize>(
             }
         }
     }
-    Err(Degenerate)
+    Err(PolytopeError::Degenerate)
 }
 
 #[cfg(test)]

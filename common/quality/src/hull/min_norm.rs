@@ -7,8 +7,18 @@
 use nalgebra::SVector;
 
 /// Relative optimality gap at which the search stops: `x.x - min_j x.p_j` below this
-/// times the largest squared norm.
-const GAP_TOLERANCE: f64 = 1e-15;
+/// times `|x|` times the largest norm `M`. Since the distance `d` satisfies
+/// `d >= min_j x.p_j / |x|`, the reported `|x|` is then within `GAP_TOLERANCE * M` of
+/// `d`, however small `d` is relative to `M`. (A gap relative to `M^2` alone, as
+/// before, only resolved distances down to `sqrt(tolerance) * M`: with points
+/// `+-1e8 e_x, +-e_y` it stopped at `e_y` and reported distance 1 for a hull that
+/// contains the origin.) The gap is computed with a rounding error of a few `eps |x| M`,
+/// well below this.
+const GAP_TOLERANCE: f64 = 1e-14;
+/// A step that shortens `|x|^2` by less than this fraction is no progress: the search
+/// stops there (the gap test alone would let rounding cycle the corral for hundreds of
+/// steps on some grasps).
+const STALL: f64 = 1e-12;
 /// Weights below this (relative) are treated as zero.
 const WEIGHT_TOLERANCE: f64 = 1e-13;
 /// Major iterations at most (the algorithm is finite; this is a guard against cycling
@@ -36,7 +46,8 @@ pub fn min_norm_point<const D: usize>(points: &[SVector<f64, D>]) -> MinNormPoin
         };
     }
     let max_sq = points.iter().fold(0.0f64, |m, p| m.max(p.norm_squared()));
-    let gap_tol = GAP_TOLERANCE * max_sq.max(f64::MIN_POSITIVE);
+    // Absolute accuracy of the distance.
+    let accuracy = GAP_TOLERANCE * max_sq.sqrt().max(f64::MIN_POSITIVE);
 
     let start = (0..points.len())
         .min_by(|&a, &b| {
@@ -49,18 +60,23 @@ pub fn min_norm_point<const D: usize>(points: &[SVector<f64, D>]) -> MinNormPoin
     let mut weights: Vec<f64> = vec![1.0];
     let mut x = points[start];
 
+    let mut previous = f64::INFINITY;
     for _ in 0..MAX_ITERATIONS {
         let xx = x.norm_squared();
-        if xx <= gap_tol {
+        let norm = xx.sqrt();
+        // Stop at the answer, or when a step no longer shortens x: near the optimum,
+        // rounding can make the corral cycle with no real progress.
+        if norm <= accuracy || xx >= previous * (1.0 - STALL) {
             break;
         }
+        previous = xx;
         let (j, xp) = points
             .iter()
             .enumerate()
             .map(|(i, p)| (i, x.dot(p)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((0, xx));
-        if xx - xp <= gap_tol || corral.contains(&j) || corral.len() > D {
+        if xx - xp <= accuracy * norm || corral.contains(&j) || corral.len() > D {
             break;
         }
         corral.push(j);
@@ -213,5 +229,25 @@ mod tests {
         // Nearest point lies on the segment (2,2)-(3,1): (2,2) + t(1,-1) with t = 0: the
         // gradient at (2,2) along (1,-1) is 2-2 = 0, so (2,2) itself.
         assert!((m.distance - 8.0f64.sqrt()).abs() < 1e-14);
+    }
+
+    #[test]
+    fn small_features_of_a_large_set_are_resolved() {
+        // The hull of +-s e_x, +-e_y contains the origin at every scale s; the old
+        // stopping rule (gap relative to the largest squared norm) stopped at e_y and
+        // reported distance 1 from s = 1e8 on.
+        for s in [1.0, 1e6, 1e8, 1e10, 1e12] {
+            let pts = [
+                Vector2::new(0.0, 1.0),
+                Vector2::new(s, 0.0),
+                Vector2::new(-s, 0.0),
+                Vector2::new(0.0, -1.0),
+            ];
+            assert!(min_norm_point(&pts).distance < 1e-13 * s, "scale {s}");
+            // Shifted by 0.5 along y: the hull's nearest point is (0, -0.5).
+            let shifted = pts.map(|p| p + Vector2::new(0.0, 1.5));
+            let d = min_norm_point(&shifted).distance;
+            assert!((d - 0.5).abs() < 1e-13 * s, "scale {s}: {d}");
+        }
     }
 }

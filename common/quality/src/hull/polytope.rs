@@ -61,9 +61,21 @@ pub struct Polytope<'a, const D: usize> {
     keys: Vec<[u64; 2]>,
 }
 
-/// Failure to build or grow the polytope (degenerate geometry in floating point).
+/// Most facets, live and removed, one polytope may create. A facet takes about 140
+/// bytes with its bookkeeping, so this bounds a polytope near 700 MB. Full hulls of
+/// large, rounded wrench sets (dense friction cones, surface patches) can need far more
+/// (three contacts with 1,024-edge cones: over 24 GB); they are refused with
+/// [`PolytopeError::TooManyFacets`] instead of exhausting memory.
+pub const FACET_LIMIT: usize = 5_000_000;
+
+/// Failure to build or grow the polytope.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Degenerate;
+pub enum PolytopeError {
+    /// Degenerate geometry in floating point.
+    Degenerate,
+    /// Growing it would create more than [`FACET_LIMIT`] facets.
+    TooManyFacets,
+}
 
 impl<'a, const D: usize> Polytope<'a, D> {
     /// The simplex on `simplex` (D+1 affinely independent point indices).
@@ -71,10 +83,10 @@ impl<'a, const D: usize> Polytope<'a, D> {
         points: &'a [SVector<f64, D>],
         simplex: &[usize],
         eps: f64,
-    ) -> Result<Self, Degenerate> {
+    ) -> Result<Self, PolytopeError> {
         const { assert!(D >= 2 && D <= MAX_DIMENSION) };
         if simplex.len() != D + 1 {
-            return Err(Degenerate);
+            return Err(PolytopeError::Degenerate);
         }
         let interior = simplex.iter().map(|&i| points[i]).sum::<SVector<f64, D>>() / (D + 1) as f64;
         let mut poly = Self {
@@ -98,7 +110,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
                 verts[k] = v as u32;
                 neighbors[k] = g as FacetId;
             }
-            let (normal, offset) = poly.hyperplane(&verts).ok_or(Degenerate)?;
+            let (normal, offset) = poly.hyperplane(&verts).ok_or(PolytopeError::Degenerate)?;
             poly.facets.push(Facet {
                 verts,
                 neighbors,
@@ -172,7 +184,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
         &mut self,
         p: usize,
         seed: FacetId,
-    ) -> Result<std::ops::Range<FacetId>, Degenerate> {
+    ) -> Result<std::ops::Range<FacetId>, PolytopeError> {
         let point = self.points[p];
         self.epoch = self.epoch.wrapping_add(1);
         if self.epoch == 0 {
@@ -215,6 +227,9 @@ impl<'a, const D: usize> Polytope<'a, D> {
             }
         }
         self.horizon.truncate(ridges);
+        if self.facets.len() + ridges > FACET_LIMIT {
+            return Err(PolytopeError::TooManyFacets);
+        }
         // Cone each horizon ridge to the new point.
         let first = self.facets.len() as FacetId;
         for i in 0..ridges {
@@ -226,14 +241,14 @@ impl<'a, const D: usize> Polytope<'a, D> {
             // The apex already on the horizon: rounding made the polytope non-convex
             // there; a facet with a repeated vertex would break the topology.
             if verts.contains(&(p as u32)) {
-                return Err(Degenerate);
+                return Err(PolytopeError::Degenerate);
             }
             verts[slot] = p as u32;
             let (normal, offset) = self.cone_hyperplane(f, outer, &point, &verts)?;
             let mut neighbors = [FacetId::MAX; D];
             neighbors[slot] = outer;
             let outer_facet = &mut self.facets[outer as usize];
-            let back = position(&outer_facet.neighbors, f).ok_or(Degenerate)?;
+            let back = position(&outer_facet.neighbors, f).ok_or(PolytopeError::Degenerate)?;
             outer_facet.neighbors[back] = id;
             self.facets.push(Facet {
                 verts,
@@ -256,10 +271,10 @@ impl<'a, const D: usize> Polytope<'a, D> {
     /// across a ridge through the apex, matched by the ridge's vertex set in a hash
     /// table. Unmatched offers write `FacetId::MAX` over `FacetId::MAX`, so the loop has
     /// no branch on the outcome.
-    fn link_new_facets(&mut self, first: FacetId) -> Result<(), Degenerate> {
+    fn link_new_facets(&mut self, first: FacetId) -> Result<(), PolytopeError> {
         let end = self.facets.len() as FacetId;
         if end >= MAX_FACETS {
-            return Err(Degenerate);
+            return Err(PolytopeError::Degenerate);
         }
         self.ridges.begin((end - first) as usize * (D - 1));
         for (g, &(_, apex_slot)) in (first..end).zip(&self.horizon) {
@@ -286,7 +301,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
         if self.ridges.complete() {
             Ok(())
         } else {
-            Err(Degenerate)
+            Err(PolytopeError::Degenerate)
         }
     }
 
@@ -302,7 +317,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
         outer: FacetId,
         apex: &SVector<f64, D>,
         verts: &[u32; D],
-    ) -> Result<(SVector<f64, D>, f64), Degenerate> {
+    ) -> Result<(SVector<f64, D>, f64), PolytopeError> {
         let f1 = &self.facets[inner as usize];
         let f2 = &self.facets[outer as usize];
         let d1 = f1.distance(apex);
@@ -321,7 +336,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
                 return Ok((normal, offset));
             }
         }
-        self.hyperplane(verts).ok_or(Degenerate)
+        self.hyperplane(verts).ok_or(PolytopeError::Degenerate)
     }
 
     /// The volume of the polytope: the sum over facets of the simplices they span with

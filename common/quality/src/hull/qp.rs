@@ -7,12 +7,17 @@
 //! The second-order cone makes `t` the distance itself rather than its square, so the
 //! solver's tolerance applies to the distance directly. Kept as the reference for the
 //! faster [`super::min_norm`] solver.
+//!
+//! The solver's tolerances are absolute, so the wrenches are first scaled by a power of
+//! two (exact in floating point) that brings their largest coordinate near 1, and the
+//! distance is scaled back: the result does not depend on the units of the input.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+use super::coordinate_scale;
 use crate::error::QualityError;
 use crate::wrench::Wrench;
 
@@ -21,10 +26,34 @@ const TOLERANCE: f64 = 1e-10;
 
 /// The distance from the origin to the hull of `w`, by Clarabel.
 pub fn distance_to_hull(w: &[Wrench]) -> Result<f64, QualityError> {
-    let m = w.len();
-    if m == 0 {
+    if w.is_empty() {
         return Err(QualityError::Empty("wrenches"));
     }
+    let unit = power_of_two_scale(coordinate_scale(w));
+    if unit == 1.0 {
+        return solve(w);
+    }
+    let scaled: Vec<Wrench> = w.iter().map(|x| x / unit).collect();
+    Ok(solve(&scaled)? * unit)
+}
+
+/// The power of two nearest `scale` (1 for a zero, subnormal or non-finite scale, or
+/// one whose power of two is not representable).
+fn power_of_two_scale(scale: f64) -> f64 {
+    if !scale.is_finite() || scale < f64::MIN_POSITIVE {
+        return 1.0;
+    }
+    let exponent = scale.log2().round();
+    if !(-1021.0..=1022.0).contains(&exponent) {
+        return 1.0;
+    }
+    // In range, so the exponent is a small integer and 2^exponent is exact.
+    2f64.powi(exponent as i32)
+}
+
+/// [`distance_to_hull`] without the scaling.
+fn solve(w: &[Wrench]) -> Result<f64, QualityError> {
+    let m = w.len();
     let n = 7 + m; // t, y (6), lambda (m)
     let lambda = |j: usize| 7 + j;
     let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
@@ -107,5 +136,23 @@ mod tests {
             .collect();
         let d = distance_to_hull(&w).unwrap();
         assert!((d - 1.0 / 6.0f64.sqrt()).abs() < 1e-8, "{d}");
+    }
+
+    #[test]
+    fn the_distance_does_not_depend_on_the_units() {
+        // A segment at distance 1 from the origin, in units from 1e-12 to 1e12: the
+        // solver's absolute tolerances used to fail (PrimalInfeasible) or drift here.
+        let base = [
+            Wrench::new(1.0, -1.0, 0.0, 0.0, 0.0, 0.0),
+            Wrench::new(1.0, 1.0, 0.0, 0.0, 0.0, 0.0),
+        ];
+        for s in [1e-12, 1e-6, 1.0, 1e6, 1e12] {
+            let w: Vec<Wrench> = base.iter().map(|x| x * s).collect();
+            let d = distance_to_hull(&w).unwrap() / s;
+            assert!((d - 1.0).abs() < 1e-8, "scale {s}: {d}");
+        }
+        assert_eq!(power_of_two_scale(3.0), 4.0);
+        assert_eq!(power_of_two_scale(0.0), 1.0);
+        assert_eq!(power_of_two_scale(f64::INFINITY), 1.0);
     }
 }

@@ -7,12 +7,16 @@
 //! finished hull is checked for convexity against every input point, and if the exact
 //! points defeat the construction (near-coplanar contact grids can), the hull of a copy
 //! moved by a tiny seeded joggle is built instead and the joggle is reported.
+//!
+//! Memory: a hull that would need more than [`FACET_LIMIT`] facets is refused
+//! ([`HullError::TooManyFacets`]) rather than allowed to exhaust memory.
 
 use nalgebra::SVector;
 
 use super::affine::affine_basis;
 use super::coordinate_scale;
-use super::polytope::{Degenerate, FacetId, Polytope};
+pub use super::polytope::FACET_LIMIT;
+use super::polytope::{FacetId, Polytope, PolytopeError};
 
 /// Visibility tolerance (relative to the coordinate scale). Points nearer a facet's
 /// hyperplane than this count as on it. Much smaller values let near-coplanar input
@@ -32,11 +36,16 @@ pub enum HullError {
     LowerDimensional { rank: usize },
     /// Floating-point degeneracy that neither the exact nor the joggled points overcame.
     Degenerate,
+    /// The hull needs more than [`FACET_LIMIT`] facets.
+    TooManyFacets,
 }
 
-impl From<Degenerate> for HullError {
-    fn from(_: Degenerate) -> Self {
-        HullError::Degenerate
+impl From<PolytopeError> for HullError {
+    fn from(e: PolytopeError) -> Self {
+        match e {
+            PolytopeError::Degenerate => HullError::Degenerate,
+            PolytopeError::TooManyFacets => HullError::TooManyFacets,
+        }
     }
 }
 
@@ -56,13 +65,18 @@ impl<const D: usize> Hull<D> {
         if basis.rank < D {
             return Err(HullError::LowerDimensional { rank: basis.rank });
         }
-        if let Ok(hull) = construct(points, &basis.indices, 0.0) {
-            return Ok(hull);
+        // Joggling does not reduce the facet count: too many facets is final.
+        match construct(points, &basis.indices, 0.0) {
+            Ok(hull) => return Ok(hull),
+            Err(HullError::TooManyFacets) => return Err(HullError::TooManyFacets),
+            Err(_) => {}
         }
         for joggle in JOGGLES {
             let moved = joggled(points, joggle);
-            if let Ok(hull) = construct(&moved, &basis.indices, joggle) {
-                return Ok(hull);
+            match construct(&moved, &basis.indices, joggle) {
+                Ok(hull) => return Ok(hull),
+                Err(HullError::TooManyFacets) => return Err(HullError::TooManyFacets),
+                Err(_) => {}
             }
         }
         Err(HullError::Degenerate)

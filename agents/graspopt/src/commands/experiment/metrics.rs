@@ -12,7 +12,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use graspopt_sim::{ContactModel, ParamKind};
 use graspopt_trial::scan::ScanPoint;
@@ -26,15 +26,37 @@ pub struct MetricsArgs {
     /// Output folder.
     #[arg(long, default_value = "results/experiment-metrics")]
     pub out: PathBuf,
-    /// Points of each 1D scan.
+    /// Points of each 1D scan (2 to 100000).
     #[arg(long, default_value_t = 61)]
     pub steps: usize,
-    /// Points per axis of each 2D scan.
+    /// Points per axis of each 2D scan (2 to 3000).
     #[arg(long, default_value_t = 31)]
     pub steps_2d: usize,
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+}
+
+/// The most points of a 1D scan.
+const MAX_STEPS: usize = 100_000;
+/// The most points per axis of a 2D scan (9 million points in all).
+const MAX_STEPS_2D: usize = 3000;
+
+/// Checks `--steps` and `--steps-2d`: a range needs at least two points per axis.
+fn check_steps(args: &MetricsArgs) -> Result<()> {
+    if !(2..=MAX_STEPS).contains(&args.steps) {
+        bail!(
+            "--steps must be between 2 and {MAX_STEPS}, got {}",
+            args.steps
+        );
+    }
+    if !(2..=MAX_STEPS_2D).contains(&args.steps_2d) {
+        bail!(
+            "--steps-2d must be between 2 and {MAX_STEPS_2D}, got {}",
+            args.steps_2d
+        );
+    }
+    Ok(())
 }
 
 /// Width of the parameter range where `pred` holds (grid spacing counted per point).
@@ -71,6 +93,7 @@ fn approach_plot<'a>(
 }
 
 pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
+    check_steps(args)?;
     let dir = &args.out;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut report = String::from(
@@ -79,8 +102,8 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
          divided by its bounding radius unless said. Approach offsets in metres from the reference pose \
          (negative: farther from the object).\n\n",
     );
-    let steps = args.steps.max(2);
-    let steps2 = args.steps_2d.max(2);
+    let steps = args.steps;
+    let steps2 = args.steps_2d;
 
     // 4.3-4.5: LS, GWV, BW along the approach axis.
     report.push_str(
@@ -135,8 +158,10 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     }
 
     // 4.6: contact models.
-    report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n\n| object | model | BW max | force-closure range |\n|---|---|---|---|\n");
+    report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n");
     for object in ["cuboid", "sphere"] {
+        // One table per object: the "File:" line after each would end a shared table.
+        report.push_str(CONTACT_MODEL_TABLE);
         let mut variants = Vec::new();
         for (name, model) in [
             ("mean point", ContactModel::MeanPoint),
@@ -247,6 +272,10 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     println!("{}", path.display());
     Ok(())
 }
+
+/// The header of each Figure 4.6 table of the report (after a blank line).
+const CONTACT_MODEL_TABLE: &str =
+    "\n| object | model | BW max | force-closure range |\n|---|---|---|---|\n";
 
 /// The header of the 2D-map tables of the report.
 const MAP_TABLE: &str = "| object | best BW | at (approach, vertical) | force closure | file |\n|---|---|---|---|---|\n";

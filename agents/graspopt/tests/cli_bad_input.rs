@@ -1,0 +1,492 @@
+//! Bad input to `graspopt` gets a clear error naming the flag and its value (exit 1), never a
+//! panic (101) or an abort (134), and loses nothing already recorded.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs the `graspopt` binary built for these tests.
+fn graspopt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_graspopt"))
+        .args(args)
+        .output()
+        .expect("run graspopt")
+}
+
+/// Runs `graspopt`, killing it after `limit` (a command that should have refused its input
+/// at once must not hang the tests); `None` if it had to be killed.
+fn graspopt_within(args: &[&str], limit: Duration) -> Option<Output> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_graspopt"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run graspopt");
+    let started = Instant::now();
+    loop {
+        if child.try_wait().expect("wait for graspopt").is_some() {
+            return Some(child.wait_with_output().expect("graspopt output"));
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// A fresh scratch folder, unique per test process and `name`.
+fn tempdir(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("graspopt-bad-input-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Asserts `out` is a refusal (exit 1, no panic) whose message holds every one of `expected`.
+fn assert_refused(out: &Output, args: &[&str], expected: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    for e in expected {
+        assert!(stderr.contains(e), "{args:?}: expected {e:?} in: {stderr}");
+    }
+}
+
+fn refused(args: &[&str], expected: &[&str]) -> Output {
+    let out = graspopt(args);
+    assert_refused(&out, args, expected);
+    out
+}
+
+// --- export ---
+
+/// A finished run of three trials in `dir`; returns its journal.
+fn small_run(dir: &Path) -> PathBuf {
+    let out = graspopt(&[
+        "run",
+        "--run",
+        "r1",
+        "--object",
+        "sphere",
+        "--trials",
+        "3",
+        "--workers",
+        "1",
+        "--method",
+        "random",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let journal = dir.join("journal.sqlite");
+    assert!(std::fs::metadata(&journal).unwrap().len() > 0);
+    journal
+}
+
+#[test]
+fn export_refuses_to_overwrite_its_journal() {
+    let dir = tempdir("export-self");
+    let journal = small_run(&dir);
+    let before = std::fs::read(&journal).unwrap();
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let link = dir.join("link.sqlite");
+    std::os::unix::fs::symlink(&journal, &link).unwrap();
+    let j = journal.to_str().unwrap();
+    let same = [
+        journal.clone(),
+        dir.join(".").join("journal.sqlite"),
+        dir.join("sub").join("..").join("journal.sqlite"),
+        link.clone(),
+    ];
+    for out_path in &same {
+        for format in ["csv", "json"] {
+            let o = out_path.to_str().unwrap();
+            let args = ["export", "r1", "--journal", j, "--format", format, "-o", o];
+            refused(&args, &["--output", o, "journal"]);
+            assert_eq!(
+                std::fs::read(&journal).unwrap(),
+                before,
+                "{args:?} changed the journal"
+            );
+        }
+    }
+    // Through the symlink as the journal, too.
+    let args = ["export", "r1", "--journal", link.to_str().unwrap(), "-o", j];
+    refused(&args, &["--output"]);
+    assert_eq!(std::fs::read(&journal).unwrap(), before);
+    // The journal still exports.
+    let ok = graspopt(&["export", "r1", "--journal", j]);
+    assert!(ok.status.success());
+    assert_eq!(String::from_utf8_lossy(&ok.stdout).lines().count(), 1 + 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn failed_export_leaves_an_existing_output_alone() {
+    let dir = tempdir("export-keep");
+    let journal = small_run(&dir);
+    let j = journal.to_str().unwrap();
+    let out = dir.join("trials-old.csv");
+    std::fs::write(&out, "previous export\n").unwrap();
+    let o = out.to_str().unwrap();
+    // An unknown run fails after the journal was opened: the old output stays.
+    let bad = graspopt(&["export", "nope", "--journal", j, "-o", o]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous export\n");
+    // A successful export replaces it, leaving no temporary file behind.
+    let ok = graspopt(&["export", "r1", "--journal", j, "-o", o]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("trial,state"), "{text}");
+    assert_eq!(text.lines().count(), 1 + 3);
+    let stray: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// --- scan ---
+
+#[test]
+fn scan_refuses_grids_too_large_to_hold() {
+    let dir = tempdir("scan-big");
+    let d = dir.to_str().unwrap();
+    // 10^20 points: more than a usize counts.
+    refused(
+        &[
+            "scan",
+            "--axes",
+            "x,y,rz,rx",
+            "--steps",
+            "100000",
+            "--out",
+            d,
+        ],
+        &["--steps", "100000"],
+    );
+    // 10^9 points on one axis: above the limit.
+    refused(
+        &["scan", "--steps", "1000000000", "--out", d],
+        &["--steps 1000000000", "10000000"],
+    );
+    refused(
+        &["scan", "--axes", "x,y", "--steps", "4000,4000", "--out", d],
+        &["--steps 4000,4000", "16000000"],
+    );
+    // Nothing was written.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scan_of_three_axes_says_it_writes_the_csv_only() {
+    let dir = tempdir("scan-3d");
+    let out = graspopt(&[
+        "scan",
+        "--object",
+        "sphere",
+        "--axes",
+        "x,y,rz",
+        "--steps",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("note:") && stderr.contains("1 or 2 axes"),
+        "{stderr}"
+    );
+    let files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(files, ["sphere-bw-approach-vertical-rz.csv"]);
+    let help = graspopt(&["scan", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        help.contains("3 or more axes") && help.contains("CSV only"),
+        "{help}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// --- optimize-function ---
+
+#[test]
+fn optimize_function_validates_initial_budget_and_seeds() {
+    refused(
+        &[
+            "optimize-function",
+            "branin",
+            "--init",
+            "18446744073709551615",
+        ],
+        &["--initial 18446744073709551615", "--budget 50"],
+    );
+    refused(
+        &[
+            "optimize-function",
+            "branin",
+            "--budget",
+            "3",
+            "--init",
+            "1000000000",
+        ],
+        &["--initial 1000000000", "--budget 3"],
+    );
+    refused(
+        &[
+            "optimize-function",
+            "branin",
+            "--budget",
+            "18446744073709551615",
+        ],
+        &["--budget", "18446744073709551615"],
+    );
+    refused(
+        &["optimize-function", "branin", "--seeds", "0"],
+        &["--seeds", "0"],
+    );
+    // `--initial` is the flag (as in `graspopt run`), `--init` its alias.
+    for flag in ["--initial", "--init"] {
+        let out = graspopt(&[
+            "optimize-function",
+            "branin",
+            "--method",
+            "random",
+            "--seeds",
+            "1",
+            "--budget",
+            "3",
+            flag,
+            "3",
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{flag}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains("budget 3, init 3"), "{flag}: {stdout}");
+    }
+}
+
+// --- bench ---
+
+#[test]
+fn bench_validates_every_argument_before_running() {
+    let out = refused(
+        &["bench", "clouds", "--points", "100", "--messages", "0"],
+        &["--messages", "0"],
+    );
+    assert!(out.stdout.is_empty());
+    refused(
+        &["bench", "clouds", "--points", "18446744073709551615"],
+        &["--points", "18446744073709551615"],
+    );
+    // The 1-worker case must not run before the 0 is refused.
+    for workers in ["1,0", "0", "1,100000"] {
+        let args = [
+            "bench",
+            "pipeline",
+            "--workers",
+            workers,
+            "--trial-cost-ms",
+            "0",
+            "--trials-per-worker",
+            "1",
+        ];
+        let out = graspopt_within(&args, Duration::from_secs(60)).expect("bench pipeline hung");
+        assert_refused(&out, &args, &["--workers"]);
+        assert!(
+            out.stdout.is_empty(),
+            "{args:?} ran before refusing: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+    refused(
+        &["bench", "pipeline", "--overhead-trials", "1"],
+        &["--overhead-trials", "1"],
+    );
+}
+
+// --- experiment metrics ---
+
+#[test]
+fn experiment_metrics_refuses_fewer_than_two_steps() {
+    let dir = tempdir("metrics-steps");
+    let out_dir = dir.join("out");
+    let o = out_dir.to_str().unwrap();
+    refused(
+        &[
+            "experiment",
+            "metrics",
+            "--steps",
+            "0",
+            "--steps-2d",
+            "0",
+            "--out",
+            o,
+        ],
+        &["--steps", "got 0"],
+    );
+    refused(
+        &["experiment", "metrics", "--steps", "1", "--out", o],
+        &["--steps", "got 1"],
+    );
+    refused(
+        &["experiment", "metrics", "--steps-2d", "1", "--out", o],
+        &["--steps-2d", "got 1"],
+    );
+    refused(
+        &["experiment", "metrics", "--steps-2d", "100000", "--out", o],
+        &["--steps-2d", "got 100000"],
+    );
+    assert!(!out_dir.exists(), "a refused experiment wrote {o}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn experiment_metrics_report_tables_each_have_a_header() {
+    let dir = tempdir("metrics-report");
+    let out = graspopt(&[
+        "experiment",
+        "metrics",
+        "--steps",
+        "3",
+        "--steps-2d",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let lines: Vec<&str> = report.lines().collect();
+    // Every block of table lines starts with a header and its |---| separator.
+    let mut tables = 0;
+    for (i, l) in lines.iter().enumerate() {
+        let starts_block = l.starts_with('|') && (i == 0 || !lines[i - 1].starts_with('|'));
+        if starts_block {
+            tables += 1;
+            assert!(
+                l.starts_with("| object") || l.starts_with("| frame"),
+                "a table without a header at line {}: {l}\n{report}",
+                i + 1
+            );
+            assert!(
+                lines.get(i + 1).is_some_and(|n| n.starts_with("|---")),
+                "line {}: {l}\n{report}",
+                i + 1
+            );
+        }
+    }
+    // 4.3-4.5, two for 4.6 (cuboid, sphere), 4.7, 4.8, 4.9-4.15.
+    assert_eq!(tables, 6, "{report}");
+    let sphere_rows = lines
+        .iter()
+        .filter(|l| l.starts_with("| sphere | "))
+        .count();
+    assert!(sphere_rows >= 3, "{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// --- topic, router ---
+
+#[test]
+fn topic_rate_windows_below_three_messages_are_refused() {
+    for what in ["hz", "bw"] {
+        let args = [
+            "topic",
+            what,
+            "status",
+            "--window",
+            "0",
+            "--duration",
+            "2",
+            "--no-multicast-scouting",
+        ];
+        let out = graspopt_within(&args, Duration::from_secs(30)).expect("topic hung");
+        assert_refused(&out, &args, &["--window", "got 0"]);
+    }
+}
+
+#[test]
+fn router_refuses_other_modes() {
+    for mode in ["client", "peer"] {
+        let args = ["router", "--mode", mode, "--listen", "tcp/127.0.0.1:0"];
+        let out = graspopt_within(&args, Duration::from_secs(20))
+            .unwrap_or_else(|| panic!("`graspopt router --mode {mode}` kept running"));
+        assert_refused(&out, &args, &[&format!("--mode {mode}"), "router"]);
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("listening"));
+    }
+}
+
+// --- trial ---
+
+#[test]
+fn trial_names_the_bad_parameter_compactly() {
+    refused(
+        &["trial", "--object", "sphere", "--at", "x=NaN"],
+        &["--at", "x (approach) = NaN"],
+    );
+    refused(
+        &["trial", "--object", "sphere", "--at", "y=0,rz=inf"],
+        &["--at", "rz", "inf"],
+    );
+    let out = refused(
+        &["trial", "--object", "sphere", "--at", "x=1e300"],
+        &["--at", "x (approach)", "1.0000e300", "outside"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.len() < 200, "{stderr}");
+    assert!(!stderr.contains("000000000000"), "{stderr}");
+}
+
+#[test]
+fn trial_refuses_picture_files_it_cannot_write() {
+    let dir = tempdir("trial-ext");
+    let jpg = dir.join("p.jpg");
+    let stl = dir.join("s.stl");
+    let bare = dir.join("scene");
+    let base = ["trial", "--object", "sphere", "--at", "x=-0.1"];
+    let with = |flag: &str, p: &Path| -> Vec<String> {
+        base.iter()
+            .map(|s| s.to_string())
+            .chain([flag.to_string(), p.to_str().unwrap().to_string()])
+            .collect()
+    };
+    for (flag, path, expected) in [
+        ("--preview", &jpg, vec![".png"]),
+        ("--scene", &stl, vec![".gltf", ".obj"]),
+        ("--scene", &bare, vec![".gltf", ".obj"]),
+    ] {
+        let args = with(flag, path);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let mut want = vec![flag, path.to_str().unwrap()];
+        want.extend(expected);
+        refused(&args, &want);
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "files written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
