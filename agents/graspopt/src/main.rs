@@ -28,7 +28,7 @@ enum Command {
     Quality(commands::quality::QualityArgs),
     /// Run one simulated trial and print its contacts and metrics.
     Trial(commands::trial::TrialArgs),
-    /// Grid-scan a metric over one or two trial parameters (CSV and SVG).
+    /// Grid-scan a metric over trial parameters (CSV; SVG and PNG images for one or two).
     Scan(commands::scan::ScanArgs),
     /// Record a grid of simulated grasps' contact clouds (for `agent hand --replay`).
     Record(commands::record::RecordArgs),

@@ -284,7 +284,7 @@ fn optimize_function_validates_initial_budget_and_seeds() {
             "{flag}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        assert!(stdout.contains("budget 3, init 3"), "{flag}: {stdout}");
+        assert!(stdout.contains("budget 3, initial 3"), "{flag}: {stdout}");
     }
 }
 

@@ -244,7 +244,14 @@ fn experiment_bo_bad_input_is_named() {
             vec!["--objects", "sphere,,mug"],
             "--objects has an empty name",
         ),
-        (vec!["--steps", "5"], "--steps \"5\": expected two counts"),
+        (
+            vec!["--steps", "5,6,7"],
+            "--steps \"5,6,7\": expected one count or two",
+        ),
+        (
+            vec!["--steps", "1"],
+            "each count must be between 2 and 1000",
+        ),
         (
             vec!["--steps", "5,100000"],
             "each count must be between 2 and 1000",

@@ -31,7 +31,60 @@ impl BusError {
     pub(crate) fn zenoh(what: impl Into<String>, e: impl std::fmt::Display) -> Self {
         BusError::Zenoh {
             what: what.into(),
-            detail: e.to_string(),
+            detail: without_source_locations(&e.to_string()),
         }
+    }
+}
+
+/// `text` without the ` at /path/to/file.rs:123` locations Zenoh appends to its errors
+/// (paths of the build machine's crate registry, of no use to a user).
+fn without_source_locations(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(" at /") {
+        let tail = &rest[i + 4..];
+        let end = tail.find(char::is_whitespace).unwrap_or(tail.len());
+        let location = tail[..end].trim_end_matches('.');
+        let is_source = location
+            .rsplit_once(".rs:")
+            .is_some_and(|(_, line)| !line.is_empty() && line.bytes().all(|b| b.is_ascii_digit()));
+        if is_source {
+            out.push_str(&rest[..i]);
+            // A sentence's full stop after the location stays, unless it ends the text.
+            let after = if end == tail.len() {
+                end
+            } else {
+                location.len()
+            };
+            rest = &tail[after..];
+        } else {
+            out.push_str(&rest[..i + 4]);
+            rest = tail;
+        }
+    }
+    out.push_str(rest);
+    out.trim_end().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::without_source_locations;
+
+    #[test]
+    fn source_locations_are_dropped_and_other_paths_kept() {
+        assert_eq!(
+            without_source_locations(
+                "Unable to connect to any of [tcp/127.0.0.1:1]! at /root/.cargo/registry/src/zenoh-1.10.0/src/net/runtime/orchestrator.rs:393."
+            ),
+            "Unable to connect to any of [tcp/127.0.0.1:1]!"
+        );
+        assert_eq!(
+            without_source_locations("a at /x/y.rs:1. b at /u/v.rs:22"),
+            "a. b"
+        );
+        assert_eq!(
+            without_source_locations("cannot read at /etc/graspopt/agent.json5"),
+            "cannot read at /etc/graspopt/agent.json5"
+        );
     }
 }

@@ -91,6 +91,23 @@ pub enum ContactModel {
     Surface,
 }
 
+impl ContactModel {
+    /// The name users type and see (`--contacts`): `mean`, `patch`, `surface`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactModel::MeanPoint => "mean",
+            ContactModel::CircularPatch => "patch",
+            ContactModel::Surface => "surface",
+        }
+    }
+}
+
+impl std::fmt::Display for ContactModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// How raw clouds are extracted from the touching links.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CloudSettings {

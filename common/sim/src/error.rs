@@ -61,7 +61,7 @@ pub enum SimError {
         path: String,
     },
     /// An I/O error while reading a mesh file.
-    #[error("cannot read mesh file `{path}`: {source}")]
+    #[error("cannot read mesh file `{path}`")]
     Io {
         /// The path.
         path: String,

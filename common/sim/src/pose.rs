@@ -40,6 +40,26 @@ pub enum ParamKind {
     RotZ,
 }
 
+impl ParamKind {
+    /// The name users type and see: `approach`, `lateral`, `vertical`, `rx`, `ry`, `rz`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ParamKind::Approach => "approach",
+            ParamKind::Lateral => "lateral",
+            ParamKind::Vertical => "vertical",
+            ParamKind::RotX => "rx",
+            ParamKind::RotY => "ry",
+            ParamKind::RotZ => "rz",
+        }
+    }
+}
+
+impl std::fmt::Display for ParamKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A parameter and its bounds.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ParamSpec {
@@ -71,13 +91,13 @@ impl TrialSpace {
             ensure_finite(&[p.lower, p.upper], "parameter bounds")?;
             if p.lower > p.upper {
                 return Err(SimError::InvalidInput(format!(
-                    "parameter {:?}: lower > upper",
+                    "parameter {}: lower > upper",
                     p.kind
                 )));
             }
             if params[..i].iter().any(|q| q.kind == p.kind) {
                 return Err(SimError::InvalidInput(format!(
-                    "parameter {:?} given twice",
+                    "parameter {} given twice",
                     p.kind
                 )));
             }
@@ -154,7 +174,7 @@ impl TrialSpace {
         for (p, &v) in self.params.iter().zip(x) {
             if v < p.lower - BOUND_SLACK || v > p.upper + BOUND_SLACK {
                 return Err(SimError::InvalidInput(format!(
-                    "parameter {:?} = {v} outside [{}, {}]",
+                    "parameter {} = {v} outside [{}, {}]",
                     p.kind, p.lower, p.upper
                 )));
             }

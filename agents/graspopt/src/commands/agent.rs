@@ -93,7 +93,13 @@ pub enum Kind {
         /// Number of trials (with --resume: raises the recorded budget).
         #[arg(long, default_value_t = 60)]
         trials: u64,
-        #[arg(long, default_value = "x,y", value_delimiter = ',')]
+        /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
+        #[arg(
+            long,
+            visible_alias = "axes",
+            default_value = "x,y",
+            value_delimiter = ','
+        )]
         params: Vec<String>,
         #[arg(long, value_enum, default_value_t = Method::Bo)]
         method: Method,

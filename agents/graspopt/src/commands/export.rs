@@ -29,7 +29,7 @@ pub struct ExportArgs {
     pub format: Format,
     /// Output file (default: standard output). Must not be the journal; an existing file is
     /// replaced only once the export succeeded.
-    #[arg(long, short)]
+    #[arg(long, short, visible_alias = "out")]
     pub output: Option<PathBuf>,
 }
 

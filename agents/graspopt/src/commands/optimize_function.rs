@@ -115,7 +115,7 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
             FormatArg::Json => {
                 let line = json!({
                     "function": function.name(),
-                    "method": format!("{:?}", args.method).to_lowercase(),
+                    "method": method_name(args.method),
                     "seed": seed,
                     "budget": budget,
                     "init": n_init,
@@ -176,7 +176,7 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                 json!({
                     "summary": {
                         "function": function.name(),
-                        "method": format!("{:?}", args.method).to_lowercase(),
+                        "method": method_name(args.method),
                         "seeds": args.seeds,
                         "budget": budget,
                         "init": n_init,
@@ -201,12 +201,17 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                 })
                 .collect();
             println!(
-                "summary {} ({:?}, budget {budget}, init {n_init}, batch {q}): {}",
+                "summary {} ({}, budget {budget}, initial {n_init}, batch {q}): {}",
                 function.name(),
-                args.method,
+                method_name(args.method),
                 parts.join("; ")
             );
         }
     }
     Ok(())
+}
+
+/// The method's name as typed (`bo`, `bo-thesis`, `random`).
+fn method_name(m: MethodArg) -> String {
+    clap::ValueEnum::to_possible_value(&m).map_or_else(String::new, |v| v.get_name().to_string())
 }

@@ -21,7 +21,7 @@ pub struct RecordArgs {
     #[command(flatten)]
     pub sim: SimArgs,
     /// Parameters of the grid, comma separated: x (approach), y (vertical), lateral, rx, ry, rz.
-    #[arg(long, default_value = "x,y")]
+    #[arg(long, visible_alias = "params", default_value = "x,y")]
     pub axes: String,
     /// Grid points per axis, comma separated (one value applies to every axis).
     #[arg(long, default_value = "9")]

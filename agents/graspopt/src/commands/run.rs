@@ -50,7 +50,12 @@ pub struct RunArgs {
     #[arg(long, default_value_t = 60)]
     pub trials: u64,
     /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
-    #[arg(long, default_value = "x,y", value_delimiter = ',')]
+    #[arg(
+        long,
+        visible_alias = "axes",
+        default_value = "x,y",
+        value_delimiter = ','
+    )]
     pub params: Vec<String>,
     /// How trials are proposed.
     #[arg(long, value_enum, default_value_t = Method::Bo)]

@@ -30,7 +30,7 @@ pub struct ScanArgs {
     pub sim: SimArgs,
     /// Parameters to scan, comma separated: x (approach), y (vertical), lateral, rx, ry, rz
     /// (images for 1 or 2 axes only; more axes write the CSV alone).
-    #[arg(long, default_value = "x")]
+    #[arg(long, visible_alias = "params", default_value = "x")]
     pub axes: String,
     /// Grid points per axis, comma separated (one value applies to every axis); at most
     /// 10,000,000 points in all.
@@ -138,7 +138,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
     std::fs::write(&csv_path, csv(&names, &points))
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
     let title = format!(
-        "{} on the {} ({:?} contacts)",
+        "{} on the {} ({} contacts)",
         args.sim.metric.to_uppercase(),
         ev.object.name(),
         ev.score.contacts

@@ -108,14 +108,7 @@ pub fn param_kind(name: &str) -> Result<ParamKind> {
 
 /// The name of a parameter as printed.
 pub fn param_name(kind: ParamKind) -> &'static str {
-    match kind {
-        ParamKind::Approach => "approach",
-        ParamKind::Lateral => "lateral",
-        ParamKind::Vertical => "vertical",
-        ParamKind::RotX => "rx",
-        ParamKind::RotY => "ry",
-        ParamKind::RotZ => "rz",
-    }
+    kind.name()
 }
 
 /// The object's default trial space restricted to `kinds`, in that order.

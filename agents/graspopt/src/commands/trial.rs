@@ -161,7 +161,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         TrialFormat::Json => println!("{}", serde_json::to_string_pretty(&e)?),
         TrialFormat::Text => {
             println!(
-                "object {}  hand {}  contacts {:?}  metric {}",
+                "object {}  hand {}  contacts {}  metric {}",
                 ev.object.name(),
                 ev.hand.name(),
                 ev.score.contacts,

@@ -63,7 +63,8 @@ pub struct BoArgs {
     /// Trials per 6D run.
     #[arg(long, default_value_t = 100)]
     pub budget_6d: usize,
-    /// Grid of the 2D reference scan, approach x vertical (the thesis's 2,211 points).
+    /// Grid of the 2D reference scan, approach x vertical (the thesis's 2,211 points); one
+    /// count is used for both axes, as in `graspopt scan`.
     #[arg(long, default_value = "67,33")]
     pub steps: String,
     /// Objects of the 2D and 6D parts, comma-separated (default: the seven of the thesis);
@@ -164,9 +165,14 @@ fn plan(args: &BoArgs) -> Result<Plan> {
         .split(',')
         .map(|s| s.trim().parse::<usize>())
         .collect::<Result<_, _>>()
-        .with_context(|| format!("--steps {:?}: expected two counts like 67,33", args.steps))?;
-    let [nx, ny] = steps[..] else {
-        bail!("--steps {:?}: expected two counts, like 67,33", args.steps);
+        .with_context(|| format!("--steps {:?}: expected counts like 67,33", args.steps))?;
+    let [nx, ny] = match steps[..] {
+        [n] => [n, n],
+        [nx, ny] => [nx, ny],
+        _ => bail!(
+            "--steps {:?}: expected one count or two, like 67,33",
+            args.steps
+        ),
     };
     if ![nx, ny].iter().all(|n| (2..=MAX_STEPS).contains(n)) {
         bail!(
