@@ -231,6 +231,15 @@ fn metric_and_planner_restarts_stall_the_run_only_while_they_are_away() {
     }));
 }
 
+/// Trials of `run` issued and not finished, by the journal.
+fn running_now(path: &std::path::Path, run: &str) -> usize {
+    Journal::open(path)
+        .and_then(|j| j.trials(run))
+        .map_or(0, |t| {
+            t.iter().filter(|t| t.state == TrialState::Running).count()
+        })
+}
+
 /// Every agent a client of one router (no peer-to-peer links: all traffic through it). The
 /// router is killed mid-run, which cuts every agent off, and started again on the same port
 /// a second later: the agents reconnect, declare their subscriptions and liveliness again,
@@ -247,8 +256,9 @@ fn the_run_survives_a_router_restart() {
     let _metric = c.agent("metric", &with(&["metric"]));
     let _hands = c.hands(2, &with(&["--trial-cost-ms", "200"]));
     let coordinator = c.coordinator("cylinder", "16", "2", &with(&["--lease-ms", "8000"]));
-    wait_until("4 trials", Duration::from_secs(90), || {
-        completed_now(&journal, "rr") >= 4
+    // Cut while a worker holds a trial (between trials both may be waiting for proposals).
+    wait_until("4 trials, and one running", Duration::from_secs(90), || {
+        completed_now(&journal, "rr") >= 4 && running_now(&journal, "rr") >= 1
     });
     c.router().kill();
     let cut = Instant::now();

@@ -643,6 +643,11 @@ pub async fn run_until(
     let metrics = bus
         .watch_alive(&run.alive_kind_key(AgentKind::Metric))
         .await?;
+    // A planner (re)appearing answers at once: a question in flight when the network was
+    // cut would otherwise wait for its timeout.
+    let planners = bus
+        .watch_alive(&run.alive_kind_key(AgentKind::Planner))
+        .await?;
     let state_server = bus
         .serve::<graspopt_protocol::RunStatus>(&run.state_key())
         .await?;
@@ -747,6 +752,12 @@ pub async fn run_until(
                     } else if let Some(t) = ctx.state.worker_down(&ev.agent.id) {
                         tracing::warn!("coordinator: worker {} lost with trial {t}: re-issuing", ev.agent.id);
                     }
+                }
+            },
+            Some(ev) = planners.recv() => {
+                if ev.alive && ev.agent.run == *run && planning.is_some() {
+                    planning = None;
+                    planner_retry_at = tokio::time::Instant::now();
                 }
             },
             Some(ev) = metrics.recv() => {
