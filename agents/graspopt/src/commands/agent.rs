@@ -264,11 +264,16 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             // With --resume, the recorded run's settings win (flags that contradict them are
             // refused); a run not recorded yet is started, so that a supervised coordinator
             // can be restarted with one command line.
-            let spec = match graspopt_coordinator::recorded_spec(&journal_path, &run_id)? {
-                Some(recorded) if *resume => {
+            let recorded = if *resume {
+                graspopt_coordinator::recorded_spec(&journal_path, &run_id)?
+            } else {
+                None
+            };
+            let spec = match recorded {
+                Some(recorded) => {
                     graspopt_coordinator::reconcile(&run_id, &recorded, &given, explicit)?
                 }
-                _ => given,
+                None => given,
             };
             if let Some(dir) = journal_path.parent()
                 && !dir.as_os_str().is_empty()

@@ -16,7 +16,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 
-use super::setup::{Contacts, Frame, SimArgs, param_kind, param_name};
+use super::setup::{Contacts, Frame, SimArgs, param_kind};
 use super::svg;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -192,11 +192,7 @@ fn resumed_args(args: &RunArgs, out: &Path, explicit: &dyn Fn(&str) -> bool) -> 
     let spec = graspopt_coordinator::reconcile(&run, &recorded, &given, explicit)?;
     let mut out_args = args.clone();
     out_args.sim.hand = spec.hand.clone();
-    out_args.params = spec
-        .params
-        .iter()
-        .map(|k| param_name(*k).to_string())
-        .collect();
+    out_args.params = spec.params.iter().map(|k| k.name().to_string()).collect();
     out_args.trials = spec.trials;
     out_args.seed = spec.seed;
     out_args.method = match spec.method {

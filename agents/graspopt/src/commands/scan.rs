@@ -13,7 +13,7 @@ use clap::Args;
 use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid, worker_count};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::setup::{SimArgs, param_kind, param_name};
+use super::setup::{SimArgs, param_kind};
 use super::svg;
 
 /// The most points a grid (`--steps` multiplied over the axes) may hold.
@@ -127,7 +127,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
 
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let names: Vec<&str> = kinds.iter().map(|k| param_name(*k)).collect();
+    let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
     let stem = format!(
         "{}-{}-{}",
         ev.object.name(),

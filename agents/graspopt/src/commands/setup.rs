@@ -106,11 +106,6 @@ pub fn param_kind(name: &str) -> Result<ParamKind> {
     })
 }
 
-/// The name of a parameter as printed.
-pub fn param_name(kind: ParamKind) -> &'static str {
-    kind.name()
-}
-
 /// The object's default trial space restricted to `kinds`, in that order.
 pub fn space_for(object: &Object, kinds: &[ParamKind]) -> Result<TrialSpace> {
     let full = TrialSpace::full_6d(object);
@@ -121,7 +116,7 @@ pub fn space_for(object: &Object, kinds: &[ParamKind]) -> Result<TrialSpace> {
                 .iter()
                 .find(|p| p.kind == *k)
                 .copied()
-                .with_context(|| format!("no bounds for {}", param_name(*k)))
+                .with_context(|| format!("no bounds for {}", k.name()))
         })
         .collect::<Result<_>>()?;
     Ok(TrialSpace::new(full.reference, params)?)

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use graspopt_trial::{Evaluation, Evaluator};
 
-use super::setup::{SimArgs, param_kind, param_name};
+use super::setup::{SimArgs, param_kind};
 use crate::{export, render};
 
 /// Size of `--preview` pictures (two views side by side).
@@ -70,7 +70,7 @@ fn compact_bound(v: f64) -> String {
 
 /// A parameter as the user named it, with its full name when that differs: `x (approach)`.
 fn described(name: &str, kind: graspopt_sim::ParamKind) -> String {
-    let full = param_name(kind);
+    let full = kind.name();
     if name == full {
         name.to_string()
     } else {
@@ -117,7 +117,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
             .with_context(|| format!("--at: expected NAME=VALUE, got {part:?}"))?;
         let kind = param_kind(name)?;
         if kinds.contains(&kind) {
-            bail!("--at: {} given twice", param_name(kind));
+            bail!("--at: {} given twice", kind.name());
         }
         let value: f64 = value
             .trim()
@@ -168,7 +168,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                 args.sim.metric
             );
             for (k, v) in kinds.iter().zip(&values) {
-                println!("  {} = {v}", param_name(*k));
+                println!("  {} = {v}", k.name());
             }
             let t = e.outcome.grasp.palm_pose.translation.vector;
             println!(
