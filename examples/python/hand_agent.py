@@ -22,7 +22,7 @@ import time
 
 import zenoh
 
-WIRE_VERSION = 2  # every payload carries it; a mismatch is refused
+WIRE_VERSION = 3  # every payload carries it; a mismatch is refused
 
 
 def load_recording(path):

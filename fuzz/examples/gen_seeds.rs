@@ -187,6 +187,7 @@ fn main() {
         }],
         pending: vec![vec![-0.5, 0.5]],
         count: 2,
+        engine_state: Some(vec![1, 2, 3, 4]),
     };
     out.message("decode_suggest_request", "request", &request, None);
 
@@ -195,6 +196,7 @@ fn main() {
         request_id: 9,
         points: vec![vec![0.1, 1.9], vec![-0.9, 0.3]],
         error: None,
+        engine_state: Some(vec![9, 8, 7]),
     };
     out.message("decode_suggest_reply", "reply", &reply, None);
     reply.points.clear();

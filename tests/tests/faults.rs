@@ -214,7 +214,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         .await;
         put_raw(
             run.command_key("hand-1"),
-            b"{\"wire\": 2}".to_vec(),
+            b"{\"wire\": 3}".to_vec(),
             Encoding::Json,
         )
         .await;

@@ -177,6 +177,7 @@ fn templates() -> (
         observations: Vec::new(),
         pending: Vec::new(),
         count: 1,
+        engine_state: None,
     };
     (result, object, clouds, command, suggest)
 }

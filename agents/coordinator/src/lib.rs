@@ -414,6 +414,9 @@ struct Ctx<'a> {
     planner_down_since: Option<i64>,
     /// When that was last logged.
     planner_warned_ms: i64,
+    /// The planner's engine after its last reply (also in the journal), sent back with every
+    /// request: a planner that lost it (restarted) continues from it exactly.
+    engine_state: Option<Vec<u8>>,
 }
 
 impl Ctx<'_> {
@@ -485,6 +488,7 @@ impl Ctx<'_> {
             observations: self.state.observations.clone(),
             pending: self.state.pending_points(),
             count: n as u32,
+            engine_state: self.engine_state.clone(),
         })
     }
 
@@ -507,6 +511,16 @@ impl Ctx<'_> {
         if let Some(e) = reply.error {
             self.planner_down(&format!("the planner could not propose: {e}"));
             return false;
+        }
+        if let Some(engine) = reply.engine_state {
+            // Losing it costs a restarted planner its exactness, not the run.
+            if let Err(e) = self
+                .journal
+                .set_planner_state(self.run.as_str(), &engine, now_ms())
+            {
+                tracing::warn!("coordinator: cannot keep the planner's state in the journal: {e}");
+            }
+            self.engine_state = Some(engine);
         }
         if let Some(since) = self.planner_down_since.take() {
             tracing::warn!(
@@ -634,6 +648,7 @@ pub async fn run_until(
         .with_context(|| format!("cannot open the journal {}", journal_path.display()))?;
     let (spec, mut state) = open_run(&mut journal, run, spec, resume)?;
     state.grace_ms = config.lease_ms as i64;
+    let engine_state = journal.planner_state(run.as_str())?;
     let results = bus.subscribe::<TrialResult>(&run.result_key()).await?;
     let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
     let hands = bus
@@ -668,6 +683,7 @@ pub async fn run_until(
         orphaned: Vec::new(),
         planner_down_since: None,
         planner_warned_ms: 0,
+        engine_state,
     };
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));

@@ -5,8 +5,13 @@
 //! A request carries the whole history of the run (observations in completion order and the
 //! trials pending), so the planner holds no state that matters: it keeps the engine of the
 //! last request warm and, when the new history extends the old one, only tells it the new
-//! observations; otherwise (a restart, another run) it rebuilds the engine from the history.
-//! The same history and seed give the same proposals.
+//! observations. Each reply also carries the engine as it left it (`engine_state`), which
+//! the coordinator keeps in its journal and sends back with every request: a planner without
+//! the run's engine (restarted, or started for a resumed run) continues from that state and
+//! proposes exactly what the first planner would have. Without a usable state (none yet,
+//! another version, a history that does not extend it) it rebuilds the engine from the
+//! history: the same design, the same data, but a model fitted afresh, whose proposals
+//! differ slightly from a warm engine's.
 //!
 //! [`Planner::propose`] is the logic (no network); [`run`] wires it to the bus.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -37,6 +42,7 @@ impl Default for PlannerConfig {
     }
 }
 
+#[derive(Serialize, Deserialize)]
 enum Engine {
     Bo(Box<Optimizer>),
     Random(RandomSearch),
@@ -52,60 +58,290 @@ struct Warm {
     engine: Engine,
 }
 
+/// What `engine_state` holds after its header: the engine with what it was built for and a
+/// digest of the observations it was told (the request carries those; the digest shows
+/// they are the same). (`E`: the engine, or a reference to it when saving.)
+#[derive(Serialize, Deserialize)]
+struct SavedEngine<E> {
+    run_id: RunId,
+    method: PlannerMethod,
+    bounds: Vec<[f64; 2]>,
+    seed: u64,
+    initial: Option<u32>,
+    told: u64,
+    told_digest: u64,
+    engine: E,
+}
+
+/// The layout of [`SavedEngine`] and of the engines in it. Bump it when `Optimizer`,
+/// `RandomSearch` or their settings change shape (the test
+/// `the_saved_engine_layout_is_pinned` fails until then): bincode reads fields by position,
+/// so a state of another layout would be misread rather than refused.
+const STATE_FORMAT: u32 = 1;
+
+/// Starts every `engine_state`, then an FNV-1a checksum of the rest (8 bytes, little
+/// endian), then the bincode of a [`SavedEngine`]. A state of another format or graspopt
+/// version, or a damaged one, is not read: the history is used instead.
+fn state_header() -> Vec<u8> {
+    format!(
+        "graspopt-engine {STATE_FORMAT} {}\n",
+        env!("CARGO_PKG_VERSION")
+    )
+    .into_bytes()
+}
+
+fn state_config() -> impl bincode::config::Config {
+    bincode::config::standard().with_limit::<{ graspopt_protocol::codec::MAX_PAYLOAD }>()
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// FNV-1a over the bits of every coordinate and value, in order.
+fn digest(observations: &[Observation]) -> u64 {
+    observations.iter().fold(FNV_OFFSET, |h, o| {
+        let h =
+            o.x.iter()
+                .chain(std::iter::once(&o.y))
+                .fold(h, |h, v| fnv(h, &v.to_bits().to_le_bytes()));
+        fnv(h, &[0xff])
+    })
+}
+
+fn same_values(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits()
+}
+
+/// The engine settings for a request: the ones a rebuilt engine gets, and the only ones a
+/// restored engine may have.
+fn bo_settings(req: &SuggestRequest) -> Settings {
+    Settings {
+        n_init: req.initial.map(|n| n as usize),
+        ..Settings::for_grasps()
+    }
+}
+
+impl Warm {
+    /// Whether `req` continues this engine's run and history.
+    fn continued_by(&self, req: &SuggestRequest) -> bool {
+        self.run_id == req.run_id
+            && self.method == req.method
+            && self.bounds == req.bounds
+            && self.seed == req.seed
+            && self.initial == req.initial
+            && req.observations.len() >= self.told.len()
+            && req.observations[..self.told.len()] == self.told[..]
+    }
+
+    /// The `engine_state` of this engine.
+    fn save(&self) -> Result<Vec<u8>, String> {
+        let saved = SavedEngine {
+            run_id: self.run_id.clone(),
+            method: self.method,
+            bounds: self.bounds.clone(),
+            seed: self.seed,
+            initial: self.initial,
+            told: self.told.len() as u64,
+            told_digest: digest(&self.told),
+            engine: &self.engine,
+        };
+        let body = bincode::serde::encode_to_vec(&saved, state_config())
+            .map_err(|e| format!("cannot encode the engine state: {e}"))?;
+        let mut out = state_header();
+        out.extend_from_slice(&fnv(FNV_OFFSET, &body).to_le_bytes());
+        out.extend_from_slice(&body);
+        Ok(out)
+    }
+
+    /// The engine `bytes` hold, if it is intact, of this format and version, and `req`
+    /// continues it with the settings a rebuilt engine would have.
+    fn restore(bytes: &[u8], req: &SuggestRequest) -> Result<Warm, String> {
+        let rest = bytes
+            .strip_prefix(state_header().as_slice())
+            .ok_or("it was saved in another format or by another graspopt version")?;
+        let (sum, body) = rest.split_first_chunk::<8>().ok_or("it is truncated")?;
+        if u64::from_le_bytes(*sum) != fnv(FNV_OFFSET, body) {
+            return Err("it is damaged (checksum)".into());
+        }
+        let (saved, used): (SavedEngine<Engine>, usize) =
+            bincode::serde::decode_from_slice(body, state_config())
+                .map_err(|e| format!("it does not decode: {e}"))?;
+        if used != body.len() {
+            return Err(format!("{} bytes follow it", body.len() - used));
+        }
+        let told = usize::try_from(saved.told)
+            .ok()
+            .filter(|&n| n <= req.observations.len())
+            .ok_or("it was told more observations than the request holds")?;
+        let history = &req.observations[..told];
+        if digest(history) != saved.told_digest {
+            return Err("the request's history does not start with its observations".into());
+        }
+        let engine_bounds: Vec<[f64; 2]> = match (&saved.engine, saved.method) {
+            (Engine::Bo(opt), PlannerMethod::Bo) => {
+                if *opt.settings() != bo_settings(req) || opt.seed() != req.seed {
+                    return Err("its engine has other settings or another seed".into());
+                }
+                opt.check_state()
+                    .map_err(|e| format!("it is inconsistent: {e}"))?;
+                let same = opt.len() == told
+                    && opt.observations().zip(history).all(|((x, y), o)| {
+                        same_values(y, o.y)
+                            && x.len() == o.x.len()
+                            && x.iter().zip(&o.x).all(|(a, b)| same_values(*a, *b))
+                    });
+                if !same {
+                    return Err("its engine was told other observations".into());
+                }
+                opt.bounds().into_iter().map(|(l, u)| [l, u]).collect()
+            }
+            (Engine::Random(r), PlannerMethod::Random) => {
+                r.check_state()
+                    .map_err(|e| format!("it is inconsistent: {e}"))?;
+                if r.observation_count() != told {
+                    return Err("its engine was told another number of observations".into());
+                }
+                r.bounds().into_iter().map(|(l, u)| [l, u]).collect()
+            }
+            _ => return Err("its engine is not of its method".into()),
+        };
+        if engine_bounds != saved.bounds {
+            return Err("its engine has other bounds".into());
+        }
+        let warm = Warm {
+            run_id: saved.run_id,
+            method: saved.method,
+            bounds: saved.bounds,
+            seed: saved.seed,
+            initial: saved.initial,
+            told: history.to_vec(),
+            engine: saved.engine,
+        };
+        if !warm.continued_by(req) {
+            return Err("it belongs to another run, method, space, seed or design".into());
+        }
+        Ok(warm)
+    }
+}
+
+/// Points proposed, and the engine state to reply with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proposal {
+    pub points: Vec<Vec<f64>>,
+    /// See the module documentation; `None` if it could not be encoded, which only costs a
+    /// later restart its exactness.
+    pub engine_state: Option<Vec<u8>>,
+}
+
 /// Proposes trials; see the module documentation.
 #[derive(Default)]
 pub struct Planner {
     warm: Option<Warm>,
-    /// Engines rebuilt from a history (restarts, other runs).
+    /// The engine state of the last reply.
+    last_saved: Option<Vec<u8>>,
+    /// Engines rebuilt from a history (no usable saved state).
     pub rebuilds: u64,
+    /// Engines continued from a request's `engine_state`.
+    pub restores: u64,
 }
 
 impl Planner {
-    fn engine_for(&mut self, req: &SuggestRequest) -> Result<&mut Warm, String> {
-        let reusable = self.warm.as_ref().is_some_and(|w| {
-            w.run_id == req.run_id
-                && w.method == req.method
-                && w.bounds == req.bounds
-                && w.seed == req.seed
-                && w.initial == req.initial
-                && req.observations.len() >= w.told.len()
-                && req.observations[..w.told.len()] == w.told[..]
-        });
-        if !reusable {
-            let bounds: Vec<(f64, f64)> = req.bounds.iter().map(|b| (b[0], b[1])).collect();
-            let engine = match req.method {
-                PlannerMethod::Bo => {
-                    let settings = Settings {
-                        n_init: req.initial.map(|n| n as usize),
-                        ..Settings::for_grasps()
-                    };
-                    Engine::Bo(Box::new(
-                        Optimizer::new(&bounds, settings, req.seed).map_err(|e| e.to_string())?,
-                    ))
-                }
-                PlannerMethod::Random => Engine::Random(
-                    RandomSearch::new(&bounds, false, req.seed).map_err(|e| e.to_string())?,
-                ),
-            };
-            self.rebuilds += 1;
-            self.warm = Some(Warm {
-                run_id: req.run_id.clone(),
-                method: req.method,
-                bounds: req.bounds.clone(),
-                seed: req.seed,
-                initial: req.initial,
-                told: Vec::new(),
-                engine,
-            });
+    /// Makes `self.warm` the engine for `req`: the warm one if the request continues it and
+    /// carries the state of this planner's last reply (a request carrying another state
+    /// follows a reply that was lost, or another planner's: the warm engine has moved on
+    /// without the coordinator), else the request's state if `use_state` and it is usable,
+    /// else a new engine told nothing. Returns whether the engine was restored.
+    fn engine_for(&mut self, req: &SuggestRequest, use_state: bool) -> Result<bool, String> {
+        let in_step = req.engine_state.is_none() || req.engine_state == self.last_saved;
+        let warm_fits = self.warm.as_ref().is_some_and(|w| w.continued_by(req));
+        if warm_fits && (in_step || !use_state) {
+            return Ok(false);
         }
-        self.warm
-            .as_mut()
-            .ok_or_else(|| "planner state missing".to_string())
+        if use_state && let Some(bytes) = &req.engine_state {
+            match Warm::restore(bytes, req) {
+                Ok(warm) => {
+                    self.warm = Some(warm);
+                    self.restores += 1;
+                    return Ok(true);
+                }
+                Err(why) => tracing::warn!(
+                    "planner: run {}: the saved engine state is not used ({why}): \
+                     rebuilding the engine from the run's history",
+                    req.run_id
+                ),
+            }
+        }
+        let bounds: Vec<(f64, f64)> = req.bounds.iter().map(|b| (b[0], b[1])).collect();
+        let engine = match req.method {
+            PlannerMethod::Bo => Engine::Bo(Box::new(
+                Optimizer::new(&bounds, bo_settings(req), req.seed).map_err(|e| e.to_string())?,
+            )),
+            PlannerMethod::Random => Engine::Random(
+                RandomSearch::new(&bounds, false, req.seed).map_err(|e| e.to_string())?,
+            ),
+        };
+        self.rebuilds += 1;
+        self.warm = Some(Warm {
+            run_id: req.run_id.clone(),
+            method: req.method,
+            bounds: req.bounds.clone(),
+            seed: req.seed,
+            initial: req.initial,
+            told: Vec::new(),
+            engine,
+        });
+        Ok(false)
     }
 
-    /// Proposes `req.count` points given the request's history.
+    /// Proposes `req.count` points given the request's history, with the engine state to
+    /// reply with.
+    pub fn propose_and_save(&mut self, req: &SuggestRequest) -> Result<Proposal, String> {
+        let points = self.propose(req)?;
+        let engine_state = match self.warm.as_ref().map(Warm::save) {
+            Some(Ok(bytes)) => Some(bytes),
+            Some(Err(e)) => {
+                tracing::warn!("planner: run {}: {e}", req.run_id);
+                None
+            }
+            None => None,
+        };
+        self.last_saved.clone_from(&engine_state);
+        Ok(Proposal {
+            points,
+            engine_state,
+        })
+    }
+
+    /// Proposes `req.count` points given the request's history. An engine restored from
+    /// the request's state that fails is dropped for one rebuilt from the history.
     pub fn propose(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, String> {
-        let warm = self.engine_for(req)?;
+        let restored = self.engine_for(req, true)?;
+        match self.propose_with_warm(req) {
+            Err(e) if restored => {
+                tracing::warn!(
+                    "planner: run {}: the engine restored from the saved state fails ({e}): \
+                     rebuilding it from the run's history",
+                    req.run_id
+                );
+                self.warm = None;
+                self.engine_for(req, false)?;
+                self.propose_with_warm(req)
+            }
+            outcome => outcome,
+        }
+    }
+
+    fn propose_with_warm(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, String> {
+        let warm = self
+            .warm
+            .as_mut()
+            .ok_or_else(|| "planner state missing".to_string())?;
         for o in &req.observations[warm.told.len()..] {
             let told = match &mut warm.engine {
                 Engine::Bo(opt) => opt.observe(&o.x, o.y),
@@ -172,17 +408,18 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
         let p = planner.clone();
         let r2 = req.clone();
         let outcome = tokio::task::spawn_blocking(move || match p.lock() {
-            Ok(mut planner) => planner.propose(&r2),
+            Ok(mut planner) => planner.propose_and_save(&r2),
             Err(_) => Err("planner state poisoned".to_string()),
         })
         .await
         .context("planner: proposal thread panicked")?;
         let reply = match outcome {
-            Ok(points) => SuggestReply {
+            Ok(proposal) => SuggestReply {
                 run_id: req.run_id.clone(),
                 request_id: req.request_id,
-                points,
+                points: proposal.points,
                 error: None,
+                engine_state: proposal.engine_state,
             },
             Err(e) => {
                 tracing::warn!("planner {}: cannot propose: {e}", config.id);
@@ -191,6 +428,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
                     request_id: req.request_id,
                     points: Vec::new(),
                     error: Some(e),
+                    engine_state: None,
                 }
             }
         };
@@ -220,6 +458,7 @@ mod tests {
             observations,
             pending,
             count,
+            engine_state: None,
         }
     }
 
@@ -261,6 +500,279 @@ mod tests {
         other[0].y += 1.0;
         warm.propose(&request(other, vec![], 1)).unwrap();
         assert_eq!(warm.rebuilds, 2);
+    }
+
+    /// Runs `steps` proposals of one point with a warm planner; at each step a planner that
+    /// never saw the run, given the previous reply's engine state, must propose the same
+    /// point and leave the same state. Returns whether a planner given only the history
+    /// ever proposed something else.
+    fn restarted_from_the_state_continue_exactly(method: PlannerMethod, steps: usize) -> bool {
+        let mut warm = Planner::default();
+        let mut history: Vec<Observation> = Vec::new();
+        let mut state: Option<Vec<u8>> = None;
+        let mut rebuilt_differs = false;
+        for step in 0..steps {
+            let req = SuggestRequest {
+                method,
+                engine_state: state.clone(),
+                // One trial pending from time to time, as with a second worker.
+                pending: if step % 3 == 2 {
+                    vec![vec![0.9, -0.9]]
+                } else {
+                    vec![]
+                },
+                ..request(history.clone(), vec![], 1)
+            };
+            let Proposal {
+                points,
+                engine_state: saved,
+            } = warm.propose_and_save(&req).unwrap();
+            assert!(saved.is_some());
+            let mut restarted = Planner::default();
+            let again = restarted.propose_and_save(&req).unwrap();
+            assert_eq!(again.points, points, "step {step}");
+            assert_eq!(again.engine_state, saved, "step {step}");
+            let from_state = u64::from(state.is_some());
+            assert_eq!(
+                (restarted.restores, restarted.rebuilds),
+                (from_state, 1 - from_state)
+            );
+            let mut rebuilt = Planner::default();
+            let without = SuggestRequest {
+                engine_state: None,
+                ..req.clone()
+            };
+            rebuilt_differs |= rebuilt.propose(&without).unwrap() != points;
+            state = saved;
+            history.push(Observation {
+                y: f(&points[0]),
+                x: points[0].clone(),
+            });
+        }
+        assert_eq!((warm.rebuilds, warm.restores), (1, 0));
+        rebuilt_differs
+    }
+
+    #[test]
+    fn a_planner_given_the_saved_engine_state_continues_exactly() {
+        // Past the 3-point design: 13 model-based proposals.
+        let rebuilt_differs = restarted_from_the_state_continue_exactly(PlannerMethod::Bo, 16);
+        // Why the state is kept: an engine rebuilt from the history fits its model afresh
+        // (the warm one starts each fit from the last) and proposes other points.
+        assert!(rebuilt_differs);
+        restarted_from_the_state_continue_exactly(PlannerMethod::Random, 6);
+    }
+
+    /// A warm planner after `n` proposals: its history and the state of its last reply.
+    fn after(n: usize) -> (Planner, Vec<Observation>, Vec<u8>) {
+        let mut warm = Planner::default();
+        let mut history: Vec<Observation> = Vec::new();
+        let mut state = None;
+        for _ in 0..n {
+            let Proposal {
+                points,
+                engine_state,
+            } = warm
+                .propose_and_save(&request(history.clone(), vec![], 1))
+                .unwrap();
+            state = engine_state;
+            history.push(Observation {
+                y: f(&points[0]),
+                x: points[0].clone(),
+            });
+        }
+        (warm, history, state.unwrap())
+    }
+
+    /// `engine` saved as the state of a run with this history.
+    fn forge(engine: Engine, method: PlannerMethod, history: &[Observation]) -> Vec<u8> {
+        let req = request(history.to_vec(), vec![], 1);
+        Warm {
+            run_id: req.run_id,
+            method,
+            bounds: req.bounds,
+            seed: req.seed,
+            initial: req.initial,
+            told: history.to_vec(),
+            engine,
+        }
+        .save()
+        .unwrap()
+    }
+
+    /// A BO engine as the planner builds it, told `history` (with `y` changed by `shift`).
+    fn told(history: &[Observation], settings: Settings, shift: f64) -> Engine {
+        let req = request(vec![], vec![], 1);
+        let bounds: Vec<(f64, f64)> = req.bounds.iter().map(|b| (b[0], b[1])).collect();
+        let mut opt = Optimizer::new(&bounds, settings, req.seed).unwrap();
+        for o in history {
+            opt.observe(&o.x, o.y + shift).unwrap();
+        }
+        Engine::Bo(Box::new(opt))
+    }
+
+    #[test]
+    fn an_unusable_engine_state_is_passed_over_for_the_history() {
+        let (mut warm, history, good) = after(6);
+        let mut flipped = good.clone();
+        let last = flipped.len() - 1;
+        flipped[last] ^= 0x55;
+        let mut other_version = good.clone();
+        other_version[state_header().len() - 2] ^= 1;
+        let mut changed_history = history.clone();
+        changed_history[1].y += 1e-9;
+        let defaults = bo_settings(&request(vec![], vec![], 1));
+        let other_settings = Settings {
+            direct_evals_per_dim: 1_000_000_000,
+            ..defaults.clone()
+        };
+        let random = RandomSearch::new(&[(0.0, 1.0), (-1.0, 1.0)], false, 3).unwrap();
+        let cases: Vec<(&str, Vec<u8>, Vec<Observation>, u64)> = vec![
+            ("garbage", vec![7; 40], history.clone(), 3),
+            ("empty", Vec::new(), history.clone(), 3),
+            (
+                "truncated",
+                good[..good.len() / 2].to_vec(),
+                history.clone(),
+                3,
+            ),
+            (
+                "trailing bytes",
+                [good.clone(), vec![0]].concat(),
+                history.clone(),
+                3,
+            ),
+            ("flipped byte", flipped, history.clone(), 3),
+            ("other version", other_version, history.clone(), 3),
+            ("another seed", good.clone(), history.clone(), 4),
+            ("another history", good.clone(), changed_history, 3),
+            ("shorter history", good.clone(), history[..3].to_vec(), 3),
+            (
+                "other settings",
+                forge(
+                    told(&history, other_settings, 0.0),
+                    PlannerMethod::Bo,
+                    &history,
+                ),
+                history.clone(),
+                3,
+            ),
+            (
+                "engine told other values",
+                forge(
+                    told(&history, defaults.clone(), 1.0),
+                    PlannerMethod::Bo,
+                    &history,
+                ),
+                history.clone(),
+                3,
+            ),
+            (
+                "engine of another method",
+                forge(Engine::Random(random), PlannerMethod::Bo, &history),
+                history.clone(),
+                3,
+            ),
+        ];
+        for (what, bytes, observations, seed) in cases {
+            let req = SuggestRequest {
+                seed,
+                engine_state: Some(bytes),
+                ..request(observations.clone(), vec![], 1)
+            };
+            let mut p = Planner::default();
+            let points = p.propose(&req).unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert_eq!((p.restores, p.rebuilds), (0, 1), "{what}");
+            let rebuilt = Planner::default()
+                .propose(&SuggestRequest {
+                    engine_state: None,
+                    ..req.clone()
+                })
+                .unwrap();
+            assert_eq!(points, rebuilt, "{what}");
+        }
+        // The intact state is used: the next point of the uninterrupted planner.
+        let req = SuggestRequest {
+            engine_state: Some(good),
+            ..request(history.clone(), vec![], 1)
+        };
+        let mut p = Planner::default();
+        assert_eq!(p.propose(&req).unwrap(), warm.propose(&req).unwrap());
+        assert_eq!((p.restores, p.rebuilds), (1, 0));
+    }
+
+    #[test]
+    fn after_a_lost_reply_the_planner_follows_the_coordinators_state() {
+        // Two identical warm planners; each answers a request whose reply the coordinator
+        // never gets (its query timed out): their engines move on without it.
+        let (mut warm, history, state) = after(6);
+        let (mut unaware, _, _) = after(6);
+        for p in [&mut warm, &mut unaware] {
+            p.propose_and_save(&request(history.clone(), vec![], 1))
+                .unwrap();
+        }
+        // Meanwhile a result came in; the coordinator asks with the state it has, the one
+        // before the lost reply.
+        let mut longer = history.clone();
+        let x = vec![0.5, 0.5];
+        longer.push(Observation { y: f(&x), x });
+        let req = SuggestRequest {
+            engine_state: Some(state),
+            ..request(longer.clone(), vec![], 1)
+        };
+        let followed = warm.propose_and_save(&req).unwrap();
+        assert_eq!((warm.restores, warm.rebuilds), (1, 1));
+        // What a planner started now (or any planner restarted later) proposes.
+        let mut fresh = Planner::default();
+        assert_eq!(followed, fresh.propose_and_save(&req).unwrap());
+        // Kept warm regardless, the engine would propose something else.
+        let without = SuggestRequest {
+            engine_state: None,
+            ..req.clone()
+        };
+        assert_ne!(
+            unaware.propose_and_save(&without).unwrap().points,
+            followed.points
+        );
+        // From there on the warm planner is in step with the coordinator again.
+        let mut next_history = longer;
+        next_history.push(Observation {
+            y: f(&followed.points[0]),
+            x: followed.points[0].clone(),
+        });
+        let next = SuggestRequest {
+            engine_state: followed.engine_state.clone(),
+            ..request(next_history, vec![], 1)
+        };
+        assert_eq!(
+            warm.propose_and_save(&next).unwrap(),
+            fresh.propose_and_save(&next).unwrap()
+        );
+        assert_eq!((warm.restores, fresh.restores), (1, 1));
+    }
+
+    /// The layout the format number stands for: a fresh engine of each kind, encoded. When
+    /// this fails, the engines changed shape: bump `STATE_FORMAT`, then update the digests.
+    #[test]
+    fn the_saved_engine_layout_is_pinned() {
+        let req = request(vec![], vec![], 1);
+        let bounds: Vec<(f64, f64)> = req.bounds.iter().map(|b| (b[0], b[1])).collect();
+        let bo = Engine::Bo(Box::new(
+            Optimizer::new(&bounds, bo_settings(&req), 3).unwrap(),
+        ));
+        let random = Engine::Random(RandomSearch::new(&bounds, false, 3).unwrap());
+        let body = |e: Engine, m| {
+            let bytes = forge(e, m, &[]);
+            fnv(FNV_OFFSET, &bytes[state_header().len() + 8..])
+        };
+        assert_eq!(
+            (
+                STATE_FORMAT,
+                body(bo, PlannerMethod::Bo),
+                body(random, PlannerMethod::Random)
+            ),
+            (1, 9564079650046669637, 17208041730547130713)
+        );
     }
 
     #[test]

@@ -67,7 +67,7 @@ impl Record {
         if better {
             self.best = Some((x.to_vec(), y));
         }
-        self.count += 1;
+        self.count = self.count.saturating_add(1);
         Ok(())
     }
 }
@@ -118,8 +118,42 @@ impl RandomSearch {
         }
     }
 
+    /// Observations told so far.
+    pub fn observation_count(&self) -> usize {
+        self.record.count
+    }
+
+    /// The box: one `(lower, upper)` per dimension.
+    pub fn bounds(&self) -> Vec<(f64, f64)> {
+        let r = &self.record;
+        r.lower
+            .iter()
+            .copied()
+            .zip(r.upper.iter().copied())
+            .collect()
+    }
+
+    /// Checks a deserialised search (see [`crate::optimizer::Optimizer::check_state`]):
+    /// valid bounds, and a finite best point of their dimension.
+    pub fn check_state(&self) -> Result<()> {
+        let r = &self.record;
+        check_bounds(&r.lower, &r.upper)?;
+        if let Some((x, y)) = &r.best {
+            if x.len() != r.lower.len() {
+                return Err(BoError::DimensionMismatch {
+                    expected: r.lower.len(),
+                    got: x.len(),
+                });
+            }
+            if !y.is_finite() || x.iter().any(|v| !v.is_finite()) {
+                return Err(BoError::NonFinite { what: "best point" });
+            }
+        }
+        Ok(())
+    }
+
     fn draw(&mut self) -> Vec<f64> {
-        self.drawn += 1;
+        self.drawn = self.drawn.saturating_add(1);
         let r = &self.record;
         r.lower
             .iter()

@@ -543,6 +543,92 @@ impl Optimizer {
         self.lower.len()
     }
 
+    /// The box: one `(lower, upper)` per dimension.
+    pub fn bounds(&self) -> Vec<(f64, f64)> {
+        self.lower
+            .iter()
+            .copied()
+            .zip(self.upper.iter().copied())
+            .collect()
+    }
+
+    /// Checks the data of a state that did not come from [`Optimizer::new`] and its methods
+    /// (a deserialised one, which serde checks for shape only) against its bounds and
+    /// settings: valid bounds and settings ranges, every point of the bounds' dimension and
+    /// finite, design and earlier incumbents in the unit cube, a design of the configured
+    /// size, one finite value per observation, positive finite hyperparameters, positions
+    /// within their lists. The settings' sizes (design size, DIRECT budget, restart window)
+    /// are not judged: a caller that takes a state from outside compares its settings with
+    /// its own.
+    pub fn check_state(&self) -> Result<()> {
+        direct::check_bounds(&self.lower, &self.upper)?;
+        self.settings.validate()?;
+        let d = self.dim();
+        let points = |what: &'static str, list: &[Vec<f64>]| -> Result<()> {
+            for p in list {
+                if p.len() != d {
+                    return Err(BoError::DimensionMismatch {
+                        expected: d,
+                        got: p.len(),
+                    });
+                }
+                if p.iter().any(|v| !v.is_finite()) {
+                    return Err(BoError::NonFinite { what });
+                }
+            }
+            Ok(())
+        };
+        points("observations", &self.xs)?;
+        points("pending points", &self.pending)?;
+        points("initial design", &self.design)?;
+        points("earlier incumbents", &self.tabu)?;
+        if self.ys.len() != self.xs.len() {
+            return Err(BoError::InvalidSetting(format!(
+                "{} observed values for {} observed points",
+                self.ys.len(),
+                self.xs.len()
+            )));
+        }
+        if self.ys.iter().any(|y| !y.is_finite()) {
+            return Err(BoError::NonFinite {
+                what: "observed values",
+            });
+        }
+        if let Some(h) = &self.hyper {
+            let positive = |v: f64| v.is_finite() && v > 0.0;
+            if h.length_scales.len() != d
+                || !h.length_scales.iter().all(|&l| positive(l))
+                || !positive(h.signal_variance)
+                || !positive(h.noise)
+            {
+                return Err(BoError::InvalidSetting(
+                    "hyperparameters must be d positive length scales, a positive signal \
+                     variance and a positive noise"
+                        .into(),
+                ));
+            }
+        }
+        let unit = |list: &[Vec<f64>]| list.iter().flatten().all(|v| (0.0..=1.0).contains(v));
+        if !unit(&self.design) || !unit(&self.tabu) {
+            return Err(BoError::InvalidSetting(
+                "initial design or earlier incumbents outside the unit cube".into(),
+            ));
+        }
+        if !self.design.is_empty() && self.design.len() != self.n_init().max(2) {
+            return Err(BoError::InvalidSetting(format!(
+                "an initial design of {} points, not {}",
+                self.design.len(),
+                self.n_init().max(2)
+            )));
+        }
+        if self.epoch_start > self.xs.len() || self.design_next > self.design.len() {
+            return Err(BoError::InvalidSetting(
+                "epoch start or design position beyond its list".into(),
+            ));
+        }
+        Ok(())
+    }
+
     /// The settings.
     pub fn settings(&self) -> &Settings {
         &self.settings
@@ -1028,12 +1114,12 @@ impl Optimizer {
             }
             if let Some(rel) = info.relative_ei {
                 if rel < self.settings.stop.relative_ei_threshold {
-                    self.low_ei_streak += 1;
+                    self.low_ei_streak = self.low_ei_streak.saturating_add(1);
                 } else {
                     self.low_ei_streak = 0;
                 }
             }
-            self.rounds += 1;
+            self.rounds = self.rounds.saturating_add(1);
         }
         self.pending.extend(out.iter().cloned());
         self.last_round = info;

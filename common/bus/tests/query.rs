@@ -20,6 +20,7 @@ fn request(run: &RunId) -> SuggestRequest {
         observations: Vec::new(),
         pending: Vec::new(),
         count: 1,
+        engine_state: None,
     }
 }
 
@@ -52,6 +53,7 @@ fn the_first_reply_is_not_held_back_by_a_responder_that_never_finishes() {
                     request_id: q.request.as_ref().map_or(0, |req| req.request_id),
                     points: vec![vec![0.25]],
                     error: None,
+                    engine_state: None,
                 };
                 q.reply(&reply).await.unwrap();
             }

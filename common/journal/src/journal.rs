@@ -182,6 +182,40 @@ impl Journal {
         Ok(())
     }
 
+    /// Keeps `state`, the planner's engine after its last reply for the run (opaque
+    /// bytes), replacing the previous one.
+    pub fn set_planner_state(&mut self, run_id: &str, state: &[u8], at_ms: i64) -> Result<()> {
+        let tx = self.write_tx()?;
+        let known: bool = tx.query_row(
+            "SELECT EXISTS (SELECT 1 FROM runs WHERE run_id = ?1)",
+            params![run_id],
+            |r| r.get(0),
+        )?;
+        if !known {
+            return Err(JournalError::UnknownRun(run_id.to_string()));
+        }
+        tx.execute(
+            "INSERT INTO planner_state (run_id, state, updated_ms) VALUES (?1, ?2, ?3)
+             ON CONFLICT (run_id) DO UPDATE SET state = excluded.state,
+                                                updated_ms = excluded.updated_ms",
+            params![run_id, state, at_ms],
+        )?;
+        tx.commit()?;
+        Ok(())
+    }
+
+    /// The planner's engine state kept for the run, if any (see [`Self::set_planner_state`]).
+    pub fn planner_state(&self, run_id: &str) -> Result<Option<Vec<u8>>> {
+        Ok(self
+            .conn
+            .query_row(
+                "SELECT state FROM planner_state WHERE run_id = ?1",
+                params![run_id],
+                |r| r.get(0),
+            )
+            .optional()?)
+    }
+
     // --------------------------------------------------------------- trials
 
     /// A trial issued to a worker (attempt 1: inserts the trial row, event

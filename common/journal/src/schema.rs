@@ -5,11 +5,28 @@ use rusqlite::{Connection, TransactionBehavior};
 use crate::error::{JournalError, Result};
 
 /// The schema version stored in `PRAGMA user_version`.
-pub const SCHEMA_VERSION: i64 = 1;
+pub const SCHEMA_VERSION: i64 = 2;
+
+/// The current layout: version 1 ([`DDL_V1`]) and what version 2 added
+/// ([`DDL_V2_ADDITIONS`]).
+pub(crate) fn ddl() -> String {
+    format!("{DDL_V1}{DDL_V2_ADDITIONS}")
+}
+
+/// Version 2 adds the planner's engine state per run (opaque bytes the planner replies
+/// with; the coordinator sends them back so that a new planner continues exactly). A
+/// version-1 journal is upgraded in place when opened.
+pub(crate) const DDL_V2_ADDITIONS: &str = "
+CREATE TABLE planner_state (
+    run_id     TEXT    NOT NULL PRIMARY KEY REFERENCES runs (run_id),
+    state      BLOB    NOT NULL,
+    updated_ms INTEGER NOT NULL
+) STRICT;
+";
 
 /// Version 1 of the layout. Tables are STRICT, so a value of the wrong type
 /// is refused by SQLite itself rather than stored silently.
-pub(crate) const DDL: &str = "
+pub(crate) const DDL_V1: &str = "
 CREATE TABLE runs (
     run_id      TEXT    NOT NULL PRIMARY KEY,
     created_ms  INTEGER NOT NULL,
@@ -111,16 +128,44 @@ const LAYOUT: &[(&str, &[&str])] = &[
             "seq", "run_id", "trial_id", "attempt", "kind", "worker", "at_ms", "note",
         ],
     ),
+    ("planner_state", &["run_id", "state", "updated_ms"]),
 ];
 
 fn user_version(conn: &Connection) -> Result<i64> {
     Ok(conn.query_row("PRAGMA user_version", [], |r| r.get(0))?)
 }
 
-/// Creates the schema in an empty database, or checks an existing one.
+/// Creates the schema in an empty database, upgrades a version-1 one, or checks an
+/// existing one.
 pub(crate) fn ensure(conn: &mut Connection) -> Result<()> {
     match user_version(conn)? {
         0 => create(conn),
+        1 => upgrade_from_v1(conn),
+        SCHEMA_VERSION => check_layout(conn),
+        found => Err(JournalError::SchemaVersion {
+            found,
+            expected: SCHEMA_VERSION,
+        }),
+    }
+}
+
+/// Adds version 2's table to a version-1 journal (nothing else changed), under the write
+/// lock: another process may be upgrading the same journal right now.
+fn upgrade_from_v1(conn: &mut Connection) -> Result<()> {
+    let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+    if user_version(&tx)? == 1 {
+        tx.execute_batch(DDL_V2_ADDITIONS)?;
+        tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
+        tx.commit()?;
+    } else {
+        drop(tx);
+    }
+    ensure_checked(conn)
+}
+
+/// After an upgrade: the version must now be current.
+fn ensure_checked(conn: &Connection) -> Result<()> {
+    match user_version(conn)? {
         SCHEMA_VERSION => check_layout(conn),
         found => Err(JournalError::SchemaVersion {
             found,
@@ -152,7 +197,7 @@ fn create(conn: &mut Connection) -> Result<()> {
             "the database holds {objects} schema objects but no journal schema version"
         )));
     }
-    tx.execute_batch(DDL)?;
+    tx.execute_batch(&ddl())?;
     tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
     tx.commit()?;
     Ok(())

@@ -1101,3 +1101,57 @@ fn kill9_leaves_consistent_prefix() {
         previous = n;
     }
 }
+
+#[test]
+fn planner_state_is_kept_per_run_replaced_and_reopened() {
+    let dir = TempDir::new("planner-state");
+    let db = dir.db();
+    {
+        let mut j = Journal::open(&db).unwrap();
+        j.create_run(&run_record(RUN)).unwrap();
+        j.create_run(&run_record("other")).unwrap();
+        assert_eq!(j.planner_state(RUN).unwrap(), None);
+        j.set_planner_state(RUN, &[1, 2, 3], 10).unwrap();
+        j.set_planner_state(RUN, &[4, 5], 20).unwrap();
+        j.set_planner_state("other", &[], 30).unwrap();
+        assert_eq!(j.planner_state(RUN).unwrap(), Some(vec![4, 5]));
+        let err = j.set_planner_state("nobody", &[1], 40).unwrap_err();
+        assert!(matches!(err, JournalError::UnknownRun(_)), "{err}");
+    }
+    let j = Journal::open(&db).unwrap();
+    assert_eq!(j.planner_state(RUN).unwrap(), Some(vec![4, 5]));
+    assert_eq!(j.planner_state("other").unwrap(), Some(vec![]));
+    assert_eq!(j.planner_state("nobody").unwrap(), None);
+}
+
+#[test]
+fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
+    let dir = TempDir::new("upgrade");
+    let db = dir.db();
+    {
+        let mut j = Journal::open(&db).unwrap();
+        j.create_run(&run_record(RUN)).unwrap();
+        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+    }
+    // Version 1 is version 2 without the planner_state table.
+    {
+        let raw = rusqlite::Connection::open(&db).unwrap();
+        raw.execute_batch("DROP TABLE planner_state; PRAGMA user_version = 1")
+            .unwrap();
+    }
+    let mut j = Journal::open(&db).unwrap();
+    let version: i64 = rusqlite::Connection::open(&db)
+        .unwrap()
+        .query_row("PRAGMA user_version", [], |r| r.get(0))
+        .unwrap();
+    assert_eq!(version, SCHEMA_VERSION);
+    assert_eq!(j.trials(RUN).unwrap()[0].score, Some(0.5));
+    assert_eq!(j.planner_state(RUN).unwrap(), None);
+    j.set_planner_state(RUN, &[9], 300).unwrap();
+    drop(j);
+    assert_eq!(
+        Journal::open(&db).unwrap().planner_state(RUN).unwrap(),
+        Some(vec![9])
+    );
+}

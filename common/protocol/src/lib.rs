@@ -20,4 +20,4 @@ pub use keys::{AgentKind, RunId, Topic};
 pub use messages::*;
 
 /// The wire version every payload carries. Bumped on any incompatible change of a message.
-pub const WIRE_VERSION: u16 = 2;
+pub const WIRE_VERSION: u16 = 3;

@@ -332,6 +332,13 @@ pub struct SuggestRequest {
     /// Trials issued and not yet completed.
     pub pending: Vec<Vec<f64>>,
     pub count: u32,
+    /// The engine state of the run's last reply ([`SuggestReply::engine_state`]), as the
+    /// coordinator keeps it in its journal. Opaque to everyone but the planner: a planner
+    /// that does not hold the run's engine (it was restarted) continues from it exactly,
+    /// instead of rebuilding a model from `observations` that would propose slightly
+    /// different points.
+    #[serde(default)]
+    pub engine_state: Option<Vec<u8>>,
 }
 
 impl Message for SuggestRequest {
@@ -381,6 +388,9 @@ pub struct SuggestReply {
     pub points: Vec<Vec<f64>>,
     /// Set when the planner could not propose.
     pub error: Option<String>,
+    /// The planner's engine after this proposal (see [`SuggestRequest::engine_state`]).
+    #[serde(default)]
+    pub engine_state: Option<Vec<u8>>,
 }
 
 impl Message for SuggestReply {

@@ -91,6 +91,7 @@ fn every_message_round_trips_exactly_in_both_encodings() {
         }],
         pending: vec![vec![0.01, 0.0]],
         count: 3,
+        engine_state: Some(vec![0, 7, 255]),
     };
     for enc in [Encoding::Bincode, Encoding::Json] {
         assert_eq!(
@@ -129,7 +130,7 @@ fn bincode_payload_starts_with_the_wire_version() {
 #[test]
 fn a_hand_written_json_result_decodes() {
     // What an agent in another language writes, from docs/protocol.md.
-    let text = r#"{"wire": 2, "run_id": "run-1", "trial_id": 4, "attempt": 1,
+    let text = r#"{"wire": 3, "run_id": "run-1", "trial_id": 4, "attempt": 1,
         "worker": "py-hand", "scorer": "py", "score": -2.5, "metrics": null,
         "contacts": 0, "fingers_in_contact": 0, "cloud_points": 0, "cloud_transport": "",
         "error": null}"#;
@@ -209,7 +210,7 @@ fn invalid_content_is_refused_naming_the_field() {
         .unwrap_err();
     assert!(e.to_string().contains("score"), "{e}");
 
-    let text = r#"{"wire": 2, "run_id": "a/b", "trial_id": 4}"#;
+    let text = r#"{"wire": 3, "run_id": "a/b", "trial_id": 4}"#;
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
 }
