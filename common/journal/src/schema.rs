@@ -160,18 +160,8 @@ fn upgrade_from_v1(conn: &mut Connection) -> Result<()> {
     } else {
         drop(tx);
     }
-    ensure_checked(conn)
-}
-
-/// After an upgrade: the version must now be current.
-fn ensure_checked(conn: &Connection) -> Result<()> {
-    match user_version(conn)? {
-        SCHEMA_VERSION => check_layout(conn),
-        found => Err(JournalError::SchemaVersion {
-            found,
-            expected: SCHEMA_VERSION,
-        }),
-    }
+    // Now current (upgraded here or by the other process): checked as any other.
+    ensure(conn)
 }
 
 fn create(conn: &mut Connection) -> Result<()> {
