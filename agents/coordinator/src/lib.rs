@@ -641,7 +641,8 @@ pub async fn run_until(
     tokio::pin!(stop);
     let mut stopped = false;
     // Two coordinators on one run would issue each trial twice and fight over the journal.
-    bus.wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
+    let _place = bus
+        .wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
         .await?;
     let journal_path = config.journal_path(run);
     let mut journal = Journal::open(&journal_path)

@@ -171,7 +171,8 @@ pub const UNIQUE_WAIT: std::time::Duration = std::time::Duration::from_secs(5);
 /// with the same id is alive on the run (see [`UNIQUE_WAIT`]).
 pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
     // Two hands with one id would both execute every trial sent to that id.
-    bus.wait_until_unique(run, AgentKind::Hand, Some(&config.id), UNIQUE_WAIT)
+    let _place = bus
+        .wait_until_unique(run, AgentKind::Hand, Some(&config.id), UNIQUE_WAIT)
         .await?;
     if let Some(path) = &config.replay {
         let recording = replay::Recording::load(path)?;

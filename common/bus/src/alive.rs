@@ -2,7 +2,7 @@
 //! coordinator and tools watch them. A token vanishes when its process dies or loses the
 //! network, which is how a killed hand worker is noticed.
 
-use graspopt_protocol::keys::{AliveKey, parse_alive_key};
+use graspopt_protocol::keys::{AliveKey, HELD_NONCE, parse_alive_key, parse_claim_nonce};
 use graspopt_protocol::{AgentKind, RunId};
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
@@ -42,6 +42,29 @@ impl AliveWatch {
 /// Empty answers in a row after which [`Bus::wait_until_unique`] takes a place as free.
 pub const UNIQUE_CHECKS: u32 = 6;
 
+/// Looks at the other claims of a place, 150 ms apart, before [`Bus::wait_until_unique`]
+/// holds it. Agents that claim together see each other within one look; a later claimant
+/// finds the place held.
+pub const CLAIM_CHECKS: u32 = 2;
+
+/// A place in a run held by this agent (see [`Bus::wait_until_unique`]): keep it as long as
+/// the agent runs; it is released when dropped or when the process dies.
+#[must_use = "the place is released when the claim is dropped"]
+pub struct Claim {
+    _held: Option<LivelinessToken>,
+}
+
+/// A random nonce for a starting claim (never [`HELD_NONCE`]).
+fn starting_nonce() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u32(std::process::id());
+    if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
+        h.write_u128(t.as_nanos());
+    }
+    h.finish().max(1)
+}
+
 impl Bus {
     /// Declares this agent alive until the token is dropped.
     pub async fn declare_alive(
@@ -72,25 +95,107 @@ impl Bus {
         Ok(AliveWatch { sub })
     }
 
-    /// Waits (up to `wait`) until no other agent of `kind` holds the place this one is about
-    /// to take in `run`: one with the same `id` or, when `id` is `None`, any agent of that
-    /// kind. A predecessor that was just killed has its token removed within moments; one
-    /// still alive after `wait` is an error naming it, so that two hands never run each
-    /// other's trials and two coordinators never share a run. A session that has just opened
-    /// may not know every token yet, so the place counts as free only after
-    /// [`UNIQUE_CHECKS`] empty answers in a row, 200 ms apart (one second). A session that
-    /// only listens ([`Bus::reaches_out`] false: the embedded run's, on a fresh loopback
-    /// port) cannot meet an earlier agent and skips the check.
+    /// Takes the place this agent is about to fill in `run`, waiting (up to `wait`) until no
+    /// other agent of `kind` holds it: one with the same `id` or, when `id` is `None`, any
+    /// agent of that kind. A predecessor that was just killed has its token removed within
+    /// moments; one still alive after `wait` is an error naming it, so that two hands never
+    /// run each other's trials and two coordinators never share a run. A session that has
+    /// just opened may not know every token yet, so the place counts as free only after
+    /// [`UNIQUE_CHECKS`] empty answers in a row, 200 ms apart (one second).
+    ///
+    /// Agents that start at the same moment all find the place free; so each then declares
+    /// a claim token with a random number and watches the others' claims for 0.3 s more
+    /// ([`CLAIM_CHECKS`]):
+    /// the one with the smallest number (or one that already holds the place) wins, the
+    /// others give up with an error. The winner's claim is returned; it holds the place until
+    /// dropped. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
+    /// on a fresh loopback port) cannot meet another agent and skips all this.
     pub async fn wait_until_unique(
         &self,
         run: &RunId,
         kind: AgentKind,
         id: Option<&str>,
         wait: std::time::Duration,
-    ) -> Result<(), BusError> {
+    ) -> Result<Claim, BusError> {
         if !self.reaches_out() {
-            return Ok(());
+            return Ok(Claim { _held: None });
         }
+        self.wait_for_holders(run, kind, id, wait).await?;
+        let slot = id.unwrap_or("any");
+        let declare = |nonce: u64| {
+            let key = run.claim_key(kind, slot, nonce);
+            async move {
+                self.session()
+                    .liveliness()
+                    .declare_token(key.clone())
+                    .await
+                    .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
+            }
+        };
+        let nonce = starting_nonce();
+        let starting = declare(nonce).await?;
+        let what = match id {
+            Some(id) => format!("a {} with the id {id}", kind.as_str()),
+            None => format!("a {}", kind.as_str()),
+        };
+        for _ in 0..CLAIM_CHECKS {
+            tokio::time::sleep(std::time::Duration::from_millis(150)).await;
+            let smallest = self
+                .claims(&run.claim_slot_key(kind, slot))
+                .await?
+                .into_iter()
+                .filter(|&n| n != nonce)
+                .min();
+            if let Some(other) = smallest.filter(|&n| n < nonce) {
+                drop(starting);
+                let when = if other == HELD_NONCE {
+                    "has just taken its place"
+                } else {
+                    "is starting at the same moment"
+                };
+                return Err(BusError::Taken(format!(
+                    "run {run}: another agent, {what}, {when}: this one gives way{}",
+                    if id.is_some() {
+                        " (give it another --id)"
+                    } else {
+                        ""
+                    }
+                )));
+            }
+        }
+        let held = declare(HELD_NONCE).await?;
+        drop(starting);
+        Ok(Claim { _held: Some(held) })
+    }
+
+    /// The nonces of the claims alive under `key`.
+    async fn claims(&self, key: &str) -> Result<Vec<u64>, BusError> {
+        let replies = self
+            .session()
+            .liveliness()
+            .get(key)
+            .await
+            .map_err(|e| BusError::zenoh(format!("liveliness query {key}"), e))?;
+        let mut out = Vec::new();
+        while let Ok(reply) = replies.recv_async().await {
+            if let Ok(sample) = reply.result()
+                && let Some(nonce) = parse_claim_nonce(sample.key_expr().as_str())
+            {
+                out.push(nonce);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The first step of [`Self::wait_until_unique`]: waits until no live agent holds the
+    /// place.
+    async fn wait_for_holders(
+        &self,
+        run: &RunId,
+        kind: AgentKind,
+        id: Option<&str>,
+        wait: std::time::Duration,
+    ) -> Result<(), BusError> {
         let deadline = tokio::time::Instant::now() + wait;
         let mut free = 0;
         loop {

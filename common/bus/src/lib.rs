@@ -18,7 +18,7 @@ pub mod clouds;
 pub mod error;
 pub mod session;
 
-pub use alive::{AliveEvent, AliveWatch};
+pub use alive::{AliveEvent, AliveWatch, Claim};
 pub use args::{BusArgs, BusMode};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
 pub use error::BusError;

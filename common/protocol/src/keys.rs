@@ -152,6 +152,23 @@ impl RunId {
         format!("{}/alive/**", self.prefix())
     }
 
+    /// `graspopt/<run>/claim/<kind>/<slot>/<nonce>`: a liveliness token an agent holds while
+    /// it makes sure it is alone in its place (`slot`: its id, or `any` for the run's one
+    /// coordinator). `nonce` is 16 hex digits: random while the agent starts (the smallest
+    /// of agents starting together wins), [`HELD_NONCE`] once the place is taken.
+    pub fn claim_key(&self, kind: AgentKind, slot: &str, nonce: u64) -> String {
+        format!(
+            "{}/claim/{}/{slot}/{nonce:016x}",
+            self.prefix(),
+            kind.as_str()
+        )
+    }
+
+    /// `graspopt/<run>/claim/<kind>/<slot>/*`
+    pub fn claim_slot_key(&self, kind: AgentKind, slot: &str) -> String {
+        format!("{}/claim/{}/{slot}/*", self.prefix(), kind.as_str())
+    }
+
     /// Everything of this run: `graspopt/<run>/**`.
     pub fn all_key(&self) -> String {
         format!("{}/**", self.prefix())
@@ -181,6 +198,18 @@ impl From<RunId> for String {
     fn from(value: RunId) -> Self {
         value.0
     }
+}
+
+/// The nonce of a claim whose agent holds its place (see [`RunId::claim_key`]).
+pub const HELD_NONCE: u64 = 0;
+
+/// The nonce of a claim key (its last chunk), if it is one.
+pub fn parse_claim_nonce(key: &str) -> Option<u64> {
+    let (rest, nonce) = key.rsplit_once('/')?;
+    if !rest.contains("/claim/") || nonce.len() != 16 {
+        return None;
+    }
+    u64::from_str_radix(nonce, 16).ok()
 }
 
 /// Checks an agent id or host name used in a key.
