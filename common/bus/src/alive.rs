@@ -105,10 +105,9 @@ impl Bus {
     ///
     /// Agents that start at the same moment all find the place free; so each then declares
     /// a claim token with a random number and watches the others' claims for 0.3 s more
-    /// ([`CLAIM_CHECKS`]):
-    /// the one with the smallest number (or one that already holds the place) wins, the
-    /// others give up with an error. The winner's claim is returned; it holds the place until
-    /// dropped. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
+    /// ([`CLAIM_CHECKS`]): the one with the smallest number (or one that already holds the
+    /// place) wins, the others give up with an error. The winner's claim is returned; it
+    /// holds the place until dropped. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
     /// on a fresh loopback port) cannot meet another agent and skips all this.
     pub async fn wait_until_unique(
         &self,
