@@ -2,7 +2,7 @@
 //! coordinator and tools watch them. A token vanishes when its process dies or loses the
 //! network, which is how a killed hand worker is noticed.
 
-use graspopt_protocol::keys::{AliveKey, HELD_NONCE, parse_alive_key, parse_claim_nonce};
+use graspopt_protocol::keys::{AliveKey, Claim as ClaimKey, parse_alive_key, parse_claim_key};
 use graspopt_protocol::{AgentKind, RunId};
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
@@ -43,9 +43,12 @@ impl AliveWatch {
 pub const UNIQUE_CHECKS: u32 = 6;
 
 /// Looks at the other claims of a place, 150 ms apart, before [`Bus::wait_until_unique`]
-/// holds it. Agents that claim together see each other within one look; a later claimant
-/// finds the place held.
+/// holds it, and once more after. Agents that claim together see each other as long as
+/// liveliness reaches them within about 150 ms.
 pub const CLAIM_CHECKS: u32 = 2;
+
+/// Pause between two looks at the claims of a place.
+const CLAIM_LOOK: std::time::Duration = std::time::Duration::from_millis(150);
 
 /// A place in a run held by this agent (see [`Bus::wait_until_unique`]): keep it as long as
 /// the agent runs; it is released when dropped or when the process dies.
@@ -54,15 +57,27 @@ pub struct Claim {
     _held: Option<LivelinessToken>,
 }
 
-/// A random nonce for a starting claim (never [`HELD_NONCE`]).
-fn starting_nonce() -> u64 {
+/// A random nonce for a claim.
+fn claim_nonce() -> u64 {
     use std::hash::{BuildHasher, Hasher};
     let mut h = std::collections::hash_map::RandomState::new().build_hasher();
     h.write_u32(std::process::id());
     if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
         h.write_u128(t.as_nanos());
     }
-    h.finish().max(1)
+    h.finish()
+}
+
+/// Who keeps a claimant with nonce `mine` from its place, among `claims`: another agent
+/// holding it, else a smaller starting nonce.
+fn blocker(claims: &[ClaimKey], mine: u64) -> Option<ClaimKey> {
+    let others = claims.iter().filter(|c| c.nonce != mine);
+    others
+        .clone()
+        .filter(|c| c.held)
+        .min_by_key(|c| c.nonce)
+        .or_else(|| others.filter(|c| c.nonce < mine).min_by_key(|c| c.nonce))
+        .copied()
 }
 
 impl Bus {
@@ -104,10 +119,14 @@ impl Bus {
     /// [`UNIQUE_CHECKS`] empty answers in a row, 200 ms apart (one second).
     ///
     /// Agents that start at the same moment all find the place free; so each then declares
-    /// a claim token with a random number and watches the others' claims for 0.3 s more
-    /// ([`CLAIM_CHECKS`]): the one with the smallest number (or one that already holds the
-    /// place) wins, the others give up with an error. The winner's claim is returned; it
-    /// holds the place until dropped. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
+    /// a claim token with a random number and looks at the others' claims ([`CLAIM_CHECKS`]
+    /// looks 150 ms apart): an agent that holds the place, or a smaller number, comes first.
+    /// Seeing none, it holds the place and looks once more: of two that held it at the same
+    /// moment, the smaller number keeps it. An agent that comes second waits, as for a
+    /// predecessor, until the deadline: if the first is gone by then (killed while it took
+    /// the place), it takes the place; else it gives up with an error. The winner's claim is
+    /// returned; it holds the place until dropped. This is sound while liveliness reaches
+    /// the claimants within about 150 ms. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
     /// on a fresh loopback port) cannot meet another agent and skips all this.
     pub async fn wait_until_unique(
         &self,
@@ -119,10 +138,12 @@ impl Bus {
         if !self.reaches_out() {
             return Ok(Claim { _held: None });
         }
-        self.wait_for_holders(run, kind, id, wait).await?;
+        let deadline = tokio::time::Instant::now() + wait;
+        self.wait_for_holders(run, kind, id, deadline).await?;
         let slot = id.unwrap_or("any");
-        let declare = |nonce: u64| {
-            let key = run.claim_key(kind, slot, nonce);
+        let nonce = claim_nonce();
+        let declare = |held: bool| {
+            let key = run.claim_key(kind, slot, ClaimKey { nonce, held });
             async move {
                 self.session()
                     .liveliness()
@@ -131,26 +152,40 @@ impl Bus {
                     .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
             }
         };
-        let nonce = starting_nonce();
-        let starting = declare(nonce).await?;
-        let what = match id {
-            Some(id) => format!("a {} with the id {id}", kind.as_str()),
-            None => format!("a {}", kind.as_str()),
-        };
-        for _ in 0..CLAIM_CHECKS {
-            tokio::time::sleep(std::time::Duration::from_millis(150)).await;
-            let smallest = self
-                .claims(&run.claim_slot_key(kind, slot))
-                .await?
-                .into_iter()
-                .filter(|&n| n != nonce)
-                .min();
-            if let Some(other) = smallest.filter(|&n| n < nonce) {
-                drop(starting);
-                let when = if other == HELD_NONCE {
+        let _starting = declare(false).await?;
+        let claims_key = run.claim_slot_key(kind, slot);
+        loop {
+            // Looks until another claimant is seen; none: hold the place, and look once
+            // more in case another claimant held it at the same moment (the smaller nonce
+            // keeps it).
+            let mut seen = None;
+            for _ in 0..CLAIM_CHECKS {
+                tokio::time::sleep(CLAIM_LOOK).await;
+                seen = blocker(&self.claims(&claims_key).await?, nonce);
+                if seen.is_some() {
+                    break;
+                }
+            }
+            if seen.is_none() {
+                let held = declare(true).await?;
+                tokio::time::sleep(CLAIM_LOOK).await;
+                let claims = self.claims(&claims_key).await?;
+                if !claims.iter().any(|c| c.held && c.nonce < nonce) {
+                    return Ok(Claim { _held: Some(held) });
+                }
+                seen = claims.iter().find(|c| c.held && c.nonce < nonce).copied();
+            }
+            // Another agent is taking or holds the place: wait for it to go, as for a
+            // predecessor, until the deadline.
+            if tokio::time::Instant::now() >= deadline {
+                let what = match id {
+                    Some(id) => format!("a {} with the id {id}", kind.as_str()),
+                    None => format!("a {}", kind.as_str()),
+                };
+                let when = if seen.is_some_and(|c| c.held) {
                     "has just taken its place"
                 } else {
-                    "is starting at the same moment"
+                    "is taking its place at the same moment"
                 };
                 return Err(BusError::Taken(format!(
                     "run {run}: another agent, {what}, {when}: this one gives way{}",
@@ -162,13 +197,10 @@ impl Bus {
                 )));
             }
         }
-        let held = declare(HELD_NONCE).await?;
-        drop(starting);
-        Ok(Claim { _held: Some(held) })
     }
 
-    /// The nonces of the claims alive under `key`.
-    async fn claims(&self, key: &str) -> Result<Vec<u64>, BusError> {
+    /// The claims alive under `key`.
+    async fn claims(&self, key: &str) -> Result<Vec<ClaimKey>, BusError> {
         let replies = self
             .session()
             .liveliness()
@@ -178,9 +210,9 @@ impl Bus {
         let mut out = Vec::new();
         while let Ok(reply) = replies.recv_async().await {
             if let Ok(sample) = reply.result()
-                && let Some(nonce) = parse_claim_nonce(sample.key_expr().as_str())
+                && let Some(claim) = parse_claim_key(sample.key_expr().as_str())
             {
-                out.push(nonce);
+                out.push(claim);
             }
         }
         Ok(out)
@@ -193,9 +225,8 @@ impl Bus {
         run: &RunId,
         kind: AgentKind,
         id: Option<&str>,
-        wait: std::time::Duration,
+        deadline: tokio::time::Instant,
     ) -> Result<(), BusError> {
-        let deadline = tokio::time::Instant::now() + wait;
         let mut free = 0;
         loop {
             let holders: Vec<AliveKey> = self

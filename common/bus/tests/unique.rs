@@ -43,7 +43,7 @@ fn of_agents_starting_together_one_takes_the_place() {
         let winners: Vec<_> = outcomes.iter().filter(|o| o.is_ok()).collect();
         assert_eq!(winners.len(), 1, "{:?}", errors(&outcomes));
         for e in errors(&outcomes) {
-            assert!(e.contains("starting at the same moment"), "{e}");
+            assert!(e.contains("gives way"), "{e}");
         }
         // Another id is another place.
         let other = peer(&endpoint).await;
@@ -60,6 +60,29 @@ fn of_agents_starting_together_one_takes_the_place() {
             .expect("the place is held");
         assert!(matches!(e, BusError::Taken(_)), "{e}");
         assert!(e.to_string().contains("has just taken its place"), "{e}");
+        // One claimant a moment after another (the first is looking, or already holds it):
+        // one place, one holder.
+        for lag_ms in [100, 250, 400] {
+            let run = RunId::new(&format!("uniquelag{lag_ms}")).unwrap();
+            let first = peer(&endpoint).await;
+            let second = peer(&endpoint).await;
+            let (a, b) = tokio::join!(
+                first.wait_until_unique(&run, AgentKind::Coordinator, None, wait),
+                async {
+                    tokio::time::sleep(Duration::from_millis(lag_ms)).await;
+                    second
+                        .wait_until_unique(&run, AgentKind::Coordinator, None, wait)
+                        .await
+                },
+            );
+            let outcomes = vec![a, b];
+            assert_eq!(
+                outcomes.iter().filter(|o| o.is_ok()).count(),
+                1,
+                "lag {lag_ms} ms: {:?}",
+                errors(&outcomes)
+            );
+        }
         let mut outcomes = outcomes;
         outcomes.retain(|o| o.is_ok());
         drop(outcomes);

@@ -152,21 +152,23 @@ impl RunId {
         format!("{}/alive/**", self.prefix())
     }
 
-    /// `graspopt/<run>/claim/<kind>/<slot>/<nonce>`: a liveliness token an agent holds while
-    /// it makes sure it is alone in its place (`slot`: its id, or `any` for the run's one
-    /// coordinator). `nonce` is 16 hex digits: random while the agent starts (the smallest
-    /// of agents starting together wins), [`HELD_NONCE`] once the place is taken.
-    pub fn claim_key(&self, kind: AgentKind, slot: &str, nonce: u64) -> String {
+    /// `graspopt/<run>/claim/<kind>/<slot>/<nonce>/<phase>`: a liveliness token an agent
+    /// holds while it makes sure it is alone in its place (`slot`: its id, or `any` for the
+    /// run's one coordinator). `nonce` is 16 hex digits, random per agent; `phase` is
+    /// `starting`, then `held` once the agent has its place (see [`Claim`]).
+    pub fn claim_key(&self, kind: AgentKind, slot: &str, claim: Claim) -> String {
+        let phase = if claim.held { "held" } else { "starting" };
         format!(
-            "{}/claim/{}/{slot}/{nonce:016x}",
+            "{}/claim/{}/{slot}/{:016x}/{phase}",
             self.prefix(),
-            kind.as_str()
+            kind.as_str(),
+            claim.nonce
         )
     }
 
-    /// `graspopt/<run>/claim/<kind>/<slot>/*`
+    /// `graspopt/<run>/claim/<kind>/<slot>/**`
     pub fn claim_slot_key(&self, kind: AgentKind, slot: &str) -> String {
-        format!("{}/claim/{}/{slot}/*", self.prefix(), kind.as_str())
+        format!("{}/claim/{}/{slot}/**", self.prefix(), kind.as_str())
     }
 
     /// Everything of this run: `graspopt/<run>/**`.
@@ -200,16 +202,34 @@ impl From<RunId> for String {
     }
 }
 
-/// The nonce of a claim whose agent holds its place (see [`RunId::claim_key`]).
-pub const HELD_NONCE: u64 = 0;
+/// A claim token's nonce and phase (see [`RunId::claim_key`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Claim {
+    pub nonce: u64,
+    pub held: bool,
+}
 
-/// The nonce of a claim key (its last chunk), if it is one.
-pub fn parse_claim_nonce(key: &str) -> Option<u64> {
-    let (rest, nonce) = key.rsplit_once('/')?;
-    if !rest.contains("/claim/") || nonce.len() != 16 {
+/// The claim a key names, if it is a claim key.
+pub fn parse_claim_key(key: &str) -> Option<Claim> {
+    let mut chunks = key.rsplit('/');
+    let held = match chunks.next()? {
+        "held" => true,
+        "starting" => false,
+        _ => return None,
+    };
+    let nonce = chunks.next()?;
+    if nonce.len() != 16 || !nonce.bytes().all(|b| b.is_ascii_hexdigit()) {
         return None;
     }
-    u64::from_str_radix(nonce, 16).ok()
+    let _slot = chunks.next()?;
+    let _kind = chunks.next()?;
+    if chunks.next()? != "claim" {
+        return None;
+    }
+    Some(Claim {
+        nonce: u64::from_str_radix(nonce, 16).ok()?,
+        held,
+    })
 }
 
 /// Checks an agent id or host name used in a key.
@@ -371,6 +391,44 @@ mod tests {
             assert_eq!(e.value, bad);
         }
         assert!(serde_json::from_str::<RunId>("\"a/b\"").is_err());
+    }
+
+    #[test]
+    fn claim_keys_parse_back_and_nothing_else_does() {
+        let run = RunId::new("r1").unwrap();
+        for claim in [
+            Claim {
+                nonce: 0x00ab_cdef_0123_4567,
+                held: false,
+            },
+            Claim {
+                nonce: u64::MAX,
+                held: true,
+            },
+        ] {
+            let key = run.claim_key(AgentKind::Hand, "hand-1", claim);
+            assert_eq!(parse_claim_key(&key), Some(claim), "{key}");
+        }
+        assert_eq!(
+            run.claim_key(
+                AgentKind::Coordinator,
+                "any",
+                Claim {
+                    nonce: 1,
+                    held: true
+                }
+            ),
+            "graspopt/r1/claim/coordinator/any/0000000000000001/held"
+        );
+        for bad in [
+            "graspopt/r1/claim/hand/h/+000000000000000/held",
+            "graspopt/r1/claim/hand/h/00000000000000001/held",
+            "graspopt/r1/claim/hand/h/0000000000000001/taken",
+            "graspopt/r1/alive/hand/h/0000000000000001/held",
+            "graspopt/r1/claim/hand/0000000000000001/held",
+        ] {
+            assert_eq!(parse_claim_key(bad), None, "{bad}");
+        }
     }
 
     #[test]
