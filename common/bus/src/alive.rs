@@ -201,6 +201,15 @@ impl Bus {
 
     /// The claims alive under `key`.
     async fn claims(&self, key: &str) -> Result<Vec<ClaimKey>, BusError> {
+        self.tokens(key, parse_claim_key).await
+    }
+
+    /// The liveliness tokens alive now under `key`, as `parse` reads them (others skipped).
+    async fn tokens<T>(
+        &self,
+        key: &str,
+        parse: impl Fn(&str) -> Option<T>,
+    ) -> Result<Vec<T>, BusError> {
         let replies = self
             .session()
             .liveliness()
@@ -210,9 +219,9 @@ impl Bus {
         let mut out = Vec::new();
         while let Ok(reply) = replies.recv_async().await {
             if let Ok(sample) = reply.result()
-                && let Some(claim) = parse_claim_key(sample.key_expr().as_str())
+                && let Some(token) = parse(sample.key_expr().as_str())
             {
-                out.push(claim);
+                out.push(token);
             }
         }
         Ok(out)
@@ -267,20 +276,6 @@ impl Bus {
 
     /// The agents alive now under `key`.
     pub async fn alive_now(&self, key: &str) -> Result<Vec<AliveKey>, BusError> {
-        let replies = self
-            .session()
-            .liveliness()
-            .get(key)
-            .await
-            .map_err(|e| BusError::zenoh(format!("liveliness query {key}"), e))?;
-        let mut out = Vec::new();
-        while let Ok(reply) = replies.recv_async().await {
-            if let Ok(sample) = reply.result()
-                && let Some(agent) = parse_alive_key(sample.key_expr().as_str())
-            {
-                out.push(agent);
-            }
-        }
-        Ok(out)
+        self.tokens(key, parse_alive_key).await
     }
 }
