@@ -16,6 +16,7 @@ Only the Python standard library and eclipse-zenoh are needed.
 import argparse
 import json
 import math
+import random
 import socket
 import sys
 import time
@@ -52,6 +53,66 @@ def measure(grasps, command):
     return best, None
 
 
+def take_place(session, prefix, hand_id, wait_s=5.0):
+    """Makes sure this is the run's only hand with this id, as graspopt's own agents do
+    (docs/reliability.md), and returns the claim token that holds the place (keep it).
+
+    First waits (up to wait_s) until no hand with the id is alive: six empty answers in a
+    row, 0.2 s apart. Then claims the place with a random number and looks at the other
+    claims twice, 0.15 s apart: a held claim, then the smallest number, comes first; seeing
+    none, holds the place and looks once more. Exits if the place stays taken."""
+    deadline = time.monotonic() + wait_s
+
+    def keys(key_expr):
+        return [str(r.ok.key_expr) for r in session.liveliness().get(key_expr) if r.ok]
+
+    free = 0
+    while free < 6:
+        holders = keys(f"{prefix}/alive/hand/*/{hand_id}/**")
+        free = 0 if holders else free + 1
+        if holders and time.monotonic() >= deadline:
+            sys.exit(f"{hand_id}: the run already has a hand with this id ({holders[0]}): "
+                     "stop it first, or give this one another --id")
+        time.sleep(0.2)
+
+    claims_key = f"{prefix}/claim/hand/{hand_id}"
+    nonce = random.getrandbits(64)
+
+    def claims():
+        out = []
+        for key in keys(f"{claims_key}/**"):
+            number, phase = key.split("/")[-2:]
+            if len(number) == 16 and phase in ("starting", "held"):
+                out.append((int(number, 16), phase == "held"))
+        return out
+
+    def blocker(seen):
+        others = [c for c in seen if c[0] != nonce]
+        return next((c for c in others if c[1]), None) or next(
+            (c for c in sorted(others) if c[0] < nonce), None)
+
+    starting = session.liveliness().declare_token(f"{claims_key}/{nonce:016x}/starting")
+    while True:
+        seen = None
+        for _ in range(2):
+            time.sleep(0.15)
+            seen = blocker(claims())
+            if seen:
+                break
+        if not seen:
+            held = session.liveliness().declare_token(f"{claims_key}/{nonce:016x}/held")
+            time.sleep(0.15)
+            seen = next((c for c in claims() if c[1] and c[0] < nonce), None)
+            if not seen:
+                starting.undeclare()
+                return held
+            held.undeclare()
+        if time.monotonic() >= deadline:
+            starting.undeclare()
+            sys.exit(f"{hand_id}: another hand with this id is taking the run's place at the "
+                     "same moment: this one gives way (give it another --id)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--connect", required=True, help="router or peer endpoint, e.g. tcp/10.0.0.5:7447")
@@ -72,6 +133,7 @@ def main():
     # A key chunk: ASCII letters, digits, '-', '_', '.', at most 64, not starting with '.'.
     host = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_"
                    for c in socket.gethostname())[:64].lstrip(".") or "host"
+    place = take_place(session, prefix, args.id)
     commands = queue_of(session, f"{prefix}/hand/{args.id}/command")
     # The trailing /json asks the coordinator for JSON commands.
     token = session.liveliness().declare_token(f"{prefix}/alive/hand/{host}/{args.id}/json")
@@ -119,6 +181,7 @@ def main():
         pass
     finally:
         token.undeclare()
+        place.undeclare()
         session.close()
 
 
