@@ -7,7 +7,8 @@
 //! last request warm and, when the new history extends the old one, only tells it the new
 //! observations. Each reply also carries the engine as it left it (`engine_state`), which
 //! the coordinator keeps in its journal and sends back with every request: a planner without
-//! the run's engine (restarted, or started for a resumed run) continues from that state and
+//! the run's engine (restarted, or started for a resumed run), or whose last reply was lost
+//! (its engine has moved on without the coordinator), continues from that state and
 //! proposes exactly what the first planner would have. Without a usable state (none yet,
 //! another version, a history that does not extend it) it rebuilds the engine from the
 //! history: the same design, the same data, but a model fitted afresh, whose proposals
