@@ -111,17 +111,14 @@ fn replay_hand_answers_trials_from_a_recording() {
     assert!(err.contains("bad.jsonl, line 1"), "{err}");
 }
 
-/// Needs Python with eclipse-zenoh: `.ci/run` makes a venv and runs this with
-/// `GRASPOPT_PYTHON` set (`cargo test --workspace --test replay -- --ignored`).
-#[test]
-#[ignore = "needs Python with eclipse-zenoh (GRASPOPT_PYTHON); .ci/run runs it"]
-fn python_hand_agent_is_the_only_worker_of_an_optimization() {
+/// The example Python hand agent (`examples/python/hand_agent.py`) as worker `id` of the
+/// cluster's run, answering from the recording `rec`; its stderr goes to `<dir>/<name>.log`.
+/// Needs `GRASPOPT_PYTHON`, a Python with eclipse-zenoh (`.ci/run` makes one).
+fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
     let python = std::env::var("GRASPOPT_PYTHON")
         .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
-    let c = Cluster::start("pyhand", "pyhand");
-    let (rec, grasps) = record(&c.dir);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/python/hand_agent.py");
-    let log = std::fs::File::create(c.dir.join("py-hand.log")).unwrap();
+    let log = std::fs::File::create(c.dir.join(format!("{name}.log"))).unwrap();
     let child = std::process::Command::new(python)
         .arg(&script)
         .args([
@@ -130,17 +127,27 @@ fn python_hand_agent_is_the_only_worker_of_an_optimization() {
             "--run",
             &c.run,
             "--id",
-            "py-hand-1",
+            id,
             "--recording",
             rec.to_str().unwrap(),
         ])
         .stderr(log)
         .spawn()
         .expect("start the Python hand agent");
-    let hand = Proc {
-        name: "py-hand".into(),
+    Proc {
+        name: name.into(),
         child,
-    };
+    }
+}
+
+/// Needs Python with eclipse-zenoh: `.ci/run` makes a venv and runs this with
+/// `GRASPOPT_PYTHON` set (`cargo test --workspace --test replay -- --ignored`).
+#[test]
+#[ignore = "needs Python with eclipse-zenoh (GRASPOPT_PYTHON); .ci/run runs it"]
+fn python_hand_agent_is_the_only_worker_of_an_optimization() {
+    let c = Cluster::start("pyhand", "pyhand");
+    let (rec, grasps) = record(&c.dir);
+    let hand = python_hand(&c, &rec, "py-hand", "py-hand-1");
     optimize_with(&c, hand, "py-hand-1", &grasps);
 }
 
@@ -151,36 +158,11 @@ fn python_hand_agent_is_the_only_worker_of_an_optimization() {
 #[test]
 #[ignore = "needs Python with eclipse-zenoh (GRASPOPT_PYTHON); .ci/run runs it"]
 fn hands_started_together_with_one_id_leave_one_running() {
-    let python = std::env::var("GRASPOPT_PYTHON")
-        .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
     let c = Cluster::start("pytwin", "pytwin");
     let (rec, _) = record(&c.dir);
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/python/hand_agent.py");
-    let python_hand = |name: &str| {
-        let log = std::fs::File::create(c.dir.join(format!("{name}.log"))).unwrap();
-        let child = std::process::Command::new(&python)
-            .arg(&script)
-            .args([
-                "--connect",
-                &c.endpoint,
-                "--run",
-                &c.run,
-                "--id",
-                "twin",
-                "--recording",
-                rec.to_str().unwrap(),
-            ])
-            .stderr(log)
-            .spawn()
-            .expect("start the Python hand agent");
-        Proc {
-            name: name.into(),
-            child,
-        }
-    };
     let mut hands = vec![
-        python_hand("py-twin-a"),
-        python_hand("py-twin-b"),
+        python_hand(&c, &rec, "py-twin-a", "twin"),
+        python_hand(&c, &rec, "py-twin-b", "twin"),
         c.agent("rust-twin", &["hand", "--id", "twin"]),
     ];
     // Each takes about 2 s to take its place; one that gives way waits up to 5 s for the
