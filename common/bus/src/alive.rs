@@ -169,11 +169,14 @@ impl Bus {
             if seen.is_none() {
                 let held = declare(true).await?;
                 tokio::time::sleep(CLAIM_LOOK).await;
-                let claims = self.claims(&claims_key).await?;
-                if !claims.iter().any(|c| c.held && c.nonce < nonce) {
+                seen = self
+                    .claims(&claims_key)
+                    .await?
+                    .into_iter()
+                    .find(|c| c.held && c.nonce < nonce);
+                if seen.is_none() {
                     return Ok(Claim { _held: Some(held) });
                 }
-                seen = claims.iter().find(|c| c.held && c.nonce < nonce).copied();
             }
             // Another agent is taking or holds the place: wait for it to go, as for a
             // predecessor, until the deadline.
