@@ -4,7 +4,8 @@
 //! second round) and a full-refit round (random restarts, every tenth round), plus realistic
 //! sequences of 20 consecutive rounds with each proposal observed (90 to 109 and 100 to 119
 //! observations; all kinds of rounds in the proportions they occur: 10 diversification rounds,
-//! 2 full refits) whose per-round medians are printed. Run with
+//! 2 full refits) whose per-round medians are printed, and a batch round of four points with
+//! each batch strategy. Run with
 //! `taskset -c 0 cargo bench -p graspopt-bayesopt --bench overhead`; the same sequence, once,
 //! is printed by `cargo run --release --example overhead_suggest`.
 
@@ -14,13 +15,19 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, criterion_group, criterion_main};
 use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::rng::Rng;
-use graspopt_bayesopt::{Optimizer, TestFunction};
+use graspopt_bayesopt::{BatchStrategy, Optimizer, TestFunction};
 
 /// Optimizer with `n_obs` random observations after `warm_rounds` proposal rounds (whose
 /// points are discarded), so the next round is of the wanted kind.
 fn optimizer_with_observations(n_obs: usize, warm_rounds: usize) -> Optimizer {
+    optimizer_with_batch(n_obs, warm_rounds, recommended_settings().batch)
+}
+
+/// [`optimizer_with_observations`] with another batch strategy.
+fn optimizer_with_batch(n_obs: usize, warm_rounds: usize, batch: BatchStrategy) -> Optimizer {
     let f = TestFunction::Hartmann6;
     let mut s = recommended_settings();
+    s.batch = batch;
     s.minimize = true;
     // 100 random observations look like a stagnating search: without this the restart rule
     // would start a new epoch and the rounds would model 6 points instead of 100.
@@ -134,5 +141,24 @@ fn bench_sequence(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, bench_sequence);
+/// One batch round of four points at 100 observations in 6D (a plain round: warm-started fit,
+/// no diversification), with the recommended sequential-greedy qEI and with the kriging
+/// believer, to price the batch strategy per point.
+fn bench_batch(c: &mut Criterion) {
+    let mut g = c.benchmark_group("overhead_n100_d6_batch_q4");
+    g.sample_size(10);
+    let qei = optimizer_with_observations(100, 2);
+    let believer = optimizer_with_batch(100, 2, BatchStrategy::KrigingBeliever);
+    for (name, opt) in [("qei_128", &qei), ("kriging_believer", &believer)] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut o = opt.clone();
+                black_box(o.suggest(4).map(|p| p.len()).unwrap_or(0))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_sequence, bench_batch);
 criterion_main!(benches);

@@ -34,7 +34,7 @@ fn main() {
         XiRule::Fixed(xi_arg.parse().unwrap_or(0.0))
     };
     // Tuning overrides (environment): BO_KERNEL=m32|m52|se, BO_LS (prior median length scale),
-    // BO_LSSD, BO_DIRECT (evals per dim), BO_POLISH (starts), BO_RESTARTS, BO_BATCH=kb|clmin|clmean|clmax.
+    // BO_LSSD, BO_DIRECT (evals per dim), BO_POLISH (starts), BO_RESTARTS, BO_BATCH=kb|clmin|clmean|clmax|qei[:SAMPLES].
     let env = |k: &str| std::env::var(k).ok();
     if let Some(k) = env("BO_KERNEL") {
         settings.kernel = match k.as_str() {
@@ -105,6 +105,13 @@ fn main() {
             "clmin" => graspopt_bayesopt::BatchStrategy::ConstantLiarMin,
             "clmean" => graspopt_bayesopt::BatchStrategy::ConstantLiarMean,
             "clmax" => graspopt_bayesopt::BatchStrategy::ConstantLiarMax,
+            "kb" => graspopt_bayesopt::BatchStrategy::KrigingBeliever,
+            s if s.starts_with("qei") => graspopt_bayesopt::BatchStrategy::Qei {
+                samples: s
+                    .strip_prefix("qei:")
+                    .and_then(|n| n.parse().ok())
+                    .unwrap_or(128),
+            },
             _ => graspopt_bayesopt::BatchStrategy::KrigingBeliever,
         };
     }

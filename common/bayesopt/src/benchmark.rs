@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::acquisition::XiRule;
 use crate::baseline::{AskTell, RandomSearch};
 use crate::error::{BoError, Result};
-use crate::optimizer::{Optimizer, OutputTransform, RestartRule, Settings};
+use crate::optimizer::{BatchStrategy, Optimizer, OutputTransform, RestartRule, Settings};
 use crate::testfunctions::TestFunction;
 
 /// Regret levels reported: 5%, 1%, 0.1%.
@@ -45,7 +45,10 @@ impl Method {
 /// round every second proposal, which were the best measured on Branin and Hartmann6, plus a
 /// restart when the incumbent has improved by at most 0.05% of the range over 8 observations
 /// (6 fresh random points, a ball of radius 0.2 sqrt(d) around each old incumbent penalised),
-/// which frees the Hartmann6 seeds caught in the 3.6% local minimum.
+/// which frees the Hartmann6 seeds caught in the 3.6% local minimum. Batches (and points
+/// proposed while others are pending) are chosen by sequential-greedy qEI with 128 base
+/// samples ([`BatchStrategy::Qei`]): over Hartmann6 seeds 0-49 at q = 4 it needs as many
+/// evaluations to 1% as the sequential engine, where the kriging believer needs about 10% more.
 pub fn recommended_settings() -> Settings {
     Settings {
         xi: XiRule::Fixed(0.0),
@@ -58,6 +61,7 @@ pub fn recommended_settings() -> Settings {
         output_transform: OutputTransform::TailLog,
         prior_mean_quantile: Some(0.0),
         diversify_every: 2,
+        batch: BatchStrategy::Qei { samples: 128 },
         ..Settings::default()
     }
 }

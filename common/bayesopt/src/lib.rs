@@ -18,6 +18,7 @@ pub mod kernel;
 pub mod lbfgs;
 pub mod linalg;
 pub mod optimizer;
+pub mod qei;
 pub mod rng;
 pub mod special;
 pub mod testfunctions;
