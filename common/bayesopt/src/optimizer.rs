@@ -1082,71 +1082,19 @@ impl Optimizer {
                 taken.push(u);
             }
             while out.len() < q {
-                if let Some(samples) = qei
-                    && !chosen.is_empty()
-                {
-                    let ctx = QeiContext::new(&gp, &chosen, incumbent + xi, samples, &mut qei_rng)?;
-                    let (u, gain) = self.maximize_qei(ctx)?;
-                    let duplicate = taken.iter().any(|t| {
-                        t.iter()
-                            .zip(&u)
-                            .map(|(a, b)| (a - b) * (a - b))
-                            .sum::<f64>()
-                            < 1e-16
-                    });
-                    let u = if duplicate { self.rng.unit_point(d) } else { u };
-                    if info.best_ei.is_none() {
-                        info.best_ei = Some(gain);
-                        let ymax = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                        let ymin = data.y.iter().copied().fold(f64::INFINITY, f64::min);
-                        let range = ymax - ymin;
-                        info.relative_ei = Some(if range > 0.0 {
-                            gain / range
-                        } else {
-                            f64::INFINITY
-                        });
+                let (u, ei) = match qei {
+                    Some(samples) if !chosen.is_empty() => {
+                        let ctx =
+                            QeiContext::new(&gp, &chosen, incumbent + xi, samples, &mut qei_rng)?;
+                        self.maximize_qei(ctx)?
                     }
-                    chosen.push(u.clone());
-                    taken.push(u.clone());
-                    out.push(self.unit_to_box(&u));
-                    continue;
-                }
-                let k = self.settings.diversify_every;
-                // A qEI batch spreads its points itself: only a round of one point with
-                // nothing pending is diversified.
-                let alone = qei.is_none() || (q == 1 && self.pending.is_empty());
-                let diversify = k > 0 && alone && out.is_empty() && self.rounds % k == k - 1;
-                let share = if diversify {
-                    1.0 / (1 + self.settings.diversify_depth.max(1)) as f64
-                } else {
-                    1.0
+                    _ => {
+                        // A qEI batch spreads its points itself: only a round of one point
+                        // with nothing pending is diversified.
+                        let alone = qei.is_none() || (q == 1 && self.pending.is_empty());
+                        self.ei_point(&gp, incumbent, xi, y_min_std, alone && out.is_empty())?
+                    }
                 };
-                let depth = self.settings.diversify_depth.max(1);
-                // In a diversification round each maximisation keeps its kernel rows for the
-                // next one, whose GP only has fantasy points appended (see `RowMemo`).
-                let mut memo = diversify.then(RowMemo::default);
-                let (mut u, mut ei) =
-                    self.maximize_acquisition(&gp, incumbent, xi, share, None, memo.as_mut())?;
-                if diversify {
-                    // Diversification round: assume the EI maximiser is as bad as the worst
-                    // observation (constant liar, min) and propose the next EI maximiser.
-                    let mut g2 = gp.clone();
-                    for step in 0..depth {
-                        g2.push(u.clone(), y_min_std)?;
-                        let previous = memo.take();
-                        memo = (step + 1 < depth).then(RowMemo::default);
-                        let (u2, ei2) = self.maximize_acquisition(
-                            &g2,
-                            incumbent,
-                            xi,
-                            share,
-                            previous.as_ref(),
-                            memo.as_mut(),
-                        )?;
-                        u = u2;
-                        ei = ei.max(ei2);
-                    }
-                }
                 let duplicate = taken.iter().any(|t| {
                     t.iter()
                         .zip(&u)
@@ -1202,6 +1150,52 @@ impl Optimizer {
         self.pending.extend(out.iter().cloned());
         self.last_round = info;
         Ok(out)
+    }
+
+    /// The EI (or UCB) maximiser on `gp` and its value. When `first` and this is a
+    /// diversification round ([`Settings::diversify_every`]), the EI maximiser is assumed to be
+    /// as bad as the worst observation (`y_min`, constant liar) and the next maximiser is
+    /// returned instead, `diversify_depth` times.
+    fn ei_point(
+        &self,
+        gp: &Gp,
+        incumbent: f64,
+        xi: f64,
+        y_min: f64,
+        first: bool,
+    ) -> Result<(Vec<f64>, f64)> {
+        let k = self.settings.diversify_every;
+        let diversify = k > 0 && first && self.rounds % k == k - 1;
+        let depth = self.settings.diversify_depth.max(1);
+        let share = if diversify {
+            1.0 / (1 + depth) as f64
+        } else {
+            1.0
+        };
+        // In a diversification round each maximisation keeps its kernel rows for the next
+        // one, whose GP only has fantasy points appended (see `RowMemo`).
+        let mut memo = diversify.then(RowMemo::default);
+        let (mut u, mut ei) =
+            self.maximize_acquisition(gp, incumbent, xi, share, None, memo.as_mut())?;
+        if diversify {
+            let mut g2 = gp.clone();
+            for step in 0..depth {
+                g2.push(u.clone(), y_min)?;
+                let previous = memo.take();
+                memo = (step + 1 < depth).then(RowMemo::default);
+                let (u2, ei2) = self.maximize_acquisition(
+                    &g2,
+                    incumbent,
+                    xi,
+                    share,
+                    previous.as_ref(),
+                    memo.as_mut(),
+                )?;
+                u = u2;
+                ei = ei.max(ei2);
+            }
+        }
+        Ok((u, ei))
     }
 
     /// Space-filling exploration step: the random candidate (100 d uniform draws) with the
