@@ -5,7 +5,7 @@
 //! sequences of 20 consecutive rounds with each proposal observed (90 to 109 and 100 to 119
 //! observations; all kinds of rounds in the proportions they occur: 10 diversification rounds,
 //! 2 full refits) whose per-round medians are printed, and a batch round of four points with
-//! each batch strategy. Run with
+//! qEI and with the kriging believer. Run with
 //! `taskset -c 0 cargo bench -p graspopt-bayesopt --bench overhead`; the same sequence, once,
 //! is printed by `cargo run --release --example overhead_suggest`.
 

@@ -106,13 +106,18 @@ fn main() {
             "clmean" => graspopt_bayesopt::BatchStrategy::ConstantLiarMean,
             "clmax" => graspopt_bayesopt::BatchStrategy::ConstantLiarMax,
             "kb" => graspopt_bayesopt::BatchStrategy::KrigingBeliever,
-            s if s.starts_with("qei") => graspopt_bayesopt::BatchStrategy::Qei {
-                samples: s
-                    .strip_prefix("qei:")
-                    .and_then(|n| n.parse().ok())
-                    .unwrap_or(128),
+            "qei" => graspopt_bayesopt::BatchStrategy::Qei { samples: 128 },
+            s if s.starts_with("qei:") => match s["qei:".len()..].parse() {
+                Ok(samples) => graspopt_bayesopt::BatchStrategy::Qei { samples },
+                Err(_) => {
+                    eprintln!("BO_BATCH={s}: the sample count is not a whole number");
+                    return;
+                }
             },
-            _ => graspopt_bayesopt::BatchStrategy::KrigingBeliever,
+            other => {
+                eprintln!("BO_BATCH={other}: known are kb, clmin, clmean, clmax, qei, qei:N");
+                return;
+            }
         };
     }
     let t0 = Instant::now();

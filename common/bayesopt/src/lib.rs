@@ -31,7 +31,7 @@ pub use fit::{FitSettings, Hyperparameters};
 pub use gp::Gp;
 pub use kernel::{Kernel, KernelKind};
 pub use optimizer::{
-    BatchStrategy, InitialDesign, ModelPoint, Optimizer, OutputTransform, RestartRule, RoundInfo,
-    Settings, StopReason, StopRule,
+    BatchStrategy, InitialDesign, MAX_QEI_SAMPLES, ModelPoint, Optimizer, OutputTransform,
+    RestartRule, RoundInfo, Settings, StopReason, StopRule,
 };
 pub use testfunctions::TestFunction;

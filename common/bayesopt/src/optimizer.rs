@@ -7,9 +7,9 @@
 //! restarts every [`Settings::full_refit_every`] rounds. The acquisition (log-EI by default) is
 //! maximised by DIRECT on the unit cube and polished by L-BFGS from the best few rectangles.
 //! Batches (`q > 1`, or points still pending from earlier calls) use the kriging believer, a
-//! constant liar or sequential-greedy qEI ([`crate::qei`]). The whole state serialises with serde, including the generator state, so a
-//! restored optimizer proposes exactly what the original would have (serde_json needs its
-//! `float_roundtrip` feature for bit-exact floats).
+//! constant liar or sequential-greedy qEI ([`crate::qei`]). The whole state serialises with
+//! serde, including the generator state, so a restored optimizer proposes exactly what the
+//! original would have (serde_json needs its `float_roundtrip` feature for bit-exact floats).
 
 use std::collections::HashMap;
 
@@ -33,6 +33,9 @@ use crate::rng::Rng;
 /// with 10 iterations 36, with 30 no more (35) for twice the extra time.
 const QEI_POLISH_ITERS: usize = 10;
 
+/// Most base samples a [`BatchStrategy::Qei`] may ask for (the cost of a point grows with them).
+pub const MAX_QEI_SAMPLES: usize = 65_536;
+
 /// Value assumed for pending points when proposing a batch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum BatchStrategy {
@@ -52,9 +55,11 @@ pub enum BatchStrategy {
     /// value integrated exactly, maximised by DIRECT and a short finite-difference polish. No
     /// fantasy values; rounds of more than one point (or with points pending) are not
     /// diversified (see [`Settings::diversify_every`]): measured on Hartmann6, qEI with the
-    /// diversification rounds was no better than the kriging believer.
+    /// diversification rounds was no better than the kriging believer. The qEI points are
+    /// chosen by (q)EI whatever [`Settings::acquisition`] says (it picks the round's first
+    /// point), and [`Settings::explore_below_ei`] does not apply to them.
     Qei {
-        /// Base samples per maximisation (>= 1).
+        /// Base samples per maximisation (1 to [`MAX_QEI_SAMPLES`]).
         samples: usize,
     },
 }
@@ -167,7 +172,8 @@ pub struct Settings {
     /// Every this many proposal rounds (0 = never), the first point of the round is the
     /// second point of a pessimistic constant-liar batch: the EI maximiser is assumed to be as
     /// bad as the worst observation and the next EI maximiser is proposed instead, which
-    /// moves the search away from an exhausted local optimum.
+    /// moves the search away from an exhausted local optimum. With [`BatchStrategy::Qei`],
+    /// only rounds of one point with nothing pending are diversified.
     pub diversify_every: usize,
     /// How many pessimistic fantasies a diversification round stacks (>= 1).
     pub diversify_depth: usize,
@@ -256,10 +262,12 @@ impl Settings {
                 "restart tol and tabu_radius must be finite and >= 0".into(),
             ));
         }
-        if let BatchStrategy::Qei { samples: 0 } = self.batch {
-            return Err(BoError::InvalidSetting(
-                "a qEI batch strategy needs samples >= 1".into(),
-            ));
+        if let BatchStrategy::Qei { samples } = self.batch
+            && !(1..=MAX_QEI_SAMPLES).contains(&samples)
+        {
+            return Err(BoError::InvalidSetting(format!(
+                "a qEI batch strategy needs 1 to {MAX_QEI_SAMPLES} samples, got {samples}"
+            )));
         }
         if let InitialDesign::MaximinLatinHypercube { candidates: 0 } = self.initial_design {
             return Err(BoError::InvalidSetting(
@@ -289,7 +297,10 @@ pub struct ModelPoint {
 /// Diagnostics of the last proposal round.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct RoundInfo {
-    /// EI (standardised units) at the first model-based proposal of the round.
+    /// EI (standardised units) at the first model-based proposal of the round. With
+    /// [`BatchStrategy::Qei`] and points pending, that proposal is a qEI point and this is its
+    /// qEI gain: the improvement it adds beyond the pending points, at most its EI. The
+    /// small-EI stop rule then reads "nothing left to gain beyond the trials in flight".
     pub best_ei: Option<f64>,
     /// The same divided by the range of the modelled outputs (the observed range of y of
     /// the current epoch, after the output transform if any).
@@ -1082,8 +1093,9 @@ impl Optimizer {
                 taken.push(u);
             }
             while out.len() < q {
+                let qei_point = qei.is_some() && !chosen.is_empty();
                 let (u, ei) = match qei {
-                    Some(samples) if !chosen.is_empty() => {
+                    Some(samples) if qei_point => {
                         let ctx =
                             QeiContext::new(&gp, &chosen, incumbent + xi, samples, &mut qei_rng)?;
                         self.maximize_qei(ctx)?
@@ -1102,7 +1114,9 @@ impl Optimizer {
                         .sum::<f64>()
                         < 1e-16
                 });
-                let explore = matches!(self.settings.explore_below_ei, Some(th) if ei < th);
+                // A qEI gain is not an EI: the exploration rule applies to EI points only.
+                let explore =
+                    !qei_point && matches!(self.settings.explore_below_ei, Some(th) if ei < th);
                 let u = if explore {
                     info.exploration_points += 1;
                     self.exploration_point(&gp)
@@ -1217,6 +1231,7 @@ impl Optimizer {
 
     fn lie(&self, gp: &Gp, u: &[f64], incumbent: f64, mean: f64, min: f64) -> f64 {
         match self.settings.batch {
+            // Qei never lies (its points enter the joint posterior); the arm is for completeness.
             BatchStrategy::KrigingBeliever | BatchStrategy::Qei { .. } => gp.predict(u).0,
             BatchStrategy::ConstantLiarMin => min,
             BatchStrategy::ConstantLiarMean => mean,

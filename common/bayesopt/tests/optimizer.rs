@@ -185,7 +185,10 @@ fn qei_batches_are_distinct_and_round_trip_with_points_pending() {
     let json = serde_json::to_string(&a).unwrap();
     let mut b: Optimizer = serde_json::from_str(&json).unwrap();
     assert_eq!(a, b);
-    for p in first.iter().chain(&second) {
+    // a qEI point proposed while five are pending, after the restore
+    let third = a.suggest(1).unwrap();
+    assert_eq!(third, b.suggest(1).unwrap());
+    for p in first.iter().chain(&second).chain(&third) {
         let y = TestFunction::Branin.eval(p);
         a.observe(p, y).unwrap();
         b.observe(p, y).unwrap();
@@ -295,14 +298,16 @@ fn bad_input_gives_errors() {
         ..Settings::default()
     };
     assert!(Optimizer::new(&[(0.0, 1.0)], bad, 0).is_err());
-    let no_samples = Settings {
-        batch: graspopt_bayesopt::BatchStrategy::Qei { samples: 0 },
-        ..Settings::default()
-    };
-    assert!(matches!(
-        Optimizer::new(&[(0.0, 1.0)], no_samples, 0),
-        Err(BoError::InvalidSetting(m)) if m.contains("samples")
-    ));
+    for samples in [0, graspopt_bayesopt::MAX_QEI_SAMPLES + 1, usize::MAX] {
+        let bad_samples = Settings {
+            batch: graspopt_bayesopt::BatchStrategy::Qei { samples },
+            ..Settings::default()
+        };
+        assert!(matches!(
+            Optimizer::new(&[(0.0, 1.0)], bad_samples, 0),
+            Err(BoError::InvalidSetting(m)) if m.contains("samples")
+        ));
+    }
     let mut opt = Optimizer::new(&[(0.0, 1.0), (0.0, 1.0)], s(), 0).unwrap();
     assert!(matches!(
         opt.observe(&[0.5], 1.0),
