@@ -1308,7 +1308,7 @@ impl Optimizer {
                     }
                     ctx.log_gain(u) + self.tabu_penalty(u, Some(g))
                 },
-                &best_u.clone(),
+                &best_u,
                 &lo,
                 &hi,
                 QEI_POLISH_ITERS,
