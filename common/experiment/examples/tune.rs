@@ -9,29 +9,23 @@
 //! `qei` (sequential-greedy qEI with 128 base samples for the pending trials instead of the
 //! kriging believer).
 //!
-//! `WORKERS=W` simulates W asynchronous workers instead of the sequential search: W trials are
-//! kept in flight (W calls of `suggest(1)` at the start, each seeing the earlier ones as
-//! pending); the oldest trial in flight is scored, observed and replaced by a new
-//! `suggest(1)` until the budget is observed. Trials to a target count observations in
-//! completion order. `WORKERS=1` reproduces the sequential search. Random search ignores it.
+//! `WORKERS=W` runs W asynchronous workers instead of one trial at a time
+//! ([`SearchSettings::workers`]): each proposal sees the other trials in flight as pending,
+//! and trials count in completion order. `WORKERS=1` is the sequential search.
 //! `PER_SEED=1` also prints, per object, the trials to 5% of every seed (`-`: never).
 
 use graspopt_bayesopt::benchmark::recommended_settings;
-use std::collections::VecDeque;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use graspopt_bayesopt::{
-    AcquisitionKind, BatchStrategy, InitialDesign, KernelKind, Method, Optimizer, OutputTransform,
-    Settings, XiRule,
+    AcquisitionKind, BatchStrategy, InitialDesign, KernelKind, Method, OutputTransform, Settings,
+    XiRule,
 };
-use graspopt_experiment::compare::summarise;
-use graspopt_experiment::{SearchSettings, Trace, compare};
+use graspopt_experiment::{SearchSettings, compare};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
 use graspopt_trial::Evaluator;
-use graspopt_trial::scan::{grid_axes, scan_grid, worker_count};
+use graspopt_trial::scan::{grid_axes, scan_grid};
 
 fn variant(name: &str) -> Option<Settings> {
     let grasp = Settings::for_grasps();
@@ -64,74 +58,6 @@ fn variant(name: &str) -> Option<Settings> {
     Some(s)
 }
 
-/// One engine run with `workers` asynchronous workers (see the module documentation): the
-/// trials in completion order.
-fn run_async(
-    ev: &Evaluator,
-    settings: &Settings,
-    budget: usize,
-    workers: usize,
-    seed: u64,
-) -> Trace {
-    let settings = Settings {
-        minimize: false,
-        ..settings.clone()
-    };
-    let mut opt = Optimizer::new(&ev.space.bounds(), settings, seed).expect("the engine");
-    let mut in_flight: VecDeque<Vec<f64>> = VecDeque::new();
-    let mut trace = Trace {
-        method: Method::Bo,
-        seed,
-        params: Vec::with_capacity(budget),
-        scores: Vec::with_capacity(budget),
-        ei_stop_at: None,
-    };
-    while in_flight.len() < workers.min(budget) {
-        in_flight.extend(opt.suggest(1).expect("a proposal"));
-    }
-    while let Some(p) = in_flight.pop_front() {
-        let y = ev.score(&p).expect("a trial");
-        assert!(y.is_finite(), "score {y} at {p:?}");
-        opt.observe(&p, y).expect("an observation");
-        trace.params.push(p);
-        trace.scores.push(y);
-        if trace.scores.len() + in_flight.len() < budget {
-            in_flight.extend(opt.suggest(1).expect("a proposal"));
-        }
-    }
-    trace
-}
-
-/// [`run_async`] for every seed, one thread per core; in seed order.
-fn runs_async(
-    ev: &Evaluator,
-    settings: &Settings,
-    budget: usize,
-    workers: usize,
-    seeds: &[u64],
-) -> Vec<Trace> {
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Trace>>> = Mutex::new(vec![None; seeds.len()]);
-    std::thread::scope(|scope| {
-        for _ in 0..worker_count(0, seeds.len()) {
-            scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&seed) = seeds.get(i) else { break };
-                    let t = run_async(ev, settings, budget, workers, seed);
-                    results.lock().expect("the results")[i] = Some(t);
-                }
-            });
-        }
-    });
-    results
-        .into_inner()
-        .expect("the results")
-        .into_iter()
-        .map(|t| t.expect("every run"))
-        .collect()
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (Some(seeds), Some(budget)) = (
@@ -147,13 +73,14 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(0);
     let seeds: Vec<u64> = (seed0..seed0 + seeds).collect();
-    let workers: Option<usize> = std::env::var("WORKERS").ok().map(|w| match w.parse() {
-        Ok(w) if w >= 1 => w,
-        _ => {
-            eprintln!("WORKERS must be a whole number >= 1, got {w}");
+    let workers: usize = match std::env::var("WORKERS").map(|w| w.parse::<usize>()) {
+        Err(_) => 1,
+        Ok(Ok(w)) if w >= 1 => w,
+        Ok(_) => {
+            eprintln!("WORKERS must be a whole number >= 1");
             std::process::exit(2);
         }
-    });
+    };
     let mut landscapes = Vec::new();
     for name in Object::names() {
         if !only.is_empty() && !only.split(',').any(|o| o == name) {
@@ -189,26 +116,20 @@ fn main() {
             budget,
             n_init: None,
             stop_on_small_ei: false,
-            engine: Some(settings.clone()),
+            engine: Some(settings),
+            workers,
         };
-        let mut line = match workers {
-            Some(w) if method != Method::Random => format!("{name:>14} W={w}:"),
-            _ => format!("{name:>14}:"),
+        let mut line = if workers > 1 {
+            format!("{name:>14} W={workers}:")
+        } else {
+            format!("{name:>14}:")
         };
         let start = Instant::now();
         for (object, ev, max) in &landscapes {
-            let m = match workers {
-                Some(w) if method != Method::Random => summarise(
-                    method,
-                    runs_async(ev, &settings, budget, w, &seeds),
-                    *max,
-                    budget,
-                ),
-                _ => compare(ev, &[method], &seeds, &template, Some(*max), 0)
-                    .expect("the runs")
-                    .methods
-                    .remove(0),
-            };
+            let m = compare(ev, &[method], &seeds, &template, Some(*max), 0)
+                .expect("the runs")
+                .methods
+                .remove(0);
             let median = m.median_trials_to[0].map_or("-".to_string(), |v| v.to_string());
             line += &format!(" {object}={median}({}/{})", m.reached[0], seeds.len());
             if std::env::var_os("PER_SEED").is_some() {

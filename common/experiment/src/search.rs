@@ -1,5 +1,8 @@
 //! One seeded run of a method on a simulated grasp: the engine (with the benchmark or the
-//! thesis settings) or uniform random search, one trial at a time, maximising the score.
+//! thesis settings) or uniform random search, maximising the score, one trial at a time or
+//! with several in flight (asynchronous workers).
+
+use std::collections::VecDeque;
 
 use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::{AskTell, Method, Optimizer, RandomSearch, Settings, StopReason};
@@ -26,6 +29,15 @@ pub struct SearchSettings {
     /// `BoThesis`: [`Engine::Thesis`]); ignored by random search; `minimize` is forced off.
     #[serde(default)]
     pub engine: Option<Settings>,
+    /// Trials in flight (>= 1): W workers run asynchronously. Each proposal is made while
+    /// the other W - 1 trials are pending; the oldest trial is scored, observed and
+    /// replaced. Trials count in completion order. 1 is the sequential run.
+    #[serde(default = "one_worker")]
+    pub workers: usize,
+}
+
+fn one_worker() -> usize {
+    1
 }
 
 /// Which engine settings a BO run uses.
@@ -153,6 +165,11 @@ pub(crate) fn run_observed(
             "the budget must be at least one trial".into(),
         ));
     }
+    if settings.workers == 0 {
+        return Err(ExperimentError::Settings(
+            "a run needs at least one worker".into(),
+        ));
+    }
     let bounds = ev.space.bounds();
     let engine = match (&settings.engine, settings.method) {
         (_, Method::Random) => None,
@@ -177,17 +194,24 @@ pub(crate) fn run_observed(
         scores: Vec::with_capacity(settings.budget),
         ei_stop_at: None,
     };
+    let mut in_flight: VecDeque<Vec<f64>> = VecDeque::new();
     while trace.scores.len() < settings.budget {
-        let next = searcher.ask_tell().suggest(1)?;
-        if let Searcher::Engine(opt) = &searcher {
-            proposed(opt, &trace, &next)?;
+        while in_flight.len() < settings.workers
+            && trace.scores.len() + in_flight.len() < settings.budget
+        {
+            let next = searcher.ask_tell().suggest(1)?;
+            if let Searcher::Engine(opt) = &searcher {
+                proposed(opt, &trace, &next)?;
+            }
+            in_flight.extend(next);
         }
-        for p in next {
-            let y = score(ev, &p)?;
-            searcher.ask_tell().observe(&p, y)?;
-            trace.params.push(p);
-            trace.scores.push(y);
-        }
+        let Some(p) = in_flight.pop_front() else {
+            break;
+        };
+        let y = score(ev, &p)?;
+        searcher.ask_tell().observe(&p, y)?;
+        trace.params.push(p);
+        trace.scores.push(y);
         if let Searcher::Engine(opt) = &searcher
             && trace.ei_stop_at.is_none()
             && opt.stop_reason() == Some(StopReason::SmallExpectedImprovement)

@@ -36,6 +36,7 @@ fn settings(method: Method, budget: usize) -> SearchSettings {
         n_init: None,
         stop_on_small_ei: false,
         engine: Some(Engine::Grasp.settings()),
+        workers: 1,
     }
 }
 
@@ -156,4 +157,30 @@ fn a_1d_run_finds_the_scan_maximum_and_stops_when_ei_vanishes() {
     // A snapshot on a space that is not 1D is refused.
     let err = run_with_snapshots(&sphere(true), &s, 0, 101).unwrap_err();
     assert!(err.to_string().contains("one-parameter"), "{err}");
+}
+
+#[test]
+fn asynchronous_workers_propose_with_trials_pending() {
+    let ev = sphere(true);
+    let one = run(&ev, &settings(Method::Bo, 12), 3).unwrap();
+    let four = run(
+        &ev,
+        &SearchSettings {
+            workers: 4,
+            ..settings(Method::Bo, 12)
+        },
+        3,
+    )
+    .unwrap();
+    assert_eq!(four.scores.len(), 12);
+    // The initial design (5 points) is the same; the first model-based proposal of four
+    // workers is made with three trials pending, and so lands elsewhere.
+    assert_eq!(one.params[..5], four.params[..5]);
+    assert_ne!(one.params[5..], four.params[5..]);
+    let none = SearchSettings {
+        workers: 0,
+        ..settings(Method::Bo, 12)
+    };
+    let err = run(&ev, &none, 3).unwrap_err().to_string();
+    assert!(err.contains("worker"), "{err}");
 }

@@ -300,6 +300,7 @@ fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Resu
             n_init: Some(2),
             stop_on_small_ei: true,
             engine: Some(engine.settings()),
+            workers: 1,
         };
         let (trace, snaps) = run_with_snapshots(&ev, &settings, args.first_seed, 201)?;
         let mut csv = String::from("trials,approach,mean,sd,ei\n");
@@ -496,6 +497,7 @@ fn bo_and_random(
         n_init: None,
         stop_on_small_ei: false,
         engine: Some(engine.settings()),
+        workers: 1,
     };
     Ok(compare(
         ev,
