@@ -34,7 +34,8 @@ fn main() {
         XiRule::Fixed(xi_arg.parse().unwrap_or(0.0))
     };
     // Tuning overrides (environment): BO_KERNEL=m32|m52|se, BO_LS (prior median length scale),
-    // BO_LSSD, BO_DIRECT (evals per dim), BO_POLISH (starts), BO_RESTARTS, BO_BATCH=kb|clmin|clmean|clmax|qei[:SAMPLES].
+    // BO_LSSD, BO_DIRECT (evals per dim), BO_POLISH (starts), BO_RESTARTS,
+    // BO_BATCH=kb|clmin|clmean|clmax|qei[:SAMPLES].
     let env = |k: &str| std::env::var(k).ok();
     if let Some(k) = env("BO_KERNEL") {
         settings.kernel = match k.as_str() {

@@ -126,8 +126,9 @@ impl Bus {
     /// predecessor, until the deadline: if the first is gone by then (killed while it took
     /// the place), it takes the place; else it gives up with an error. The winner's claim is
     /// returned; it holds the place until dropped. This is sound while liveliness reaches
-    /// the claimants within about 150 ms. A session that only listens ([`Bus::reaches_out`] false: the embedded run's,
-    /// on a fresh loopback port) cannot meet another agent and skips all this.
+    /// the claimants within about 150 ms. A session that only listens ([`Bus::reaches_out`]
+    /// false: the embedded run's, on a fresh loopback port) cannot meet another agent and
+    /// skips all this.
     pub async fn wait_until_unique(
         &self,
         run: &RunId,

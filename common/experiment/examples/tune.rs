@@ -5,9 +5,9 @@
 //! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
 //! with variants `random`, `thesis`, `benchmark`, `grasp` and `grasp-` followed by one change:
 //! `rank`, `xi0`, `init3`, `init8`, `m52`, `pm` (pessimistic prior mean), `m52-pm`, `noise`
-//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`, `uniform` (uniform initial design instead of the Latin hypercube),
-//! `qei` (sequential-greedy qEI with 128 base samples for the pending trials instead of the
-//! kriging believer).
+//! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`,
+//! `uniform` (uniform initial design instead of the Latin hypercube), `qei` (sequential-greedy
+//! qEI with 128 base samples for the pending trials instead of the kriging believer).
 //!
 //! `WORKERS=W` runs W asynchronous workers instead of one trial at a time
 //! ([`SearchSettings::workers`]): each proposal sees the other trials in flight as pending,
