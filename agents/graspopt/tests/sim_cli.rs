@@ -282,3 +282,42 @@ fn experiment_bo_bad_input_is_named() {
         "a refused run wrote a report"
     );
 }
+
+#[test]
+fn a_mesh_in_millimetres_is_refused_until_scaled() {
+    let dir = tempdir("mesh-mm");
+    // A 40 mm cube standing on z = 0, written in millimetres.
+    let obj = "v -20 -20 0\nv 20 -20 0\nv 20 20 0\nv -20 20 0\n\
+               v -20 -20 40\nv 20 -20 40\nv 20 20 40\nv -20 20 40\n\
+               f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    let path = dir.join("cube_mm.obj");
+    std::fs::write(&path, obj).unwrap();
+    let path = path.to_str().unwrap();
+    let out = graspopt(&["trial", "--mesh", path, "--format", "json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cube_mm.obj") && err.contains("--mesh-scale 0.001"),
+        "{err}"
+    );
+    let out = graspopt(&[
+        "trial",
+        "--mesh",
+        path,
+        "--mesh-scale",
+        "0.001",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let e: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(!e["outcome"]["fingers"].as_array().unwrap().is_empty());
+    // The scale needs a mesh.
+    let out = graspopt(&["trial", "--mesh-scale", "0.001"]);
+    assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

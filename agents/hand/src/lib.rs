@@ -37,6 +37,8 @@ pub struct HandConfig {
     pub object: Option<String>,
     /// A user mesh as the world's object.
     pub mesh: Option<PathBuf>,
+    /// Factor from the mesh file's units to metres (0.001 for millimetres).
+    pub mesh_scale: f64,
     /// Minimum duration of a trial (milliseconds), to model a robot's cycle time.
     pub trial_cost_ms: u64,
     /// Answer trials from this recording (JSON lines, see [`replay`]) instead of simulating.
@@ -50,6 +52,7 @@ impl Default for HandConfig {
             hand: "barrett".into(),
             object: None,
             mesh: None,
+            mesh_scale: 1.0,
             trial_cost_ms: 0,
             replay: None,
         }
@@ -116,7 +119,7 @@ impl SimulatedHand {
 /// The world's object: the configured one, or the one the estimate names at its true pose.
 pub fn world_object(config: &HandConfig, estimate: Option<&ObjectEstimate>) -> Option<Object> {
     let loaded = match (&config.mesh, &config.object, estimate) {
-        (Some(path), _, _) => Object::from_file(path),
+        (Some(path), _, _) => Object::from_file_scaled(path, config.mesh_scale),
         (None, Some(name), _) => Object::by_name(name),
         (None, None, Some(e)) => {
             let mut truth = e.clone();

@@ -28,6 +28,8 @@ pub struct PerceptionConfig {
     pub object: String,
     /// A user mesh (OBJ or STL) instead of a built-in object.
     pub mesh: Option<PathBuf>,
+    /// Factor from the mesh file's units to metres (0.001 for millimetres).
+    pub mesh_scale: f64,
     /// Standard deviation of the position error, per axis (metres).
     pub position_noise: f64,
     /// Standard deviation of the orientation error, per axis of a rotation vector (radians).
@@ -42,6 +44,7 @@ impl Default for PerceptionConfig {
             id: "perception".into(),
             object: "mug".into(),
             mesh: None,
+            mesh_scale: 1.0,
             position_noise: 0.0,
             rotation_noise: 0.0,
             seed: 0,
@@ -71,7 +74,7 @@ impl PerceptionConfig {
 /// The scene's object (at its true pose).
 pub fn scene_object(config: &PerceptionConfig) -> anyhow::Result<Object> {
     match &config.mesh {
-        Some(path) => Object::from_file(path)
+        Some(path) => Object::from_file_scaled(path, config.mesh_scale)
             .with_context(|| format!("perception: cannot load mesh {}", path.display())),
         None => Object::by_name(&config.object).context("perception"),
     }

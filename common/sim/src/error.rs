@@ -39,12 +39,33 @@ pub enum SimError {
         triangles: usize,
     },
     /// A mesh that does not enclose a volume.
-    #[error("mesh `{name}` is not watertight: {reason}")]
+    #[error(
+        "mesh `{name}` is not watertight: {reason}; repair it (e.g. MeshLab: Filters > Cleaning and Repairing > Merge Close Vertices, then Close Holes; or Blender's 3D-Print Toolbox: Make Manifold) and load it again"
+    )]
     NotWatertight {
         /// Mesh name.
         name: String,
         /// The first defect found (e.g. an edge used by one triangle only).
         reason: String,
+    },
+    /// A user mesh whose size cannot be an object a hand grasps (a mesh in millimetres read as
+    /// metres, say).
+    #[error(
+        "mesh `{name}` has a bounding radius of {radius:.4e} m{scaled}: a hand grasps objects of {min} m to {max} m in radius; {advice}"
+    )]
+    ImplausibleSize {
+        /// Mesh name (the path).
+        name: String,
+        /// Half the diagonal of its bounding box, after scaling (metres).
+        radius: f64,
+        /// ` after scaling by S`, or empty.
+        scaled: String,
+        /// The smallest plausible radius.
+        min: f64,
+        /// The largest plausible radius.
+        max: f64,
+        /// Which scale factor would make it plausible (`--mesh-scale S` in graspopt's commands).
+        advice: String,
     },
     /// A malformed mesh file or buffer.
     #[error("cannot parse mesh `{name}`: {reason}")]

@@ -2,8 +2,14 @@
 //! the built-in objects and hands (box, revolved profile, tube, extruded star-shaped polygon), and
 //! loading user meshes from OBJ and STL (ASCII and binary) files or buffers.
 //!
-//! This is the only module that reads files. Every defect (empty mesh, open or inconsistently
-//! oriented mesh, malformed line) is a typed [`SimError`], never a panic.
+//! This is the only module that reads files: OBJ through `tobj`, STL through `stl_io`. Every
+//! defect (empty mesh, open or inconsistently oriented mesh, malformed file) is a typed
+//! [`SimError`], never a panic, and the same file always gives the same message.
+//!
+//! Welding: formats that store each triangle's corners apart (STL) or exporters that write
+//! each face patch apart (CAD) give coincident vertices that differ in their last bits. Vertices
+//! closer than [`WELD_TOLERANCE`] times the mesh's bounding-box diagonal are merged before the
+//! closedness check, so a float32 STL of a closed solid loads.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -11,6 +17,11 @@ use std::path::Path;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::error::{Result, SimError};
+
+/// Vertices closer than this fraction of a loaded mesh's bounding-box diagonal are one vertex
+/// ([`TriangleMesh::welded`]): about 16 float32 rounding steps, far below any feature a hand
+/// can feel (1 nm on a 1 m mesh).
+pub const WELD_TOLERANCE: f64 = 1e-6;
 
 /// An indexed triangle mesh (vertices in metres, counter-clockwise triangles seen from outside
 /// for closed meshes built or accepted by this crate).
@@ -108,22 +119,74 @@ impl TriangleMesh {
         )
     }
 
-    /// Merges vertices with bit-identical coordinates (STL stores each triangle's corners
-    /// separately) and drops triangles that become degenerate.
+    /// Merges vertices closer than [`WELD_TOLERANCE`] times the bounding-box diagonal (STL
+    /// stores each triangle's corners separately, and float32 files round them apart) and drops
+    /// triangles that become degenerate.
     pub fn welded(&self) -> Self {
-        let mut map: HashMap<[u64; 3], u32> = HashMap::new();
-        let mut vertices = Vec::new();
+        let diagonal = self.bounds().map_or(0.0, |(lo, hi)| (hi - lo).norm());
+        self.welded_within(WELD_TOLERANCE * diagonal)
+    }
+
+    /// Merges vertices at most `tolerance` apart (metres; 0 merges bit-identical ones only),
+    /// each onto the first one of its neighbourhood in vertex order, and drops triangles that
+    /// become degenerate. Deterministic: the same mesh gives the same result.
+    pub fn welded_within(&self, tolerance: f64) -> Self {
+        let tol = if tolerance.is_finite() && tolerance > 0.0 {
+            tolerance
+        } else {
+            0.0
+        };
+        // Cells of side `tol`: two vertices within `tol` are in the same or adjacent cells.
+        let cell = |v: &Point3<f64>| -> [i64; 3] {
+            if tol > 0.0 {
+                [
+                    (v.x / tol).floor() as i64,
+                    (v.y / tol).floor() as i64,
+                    (v.z / tol).floor() as i64,
+                ]
+            } else {
+                // +0.0 normalises -0.0 so that both weld together.
+                [
+                    (v.x + 0.0).to_bits() as i64,
+                    (v.y + 0.0).to_bits() as i64,
+                    (v.z + 0.0).to_bits() as i64,
+                ]
+            }
+        };
+        let reach: i64 = if tol > 0.0 { 1 } else { 0 };
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        let mut vertices: Vec<Point3<f64>> = Vec::new();
         let mut remap = Vec::with_capacity(self.vertices.len());
         for v in &self.vertices {
-            // +0.0 normalises -0.0 so that both weld together.
-            let key = [
-                (v.x + 0.0).to_bits(),
-                (v.y + 0.0).to_bits(),
-                (v.z + 0.0).to_bits(),
-            ];
-            let idx = *map.entry(key).or_insert_with(|| {
+            let c = cell(v);
+            let mut found: Option<u32> = None;
+            for dx in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dz in -reach..=reach {
+                        let key = [
+                            c[0].wrapping_add(dx),
+                            c[1].wrapping_add(dy),
+                            c[2].wrapping_add(dz),
+                        ];
+                        for &r in cells.get(&key).into_iter().flatten() {
+                            let w = &vertices[r as usize];
+                            let close = if tol > 0.0 {
+                                (w - v).norm() <= tol
+                            } else {
+                                cell(w) == c
+                            };
+                            if close && found.is_none_or(|f| r < f) {
+                                found = Some(r);
+                            }
+                        }
+                    }
+                }
+            }
+            let idx = found.unwrap_or_else(|| {
                 vertices.push(*v);
-                (vertices.len() - 1) as u32
+                let i = (vertices.len() - 1) as u32;
+                cells.entry(c).or_default().push(i);
+                i
             });
             remap.push(idx);
         }
@@ -142,6 +205,20 @@ impl TriangleMesh {
         Self {
             vertices,
             triangles,
+        }
+    }
+
+    /// The mesh with its vertices scaled about the origin, per axis (URDF's `scale`; a
+    /// unit change is the same factor on every axis). A negative factor mirrors the mesh,
+    /// which reverses its orientation.
+    pub fn scaled(&self, scale: &Vector3<f64>) -> Self {
+        Self {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| Point3::from(v.coords.component_mul(scale)))
+                .collect(),
+            triangles: self.triangles.clone(),
         }
     }
 
@@ -183,20 +260,35 @@ impl TriangleMesh {
                 *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
             }
         }
-        for (&(a, b), &count) in &edges {
-            if count > 1 {
-                return Err(SimError::NotWatertight {
-                    name: name.to_string(),
-                    reason: format!(
-                        "edge {a}-{b} is used {count} times in the same direction (non-manifold or inconsistently oriented)"
-                    ),
-                });
-            }
-            if !edges.contains_key(&(b, a)) {
-                return Err(SimError::NotWatertight {
-                    name: name.to_string(),
-                    reason: format!("edge {a}-{b} borders only one triangle (the mesh has a hole)"),
-                });
+        // Defects are reported in triangle order, so a file always gives the same message.
+        let at = |i: u32| {
+            let v = self.vertices[i as usize];
+            format!("{i} ({:.6}, {:.6}, {:.6})", v.x, v.y, v.z)
+        };
+        for (ti, t) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let count = edges.get(&(a, b)).copied().unwrap_or(0);
+                if count > 1 {
+                    return Err(SimError::NotWatertight {
+                        name: name.to_string(),
+                        reason: format!(
+                            "the edge from vertex {} to vertex {} (triangle {ti}) is used by {count} triangles in the same direction (non-manifold or inconsistently oriented)",
+                            at(a),
+                            at(b)
+                        ),
+                    });
+                }
+                if !edges.contains_key(&(b, a)) {
+                    return Err(SimError::NotWatertight {
+                        name: name.to_string(),
+                        reason: format!(
+                            "the edge from vertex {} to vertex {} borders only triangle {ti} (the mesh has a hole)",
+                            at(a),
+                            at(b)
+                        ),
+                    });
+                }
             }
         }
         Ok(())
@@ -386,151 +478,124 @@ pub fn extrude_star_shaped(polygon: &[(f64, f64)], z0: f64, z1: f64) -> Triangle
 // Loading
 // ---------------------------------------------------------------------------------------------
 
-/// Loads a closed mesh from an `.obj` or `.stl` file (ASCII or binary STL), validated and
-/// oriented outward. Units are taken as metres.
+/// Loads a closed mesh from an `.obj` or `.stl` file (ASCII or binary STL), welded, validated
+/// and oriented outward. Units are taken as metres.
 pub fn load(path: &Path) -> Result<TriangleMesh> {
+    read(path)?.into_closed_solid(&path.display().to_string())
+}
+
+/// Reads an `.obj` or `.stl` file (ASCII or binary STL) as it is: no welding, no validation
+/// (link meshes of a hand need not be closed).
+pub fn read(path: &Path) -> Result<TriangleMesh> {
     let name = path.display().to_string();
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
+    if ext != "obj" && ext != "stl" {
+        return Err(SimError::UnsupportedFormat { path: name });
+    }
     let bytes = std::fs::read(path).map_err(|source| SimError::Io {
         path: name.clone(),
         source,
     })?;
-    let mesh = match ext.as_str() {
-        "obj" => {
-            let text = String::from_utf8_lossy(&bytes);
-            parse_obj(&name, &text)?
-        }
-        "stl" => parse_stl(&name, &bytes)?,
-        _ => return Err(SimError::UnsupportedFormat { path: name }),
-    };
-    mesh.into_closed_solid(&name)
-}
-
-/// Parses Wavefront OBJ text: `v` and `f` records (polygons are fan-triangulated, `a/b/c` and
-/// negative indices accepted); everything else is ignored. No validation of closedness.
-pub fn parse_obj(name: &str, text: &str) -> Result<TriangleMesh> {
-    let err = |line: usize, reason: &str| SimError::MeshParse {
-        name: name.to_string(),
-        reason: format!("line {line}: {reason}"),
-    };
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::new();
-    for (ln, raw) in text.lines().enumerate() {
-        let line_no = ln + 1;
-        let line = raw.split('#').next().unwrap_or("").trim();
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let mut c = [0.0; 3];
-                for slot in &mut c {
-                    let tok = it
-                        .next()
-                        .ok_or_else(|| err(line_no, "vertex with fewer than 3 coordinates"))?;
-                    *slot = tok
-                        .parse::<f64>()
-                        .map_err(|_| err(line_no, "bad vertex coordinate"))?;
-                }
-                vertices.push(Point3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let mut idx = Vec::new();
-                for tok in it {
-                    let first = tok.split('/').next().unwrap_or("");
-                    let i: i64 = first.parse().map_err(|_| err(line_no, "bad face index"))?;
-                    let n = vertices.len() as i64;
-                    let resolved = if i > 0 {
-                        i - 1
-                    } else if i < 0 {
-                        n + i
-                    } else {
-                        -1
-                    };
-                    if resolved < 0 || resolved >= n {
-                        return Err(err(line_no, "face index out of range"));
-                    }
-                    idx.push(resolved as u32);
-                }
-                if idx.len() < 3 {
-                    return Err(err(line_no, "face with fewer than 3 vertices"));
-                }
-                for k in 1..idx.len() - 1 {
-                    triangles.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
+    if ext == "obj" {
+        parse_obj(&name, &String::from_utf8_lossy(&bytes))
+    } else {
+        parse_stl(&name, &bytes)
     }
-    Ok(TriangleMesh::new(vertices, triangles))
 }
 
-/// Parses an STL buffer, binary (detected by its exact size) or ASCII. Corners are not welded.
+/// Parses Wavefront OBJ text with `tobj`: every object and group, polygons fan-triangulated,
+/// points and lines ignored. No validation of closedness.
+pub fn parse_obj(name: &str, text: &str) -> Result<TriangleMesh> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let mut reader = std::io::BufReader::new(text.as_bytes());
+    // Materials are irrelevant to collision geometry: every `mtllib` is answered empty.
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| SimError::MeshParse {
+        name: name.to_string(),
+        reason: format!("not a valid OBJ file: {e}"),
+    })?;
+    let mut mesh = TriangleMesh::default();
+    for model in &models {
+        let m = &model.mesh;
+        let vertices: Vec<Point3<f64>> = m
+            .positions
+            .chunks_exact(3)
+            .map(|c| Point3::new(c[0], c[1], c[2]))
+            .collect();
+        let triangles = m
+            .indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        mesh.append(&TriangleMesh::new(vertices, triangles));
+    }
+    Ok(mesh)
+}
+
+/// Parses an STL buffer, binary or ASCII, with `stl_io`. Corners are not welded.
+///
+/// A binary file is recognised by its size (84 bytes plus 50 per triangle) even when its
+/// 80-byte header begins with `solid`, as some CAD exporters write it (`stl_io` alone would read
+/// such a file as ASCII and fail); an ASCII file may have a bare `solid` line.
 pub fn parse_stl(name: &str, bytes: &[u8]) -> Result<TriangleMesh> {
     let err = |reason: String| SimError::MeshParse {
         name: name.to_string(),
         reason,
     };
-    if bytes.len() >= 84 {
-        let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
-        if bytes.len() == 84 + 50 * count {
-            let mut mesh = TriangleMesh::default();
-            for t in 0..count {
-                let rec = &bytes[84 + 50 * t..84 + 50 * (t + 1)];
-                let f = |k: usize| {
-                    let o = 12 + 4 * k;
-                    f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]) as f64
-                };
-                let base = mesh.vertices.len() as u32;
-                for c in 0..3 {
-                    mesh.vertices
-                        .push(Point3::new(f(3 * c), f(3 * c + 1), f(3 * c + 2)));
-                }
-                mesh.triangles.push([base, base + 1, base + 2]);
-            }
-            return Ok(mesh);
-        }
-    }
-    let text = std::str::from_utf8(bytes)
-        .map_err(|_| err("neither a binary STL (size mismatch) nor ASCII text".to_string()))?;
-    if !text.trim_start().starts_with("solid") {
+    let binary = bytes.len() >= 84 && {
+        let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        bytes.len() as u64 == 84 + 50 * count
+    };
+    let mut owned;
+    let input: &[u8] = if binary && bytes.starts_with(b"solid") {
+        owned = bytes.to_vec();
+        owned[..5].copy_from_slice(b"     ");
+        &owned
+    } else if !binary && (bytes.starts_with(b"solid\n") || bytes.starts_with(b"solid\r\n")) {
+        owned = b"solid ".to_vec();
+        owned.extend_from_slice(&bytes[5..]);
+        &owned
+    } else {
+        bytes
+    };
+    if !binary && !input.starts_with(b"solid ") {
         return Err(err(
-            "neither a binary STL (size mismatch) nor an ASCII STL (no `solid`)".to_string(),
+            "neither a binary STL (its size is not 84 bytes plus 50 per triangle) nor an ASCII STL (no `solid` line)"
+                .to_string(),
         ));
     }
-    let mut mesh = TriangleMesh::default();
-    let mut corners: Vec<Point3<f64>> = Vec::with_capacity(3);
-    for (ln, raw) in text.lines().enumerate() {
-        let mut it = raw.split_whitespace();
-        match it.next() {
-            Some("vertex") => {
-                let mut c = [0.0; 3];
-                for slot in &mut c {
-                    *slot = it
-                        .next()
-                        .and_then(|t| t.parse::<f64>().ok())
-                        .ok_or_else(|| err(format!("line {}: bad vertex", ln + 1)))?;
-                }
-                corners.push(Point3::new(c[0], c[1], c[2]));
-            }
-            Some("endfacet") => {
-                if corners.len() != 3 {
-                    return Err(err(format!(
-                        "line {}: facet with {} vertices",
-                        ln + 1,
-                        corners.len()
-                    )));
-                }
-                let base = mesh.vertices.len() as u32;
-                mesh.vertices.append(&mut corners);
-                mesh.triangles.push([base, base + 1, base + 2]);
-            }
-            _ => {}
-        }
-    }
-    Ok(mesh)
+    let mut cursor = std::io::Cursor::new(input);
+    let indexed = stl_io::read_stl(&mut cursor).map_err(|e| {
+        err(format!(
+            "not a valid {} STL file: {e}",
+            if binary { "binary" } else { "ASCII" }
+        ))
+    })?;
+    let vertices = indexed
+        .vertices
+        .iter()
+        .map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+        .collect();
+    let triangles = indexed
+        .faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.vertices;
+            [a as u32, b as u32, c as u32]
+        })
+        .collect();
+    Ok(TriangleMesh::new(vertices, triangles))
 }
 
 #[cfg(test)]

@@ -519,9 +519,27 @@ impl Object {
         )
     }
 
-    /// An object from an `.obj` or `.stl` file (see [`mesh::load`]); named after the file stem.
+    /// An object from an `.obj` or `.stl` file in metres (see [`mesh::load`]); named after the
+    /// file stem. The same as [`Object::from_file_scaled`] with scale 1.
     pub fn from_file(path: &Path) -> Result<Object> {
-        let mesh = mesh::load(path)?;
+        Object::from_file_scaled(path, 1.0)
+    }
+
+    /// An object from an `.obj` or `.stl` file whose coordinates are multiplied by `scale` (0.001
+    /// for a file in millimetres), named after the file stem. A mesh whose bounding radius is
+    /// then outside [`PLAUSIBLE_RADIUS`] is refused with [`SimError::ImplausibleSize`], which
+    /// names the scale that would fit.
+    pub fn from_file_scaled(path: &Path, scale: f64) -> Result<Object> {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(SimError::InvalidInput(format!(
+                "the mesh scale must be a finite factor > 0, got {scale}"
+            )));
+        }
+        let mut mesh = mesh::load(path)?;
+        if scale != 1.0 {
+            mesh = mesh.scaled(&Vector3::repeat(scale));
+        }
+        check_plausible_size(&mesh, &path.display().to_string(), scale)?;
         let name = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -1028,6 +1046,54 @@ fn user_parts(mesh: TriangleMesh, name: &str) -> Result<(Part, Vec<CollisionPart
         },
     };
     Ok((part, vec![coll]))
+}
+
+/// The bounding radius (half the bounding box's diagonal, metres) a user mesh may have: from
+/// a 1 cm marble to a 1 m box, what the hands here can close on.
+pub const PLAUSIBLE_RADIUS: (f64, f64) = (0.005, 0.5);
+
+/// Refuses a user mesh whose size is implausible for a hand, naming a unit scale that fits.
+fn check_plausible_size(mesh: &TriangleMesh, name: &str, scale: f64) -> Result<()> {
+    let Some((lo, hi)) = mesh.bounds() else {
+        return Ok(());
+    };
+    let radius = (hi - lo).norm() / 2.0;
+    let (min, max) = PLAUSIBLE_RADIUS;
+    if (min..=max).contains(&radius) {
+        return Ok(());
+    }
+    let units = [
+        (0.001, "millimetres"),
+        (0.01, "centimetres"),
+        (0.0254, "inches"),
+        (1000.0, "kilometres"),
+    ];
+    let advice = units
+        .iter()
+        .find(|(f, _)| (min..=max).contains(&(radius * f)))
+        .map(|(f, unit)| {
+            format!(
+                "if the file is in {unit}, scale it by {} (--mesh-scale {})",
+                f * scale,
+                f * scale
+            )
+        })
+        .unwrap_or_else(|| {
+            "give the factor from the file's units to metres (--mesh-scale S)".to_string()
+        });
+    let scaled = if scale == 1.0 {
+        String::new()
+    } else {
+        format!(" after scaling by {scale}")
+    };
+    Err(SimError::ImplausibleSize {
+        name: name.to_string(),
+        radius,
+        scaled,
+        min,
+        max,
+        advice,
+    })
 }
 
 /// A mesh part (identity frame) from a closed, outward mesh.

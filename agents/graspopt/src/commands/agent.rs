@@ -48,6 +48,9 @@ pub enum Kind {
         /// A user mesh (OBJ/STL).
         #[arg(long)]
         mesh: Option<PathBuf>,
+        /// Factor from the mesh file's units to metres (0.001 for millimetres).
+        #[arg(long, requires = "mesh")]
+        mesh_scale: Option<f64>,
         #[arg(long)]
         position_noise: Option<f64>,
         #[arg(long)]
@@ -163,6 +166,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             common,
             object,
             mesh,
+            mesh_scale,
             position_noise,
             rotation_noise,
             seed,
@@ -177,6 +181,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             if mesh.is_some() {
                 c.mesh = mesh.clone();
             }
+            c.mesh_scale = mesh_scale.unwrap_or(c.mesh_scale);
             c.position_noise = position_noise.unwrap_or(c.position_noise);
             c.rotation_noise = rotation_noise.unwrap_or(c.rotation_noise);
             c.seed = seed.unwrap_or(c.seed);

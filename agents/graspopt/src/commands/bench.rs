@@ -147,6 +147,7 @@ fn bench_sim() -> SimArgs {
     SimArgs {
         object: "cylinder".into(),
         mesh: None,
+        mesh_scale: 1.0,
         hand: "barrett".into(),
         contacts: super::setup::Contacts::Surface,
         metric: "bw".into(),

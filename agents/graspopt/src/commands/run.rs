@@ -110,12 +110,19 @@ pub struct Embedded {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct EmbeddedSettings {
     mesh: Option<PathBuf>,
+    /// Runs recorded before `--mesh-scale` existed used their meshes in metres.
+    #[serde(default = "unit_scale")]
+    mesh_scale: f64,
     contacts: String,
     metric: String,
     frame: String,
     torque_scale: Option<f64>,
     position_noise: f64,
     rotation_noise: f64,
+}
+
+fn unit_scale() -> f64 {
+    1.0
 }
 
 fn value_name<T: ValueEnum>(v: &T) -> String {
@@ -131,6 +138,7 @@ impl EmbeddedSettings {
                 .mesh
                 .as_ref()
                 .map(|m| std::fs::canonicalize(m).unwrap_or_else(|_| m.clone())),
+            mesh_scale: args.sim.mesh_scale,
             contacts: value_name(&args.sim.contacts),
             metric: args.sim.metric.clone(),
             frame: value_name(&args.sim.frame),
@@ -208,6 +216,7 @@ fn resumed_args(args: &RunArgs, out: &Path, explicit: &dyn Fn(&str) -> bool) -> 
         return Ok(out_args);
     };
     out_args.sim.mesh = recorded_settings.mesh.clone();
+    out_args.sim.mesh_scale = recorded_settings.mesh_scale;
     if out_args.sim.mesh.is_none() {
         out_args.sim.object = spec.object.clone();
     }
@@ -235,6 +244,12 @@ fn settings_conflicts(
             .map_or("none".into(), |p| p.display().to_string())
     };
     c.check(explicit, "mesh", path(&given.mesh), path(&recorded.mesh));
+    c.check(
+        explicit,
+        "mesh_scale",
+        given.mesh_scale,
+        recorded.mesh_scale,
+    );
     c.check(explicit, "contacts", &given.contacts, &recorded.contacts);
     c.check(explicit, "metric", &given.metric, &recorded.metric);
     c.check(explicit, "frame", &given.frame, &recorded.frame);
@@ -320,6 +335,7 @@ impl Embedded {
         let perception = graspopt_perception::PerceptionConfig {
             object: object_name.clone(),
             mesh: args.sim.mesh.clone(),
+            mesh_scale: args.sim.mesh_scale,
             position_noise: args.position_noise,
             rotation_noise: args.rotation_noise,
             seed: args.seed,

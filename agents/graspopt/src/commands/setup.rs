@@ -17,6 +17,9 @@ pub struct SimArgs {
     /// A user mesh (OBJ or STL, closed) instead of a built-in object.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
+    /// Factor from the mesh file's units to metres (0.001 for a mesh in millimetres).
+    #[arg(long, default_value_t = 1.0, requires = "mesh")]
+    pub mesh_scale: f64,
     /// Hand: barrett or parallel_jaw.
     #[arg(long, default_value = "barrett")]
     pub hand: String,
@@ -62,7 +65,7 @@ impl SimArgs {
     /// The object named by the flags.
     pub fn object(&self) -> Result<Object> {
         match &self.mesh {
-            Some(path) => Object::from_file(path)
+            Some(path) => Object::from_file_scaled(path, self.mesh_scale)
                 .with_context(|| format!("cannot load the mesh {}", path.display())),
             None => Ok(Object::by_name(&self.object)?),
         }
