@@ -32,7 +32,10 @@ fn endpoints_that_do_not_parse_are_refused_at_once_naming_them() {
             "tcp/127.0.0.1:99999",
             "port 99999 is out of range (1 to 65535)",
         ),
-        ("127.0.0.1:7447", "no protocol: write e.g. tcp/127.0.0.1:7447"),
+        (
+            "127.0.0.1:7447",
+            "no protocol: write e.g. tcp/127.0.0.1:7447",
+        ),
         (
             "udp/127.0.0.1:7447",
             "unknown protocol \"udp\": graspopt speaks tcp and unixsock-stream",
@@ -47,8 +50,7 @@ fn endpoints_that_do_not_parse_are_refused_at_once_naming_them() {
             let mut args = args.clone();
             args.extend(["--connect", endpoint, "--no-shm"]);
             // Before: the agent waited forever on a port Zenoh could never use.
-            let (status, _) =
-                start_plain(&name, &args, &dir).wait_output(Duration::from_secs(15));
+            let (status, _) = start_plain(&name, &args, &dir).wait_output(Duration::from_secs(15));
             let text = log(&dir, &name);
             assert_eq!(status.code(), Some(1), "{name}: {text}");
             assert!(
@@ -170,7 +172,15 @@ fn a_hand_given_a_wrong_address_does_not_join_through_multicast_scouting() {
     let _hand = start_plain(
         "hand-x",
         &[
-            "agent", "hand", "--run", "scout", "--id", "hand-x", "--connect", &wrong, "--no-shm",
+            "agent",
+            "hand",
+            "--run",
+            "scout",
+            "--id",
+            "hand-x",
+            "--connect",
+            &wrong,
+            "--no-shm",
         ],
         &dir,
     );

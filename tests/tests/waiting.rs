@@ -14,9 +14,9 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
         "the coordinator says it waits for perception, a metric agent and a hand",
         Duration::from_secs(20),
         || {
-            c.log("coordinator").contains(
-                "run wait is waiting: no object estimate yet (",
-            ) && c.log("coordinator").contains("no metric agent (")
+            c.log("coordinator")
+                .contains("run wait is waiting: no object estimate yet (")
+                && c.log("coordinator").contains("no metric agent (")
                 && c.log("coordinator").contains("no hand (")
         },
     );
@@ -25,13 +25,13 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
     args.extend(connect);
     let o = graspopt(&args);
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
     assert!(
-        text.contains(
-            "waiting: no object estimate yet ("
-        ) && text.contains("s), no metric agent (")
+        text.contains("waiting: no object estimate yet (")
+            && text.contains("s), no metric agent (")
             && text.contains("s), no hand ("),
-        "{text}"
+        "{text}\n{stderr}"
     );
     // The status on the bus carries the same.
     let mut args = vec![
@@ -42,13 +42,17 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let status: serde_json::Value =
         serde_json::from_str(String::from_utf8_lossy(&o.stdout).lines().next().unwrap()).unwrap();
-    let reasons: Vec<&str> = status["waiting"]
+    let reasons: Vec<&str> = status["message"]["waiting"]
         .as_array()
         .unwrap_or_else(|| panic!("no waiting in {status}"))
         .iter()
         .map(|w| w["reason"].as_str().unwrap())
         .collect();
-    assert_eq!(reasons, ["object_estimate", "metric_agent", "hand"], "{status}");
+    assert_eq!(
+        reasons,
+        ["object_estimate", "metric_agent", "hand"],
+        "{status}"
+    );
 
     // Everything but the planner: the wait changes to the planner's answer.
     let _perception = c.agent("perception", &["perception", "--object", "sphere"]);
@@ -57,7 +61,10 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
     wait_until(
         "the coordinator says it waits for the planner",
         Duration::from_secs(30),
-        || c.log("coordinator").contains("run wait is waiting: no planner answer ("),
+        || {
+            c.log("coordinator")
+                .contains("run wait is waiting: no planner answer (")
+        },
     );
     let _planner = c.agent("planner", &["planner"]);
     let status = c.final_status(coordinator, Duration::from_secs(60));

@@ -89,14 +89,12 @@ impl BusArgs {
             None => zenoh::Config::default(),
         };
         let mut set = |key: &str, value: String| {
-            config
-                .insert_json5(key, &value)
-                .map_err(|e| {
-                    BusError::Config(format!(
-                        "{key} = {value}: {}",
-                        without_source_locations(&e.to_string())
-                    ))
-                })
+            config.insert_json5(key, &value).map_err(|e| {
+                BusError::Config(format!(
+                    "{key} = {value}: {}",
+                    without_source_locations(&e.to_string())
+                ))
+            })
         };
         if let Some(mode) = self.mode {
             // A client talks only through routers: without one to connect to (or a
@@ -159,9 +157,7 @@ pub const PROTOCOLS: [&str; 2] = ["tcp", "unixsock-stream"];
 pub fn check_endpoint(endpoint: &str, use_: EndpointUse) -> Result<(), crate::BusError> {
     let bad = |why: String| crate::BusError::Config(format!("endpoint {endpoint:?}: {why}"));
     let Some((protocol, rest)) = endpoint.split_once('/') else {
-        return Err(bad(format!(
-            "no protocol: write e.g. tcp/{endpoint}"
-        )));
+        return Err(bad(format!("no protocol: write e.g. tcp/{endpoint}")));
     };
     // Zenoh's own parser: metadata and configuration after the address.
     let parsed = zenoh::config::EndPoint::try_from(endpoint.to_string())
@@ -181,9 +177,7 @@ pub fn check_endpoint(endpoint: &str, use_: EndpointUse) -> Result<(), crate::Bu
         return Ok(());
     }
     let Some((host, port)) = address.rsplit_once(':') else {
-        return Err(bad(format!(
-            "no port: write e.g. tcp/{address}:7447"
-        )));
+        return Err(bad(format!("no port: write e.g. tcp/{address}:7447")));
     };
     let port: u32 = port
         .parse()
@@ -238,13 +232,25 @@ mod tests {
         ] {
             assert_eq!(connect(ok), Ok(()), "{ok}");
         }
-        assert_eq!(check_endpoint("tcp/0.0.0.0:0", EndpointUse::Listen).ok(), Some(()));
+        assert_eq!(
+            check_endpoint("tcp/0.0.0.0:0", EndpointUse::Listen).ok(),
+            Some(())
+        );
         for (bad, why) in [
-            ("tcp/127.0.0.1:99999", "port 99999 is out of range (1 to 65535)"),
+            (
+                "tcp/127.0.0.1:99999",
+                "port 99999 is out of range (1 to 65535)",
+            ),
             ("tcp/127.0.0.1:0", "port 0 is out of range"),
             ("tcp/127.0.0.1:port", "the port \"port\" is not a number"),
-            ("127.0.0.1:7447", "no protocol: write e.g. tcp/127.0.0.1:7447"),
-            ("udp/127.0.0.1:7447", "unknown protocol \"udp\": graspopt speaks tcp and unixsock-stream"),
+            (
+                "127.0.0.1:7447",
+                "no protocol: write e.g. tcp/127.0.0.1:7447",
+            ),
+            (
+                "udp/127.0.0.1:7447",
+                "unknown protocol \"udp\": graspopt speaks tcp and unixsock-stream",
+            ),
             ("tpc/127.0.0.1:7447", "unknown protocol \"tpc\""),
             ("tcp/127.0.0.1", "no port"),
             ("tcp/", "endpoint \"tcp/\""),

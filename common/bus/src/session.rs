@@ -303,7 +303,8 @@ async fn watch_reach(session: Session, endpoints: Vec<String>) {
         }
     }
     let why = if why.is_empty() {
-        "nothing answers there: check the address, and that the router runs and its port is open".to_string()
+        "nothing answers there: check the address, and that the router runs and its port is open"
+            .to_string()
     } else {
         why.join("; ")
     };
@@ -341,7 +342,8 @@ async fn unresolved(endpoint: &str) -> Option<String> {
     }
     let host = host.to_string();
     let lookup = tokio::task::spawn_blocking(move || {
-        std::net::ToSocketAddrs::to_socket_addrs(&(host.as_str(), 0)).map(|_| ())
+        std::net::ToSocketAddrs::to_socket_addrs(&(host.as_str(), 0))
+            .map(|_| ())
             .map_err(|e| (host, e))
     });
     match lookup.await {

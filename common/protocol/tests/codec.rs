@@ -265,7 +265,10 @@ fn a_status_from_before_waiting_still_decodes() {
     ];
     let s = status(waits);
     for enc in [Encoding::Bincode, Encoding::Json] {
-        assert_eq!(decode::<RunStatus>(&encode(&s, enc).unwrap(), enc).unwrap(), s);
+        assert_eq!(
+            decode::<RunStatus>(&encode(&s, enc).unwrap(), enc).unwrap(),
+            s
+        );
     }
     let json: serde_json::Value =
         serde_json::from_slice(&encode(&s, Encoding::Json).unwrap()).unwrap();
@@ -279,7 +282,10 @@ fn a_status_from_before_waiting_still_decodes() {
         serde_json::from_slice(&encode(&empty, Encoding::Json).unwrap()).unwrap();
     old_json.as_object_mut().unwrap().remove("waiting");
     let old_json = serde_json::to_vec(&old_json).unwrap();
-    assert_eq!(decode::<RunStatus>(&old_json, Encoding::Json).unwrap(), empty);
+    assert_eq!(
+        decode::<RunStatus>(&old_json, Encoding::Json).unwrap(),
+        empty
+    );
     // Still refused: a payload cut anywhere else, and bytes after the message.
     old.pop();
     assert!(decode::<RunStatus>(&old, Encoding::Bincode).is_err());
