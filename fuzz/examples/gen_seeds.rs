@@ -10,8 +10,8 @@ use graspopt_protocol::keys::AgentKind;
 use graspopt_protocol::{
     BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, Message, MeshData,
     MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
-    SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WorkerStatus, decode,
-    encode,
+    SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
+    WorkerStatus, decode, encode,
 };
 
 struct Out(PathBuf);
@@ -171,6 +171,10 @@ fn main() {
             ..ErrorCounts::default()
         },
         stamp_ms: 1_700_000_000_789,
+        waiting: vec![Waiting {
+            reason: WaitReason::MetricAgent,
+            since_ms: 1_700_000_000_000,
+        }],
     };
     out.message("decode_status", "status", &status, Some(Topic::Status));
 

@@ -10,6 +10,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod state;
+pub mod waits;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -23,13 +24,14 @@ use graspopt_journal::{
 };
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, PlannerMethod, RunId, RunPhase, RunStatus, SuggestReply,
-    SuggestRequest, TrialCommand, TrialResult,
+    SuggestRequest, TrialCommand, TrialResult, WaitReason,
 };
 use graspopt_sim::{ParamKind, ParamSpec, TrialSpace, reference_pose};
 use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 
 use crate::state::{Disposition, RunState, TrialPhase};
+use crate::waits::Waits;
 
 /// What a run is: recorded in the journal when the run is created, and taken from there when
 /// it resumes.
@@ -350,7 +352,14 @@ pub fn open_run(
     Ok((spec, state))
 }
 
-fn status(run: &RunId, spec: &RunSpec, state: &RunState, phase: RunPhase) -> RunStatus {
+fn status(
+    run: &RunId,
+    spec: &RunSpec,
+    state: &RunState,
+    phase: RunPhase,
+    waits: &Waits,
+) -> RunStatus {
+    let now = now_ms();
     RunStatus {
         run_id: run.clone(),
         phase,
@@ -364,7 +373,12 @@ fn status(run: &RunId, spec: &RunSpec, state: &RunState, phase: RunPhase) -> Run
         best_history: state.best_history.clone(),
         workers: state.worker_statuses(),
         errors: state.errors,
-        stamp_ms: now_ms(),
+        stamp_ms: now,
+        waiting: if phase == RunPhase::Finished {
+            Vec::new()
+        } else {
+            waits.shown(now)
+        },
     }
 }
 
@@ -417,6 +431,8 @@ struct Ctx<'a> {
     /// The planner's engine after its last reply (also in the journal), sent back with every
     /// request: a planner that lost it (restarted) continues from it exactly.
     engine_state: Option<Vec<u8>>,
+    /// What the run waits for (object estimate, metric agent, hand, planner).
+    waits: Waits,
 }
 
 impl Ctx<'_> {
@@ -563,6 +579,26 @@ impl Ctx<'_> {
         }
     }
 
+    /// Notes what the run waits for now: the object estimate (since the start), a metric
+    /// agent and a hand (since the start or since the last one left), and the planner (since
+    /// it stopped answering, or since a question asked at `planning_since` went unanswered
+    /// for [`waits::PLANNER_SLOW_MS`]).
+    fn note_waits(&mut self, started_ms: i64, planning_since: Option<i64>) {
+        let now = now_ms();
+        let since = |waiting: bool| waiting.then_some(now);
+        self.waits.set(
+            WaitReason::ObjectEstimate,
+            self.space.is_none().then_some(started_ms),
+        );
+        self.waits
+            .set(WaitReason::MetricAgent, since(self.scorers.is_empty()));
+        self.waits
+            .set(WaitReason::Hand, since(self.state.workers.is_empty()));
+        let slow = planning_since.filter(|t| now - t >= waits::PLANNER_SLOW_MS);
+        self.waits
+            .set(WaitReason::Planner, self.planner_down_since.or(slow));
+    }
+
     fn on_result(&mut self, result: &TrialResult) -> anyhow::Result<Disposition> {
         let now = now_ms();
         // A result must name an attempt issued to the worker it names: anything else (a
@@ -685,13 +721,17 @@ pub async fn run_until(
         planner_down_since: None,
         planner_warned_ms: 0,
         engine_state,
+        waits: Waits::default(),
     };
+    let started_ms = now_ms();
     let mut tick = tokio::time::interval(Duration::from_millis(config.status_period_ms.max(20)));
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
     let mut planner_retry_at = tokio::time::Instant::now();
     // The planner's answer is awaited beside everything else, so results, leases and
     // workers are still handled while it thinks or while the bus cannot reach it.
     let mut planning: Option<PlannerCall> = None;
+    // When the question in `planning` was asked.
+    let mut planning_since: Option<i64> = None;
     let planner_timeout = Duration::from_millis(config.planner_timeout_ms);
     let suggest_key = run.suggest_key();
     let status_key = run.status_key();
@@ -709,8 +749,10 @@ pub async fn run_until(
                 planning = Some(Box::pin(async move {
                     bus.query(&key, &request, planner_timeout).await
                 }));
+                planning_since = Some(now_ms());
             }
         }
+        ctx.note_waits(started_ms, planning_since);
         tokio::select! {
             reply = async {
                 match planning.as_mut() {
@@ -719,6 +761,7 @@ pub async fn run_until(
                 }
             }, if planning.is_some() => {
                 planning = None;
+                planning_since = None;
                 if ctx.take_proposals(reply) {
                     ctx.issue_queued().await?;
                 } else {
@@ -734,7 +777,7 @@ pub async fn run_until(
                         Disposition::StaleFailure => tracing::warn!("coordinator: attempt {} of trial {} failed, a later attempt is running: ignored", result.attempt, result.trial_id),
                         _ => {}
                     }
-                    let s = status(run, &spec, &ctx.state, RunPhase::Running);
+                    let s = status(run, &spec, &ctx.state, RunPhase::Running, &ctx.waits);
                     if let Some(p) = &progress { let _ = p.send(s); }
                 }
                 Ok(result) => {
@@ -774,6 +817,7 @@ pub async fn run_until(
             Some(ev) = planners.recv() => {
                 if ev.alive && ev.agent.run == *run && planning.is_some() {
                     planning = None;
+                    planning_since = None;
                     planner_retry_at = tokio::time::Instant::now();
                 }
             },
@@ -799,7 +843,7 @@ pub async fn run_until(
                 }
             },
             Some(q) = state_server.recv() => {
-                let s = status(run, &spec, &ctx.state, if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting });
+                let s = status(run, &spec, &ctx.state, if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting }, &ctx.waits);
                 let _ = q.reply(&s).await;
             },
             _ = lease_tick.tick() => {
@@ -813,7 +857,10 @@ pub async fn run_until(
             },
             _ = tick.tick() => {
                 let phase = if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting };
-                let s = status(run, &spec, &ctx.state, phase);
+                let s = status(run, &spec, &ctx.state, phase, &ctx.waits);
+                if let Some(m) = ctx.waits.message(s.stamp_ms) {
+                    tracing::warn!("coordinator: run {run} {m}");
+                }
                 let _ = bus.put_droppable(&status_key, &s, Encoding::Bincode).await;
                 if let Some(p) = &progress { let _ = p.send(s); }
             },
@@ -827,9 +874,17 @@ pub async fn run_until(
         } else {
             RunPhase::Waiting
         };
-        let s = status(run, &spec, &ctx.state, phase);
+        let s = status(run, &spec, &ctx.state, phase, &ctx.waits);
+        let waiting = if s.waiting.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " while waiting ({})",
+                waits::describe(&s.waiting, s.stamp_ms)
+            )
+        };
         tracing::warn!(
-            "coordinator: run {run} stopped with {} of {} trials completed ({} failed, {} running); every result is in {}; resume with --resume",
+            "coordinator: run {run} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; resume with --resume",
             s.completed,
             s.budget,
             s.failed,
@@ -840,7 +895,7 @@ pub async fn run_until(
     }
     ctx.journal
         .set_run_status(run.as_str(), JournalStatus::Finished, now_ms())?;
-    let s = status(run, &spec, &ctx.state, RunPhase::Finished);
+    let s = status(run, &spec, &ctx.state, RunPhase::Finished, &ctx.waits);
     let _ = bus.put(&status_key, &s, Encoding::Bincode).await;
     if let Some(p) = &progress {
         let _ = p.send(s.clone());

@@ -64,6 +64,12 @@ fn given(matches: Option<&ArgMatches>, name: &str) -> bool {
     })
 }
 
+/// The log filter when `RUST_LOG` is not set: warnings, but Zenoh's own connection and
+/// scouting warnings only from errors up. Those name a source file of the build machine and
+/// repeat what graspopt says in its own words (`cannot reach tcp/...`); `RUST_LOG=warn` or
+/// `RUST_LOG=zenoh=debug` shows them.
+const DEFAULT_LOG: &str = "warn,zenoh::net::runtime::orchestrator=error";
+
 fn main() -> ExitCode {
     let matches = Cli::command().get_matches();
     let cli = match Cli::from_arg_matches(&matches) {
@@ -74,11 +80,11 @@ fn main() -> ExitCode {
     let coordinator_matches = matches
         .subcommand_matches("agent")
         .and_then(|m| m.subcommand_matches("coordinator"));
-    // Logs go to stderr; RUST_LOG overrides the default level (warnings).
+    // Logs go to stderr; RUST_LOG overrides the default filter.
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(DEFAULT_LOG)),
         )
         .with_writer(std::io::stderr)
         // Colours only on a terminal: logs redirected to files stay plain text.

@@ -38,7 +38,7 @@ impl BusError {
 
 /// `text` without the ` at /path/to/file.rs:123` locations Zenoh appends to its errors
 /// (paths of the build machine's crate registry, of no use to a user).
-fn without_source_locations(text: &str) -> String {
+pub(crate) fn without_source_locations(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(i) = rest.find(" at /") {

@@ -65,18 +65,11 @@ impl Bus {
         let session = zenoh::open(config)
             .await
             .map_err(|e| BusError::zenoh("opening the session", e))?;
-        // A peer does not fail when its `--connect` endpoints are unreachable: it keeps
-        // trying in the background. Say so, or the agent just waits in silence.
-        if !args.connect.is_empty() {
-            let info = session.info();
-            let routers = info.routers_zid().await.count();
-            let peers = info.peers_zid().await.count();
-            if routers == 0 && peers == 0 {
-                tracing::warn!(
-                    "cannot reach {} yet (is the router running?): still trying in the background",
-                    args.connect.join(", ")
-                );
-            }
+        // A peer does not fail when its `--connect` endpoints are unreachable: Zenoh keeps
+        // trying in the background, in silence. Say which cannot be reached, and when they
+        // are.
+        if !args.connect.is_empty() && args.mode != Some(crate::BusMode::Client) {
+            tokio::spawn(watch_reach(session.clone(), args.connect.clone()));
         }
         let shm = if args.no_shm {
             None
@@ -100,7 +93,7 @@ impl Bus {
             host: host_name(),
             shm,
             reaches_out: !args.connect.is_empty()
-                || !args.no_multicast_scouting
+                || args.multicast_scouting()
                 || args.zenoh_config.is_some(),
         })
     }
@@ -276,6 +269,86 @@ impl Bus {
             .close()
             .await
             .map_err(|e| BusError::zenoh("closing the session", e))
+    }
+}
+
+/// How long a process waits for its `--connect` endpoints before saying it cannot reach them.
+pub const REACH_GRACE: Duration = Duration::from_secs(3);
+/// How often it says so again while Zenoh keeps trying (every 1 to 4 s, in the background).
+pub const REACH_REMINDER: Duration = Duration::from_secs(15);
+
+/// Whether the session holds a link to a router or peer.
+async fn linked(session: &Session) -> bool {
+    let info = session.info();
+    info.routers_zid().await.next().is_some() || info.peers_zid().await.next().is_some()
+}
+
+/// Warns, [`REACH_GRACE`] after the session opened, that none of `endpoints` answered (naming
+/// them, with the reason when a host name does not resolve), then every [`REACH_REMINDER`]
+/// while that lasts; says so when one answers at last. Ends with the session.
+async fn watch_reach(session: Session, endpoints: Vec<String>) {
+    let started = tokio::time::Instant::now();
+    let poll = Duration::from_millis(100);
+    while started.elapsed() < REACH_GRACE {
+        if session.is_closed() || linked(&session).await {
+            return;
+        }
+        tokio::time::sleep(poll).await;
+    }
+    let names = endpoints.join(", ");
+    let mut why = Vec::new();
+    for e in &endpoints {
+        if let Some(reason) = unresolved(e).await {
+            why.push(reason);
+        }
+    }
+    let why = if why.is_empty() {
+        "nothing answers there: check the address, and that the router runs and its port is open"
+            .to_string()
+    } else {
+        why.join("; ")
+    };
+    tracing::warn!("cannot reach {names}: {why}. Still trying in the background");
+    let mut told = tokio::time::Instant::now();
+    loop {
+        tokio::time::sleep(poll).await;
+        if session.is_closed() {
+            return;
+        }
+        if linked(&session).await {
+            tracing::warn!(
+                "reached {names} after {:.0} s",
+                started.elapsed().as_secs_f64()
+            );
+            return;
+        }
+        if told.elapsed() >= REACH_REMINDER {
+            told = tokio::time::Instant::now();
+            tracing::warn!(
+                "still cannot reach {names} after {:.0} s: still trying",
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
+
+/// Why a `tcp/HOST:PORT` endpoint cannot be reached when its host name does not resolve.
+async fn unresolved(endpoint: &str) -> Option<String> {
+    let address = endpoint.strip_prefix("tcp/")?;
+    let address = address.split(['?', '#']).next()?;
+    let (host, _) = address.rsplit_once(':')?;
+    if host.starts_with('[') || host.parse::<std::net::Ipv4Addr>().is_ok() {
+        return None;
+    }
+    let host = host.to_string();
+    let lookup = tokio::task::spawn_blocking(move || {
+        std::net::ToSocketAddrs::to_socket_addrs(&(host.as_str(), 0))
+            .map(|_| ())
+            .map_err(|e| (host, e))
+    });
+    match lookup.await {
+        Ok(Err((host, e))) => Some(format!("the host name {host} does not resolve ({e})")),
+        _ => None,
     }
 }
 

@@ -93,6 +93,13 @@ fn bincode_config() -> impl bincode::config::Config {
     bincode::config::standard().with_limit::<MAX_PAYLOAD>()
 }
 
+/// A bincode body (after the wire version) as a `T`, and the bytes it took.
+pub(crate) fn decode_bincode_body<T: serde::de::DeserializeOwned>(
+    body: &[u8],
+) -> Result<(T, usize), bincode::error::DecodeError> {
+    bincode::serde::decode_from_slice::<T, _>(body, bincode_config())
+}
+
 /// Encodes a message.
 pub fn encode<T: Message>(msg: &T, encoding: Encoding) -> Result<Vec<u8>, EncodeError> {
     match encoding {
@@ -153,8 +160,12 @@ pub fn decode<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<T, DecodeE
                     expected: WIRE_VERSION,
                 });
             }
-            let (msg, read) = bincode::serde::decode_from_slice::<T, _>(body, bincode_config())
-                .map_err(|e| malformed(e.to_string()))?;
+            let (msg, read) = match decode_bincode_body::<T>(body) {
+                Ok(decoded) => decoded,
+                Err(e) => T::decode_older(body)
+                    .filter(|(_, read)| *read == body.len())
+                    .ok_or_else(|| malformed(e.to_string()))?,
+            };
             if read != body.len() {
                 return Err(malformed(format!(
                     "{} trailing bytes after the message",

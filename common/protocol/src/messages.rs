@@ -23,6 +23,16 @@ pub trait Message: Serialize + for<'de> Deserialize<'de> {
     fn attempt_ref(&self) -> Option<AttemptRef> {
         None
     }
+    /// A bincode body of this message as an earlier layout of the same wire version wrote it
+    /// (before fields were appended), and the bytes it took: for messages that grew a field
+    /// at the end (`None`: this one never did). JSON needs no such help: an appended field
+    /// is `#[serde(default)]`.
+    fn decode_older(_body: &[u8]) -> Option<(Self, usize)>
+    where
+        Self: Sized,
+    {
+        None
+    }
 }
 
 /// One attempt of one trial, as named by a message.
@@ -451,6 +461,47 @@ pub struct ErrorCounts {
     pub failed: u64,
 }
 
+/// What a run can be waiting for before trials go out (or go on).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WaitReason {
+    /// No object estimate yet: no perception agent publishes on the run.
+    ObjectEstimate,
+    /// No metric agent alive: trials are held back, their clouds would not be scored.
+    MetricAgent,
+    /// No hand worker alive.
+    Hand,
+    /// No answer from the planner (none running, or it has not answered yet).
+    Planner,
+}
+
+impl WaitReason {
+    /// Every reason, in the order they are shown.
+    pub const ALL: [WaitReason; 4] = [
+        WaitReason::ObjectEstimate,
+        WaitReason::MetricAgent,
+        WaitReason::Hand,
+        WaitReason::Planner,
+    ];
+
+    /// What is missing, for people: "no metric agent".
+    pub fn describe(self) -> &'static str {
+        match self {
+            WaitReason::ObjectEstimate => "no object estimate yet",
+            WaitReason::MetricAgent => "no metric agent",
+            WaitReason::Hand => "no hand",
+            WaitReason::Planner => "no planner answer",
+        }
+    }
+}
+
+/// One thing a run waits for, and since when (milliseconds since the Unix epoch).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Waiting {
+    pub reason: WaitReason,
+    pub since_ms: i64,
+}
+
 /// coordinator -> monitors: the state of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunStatus {
@@ -468,6 +519,29 @@ pub struct RunStatus {
     pub workers: Vec<WorkerStatus>,
     pub errors: ErrorCounts,
     pub stamp_ms: i64,
+    /// What the run has been waiting for, for a second or more (empty: nothing). Added last,
+    /// within wire version 3: a status without it (an older coordinator's) decodes with none
+    /// (see [`RunStatus::decode_older`]).
+    #[serde(default)]
+    pub waiting: Vec<Waiting>,
+}
+
+/// [`RunStatus`] as wire version 3 first had it, before `waiting`.
+#[derive(Deserialize)]
+struct RunStatusBeforeWaiting {
+    run_id: RunId,
+    phase: RunPhase,
+    object: String,
+    param_names: Vec<String>,
+    budget: u64,
+    completed: u64,
+    running: u64,
+    failed: u64,
+    best: Option<BestTrial>,
+    best_history: Vec<f64>,
+    workers: Vec<WorkerStatus>,
+    errors: ErrorCounts,
+    stamp_ms: i64,
 }
 
 impl Message for RunStatus {
@@ -477,5 +551,25 @@ impl Message for RunStatus {
     }
     fn validate(&self) -> Result<(), String> {
         Ok(())
+    }
+    fn decode_older(body: &[u8]) -> Option<(Self, usize)> {
+        let (s, read) = crate::codec::decode_bincode_body::<RunStatusBeforeWaiting>(body).ok()?;
+        let status = RunStatus {
+            run_id: s.run_id,
+            phase: s.phase,
+            object: s.object,
+            param_names: s.param_names,
+            budget: s.budget,
+            completed: s.completed,
+            running: s.running,
+            failed: s.failed,
+            best: s.best,
+            best_history: s.best_history,
+            workers: s.workers,
+            errors: s.errors,
+            stamp_ms: s.stamp_ms,
+            waiting: Vec::new(),
+        };
+        Some((status, read))
     }
 }

@@ -229,3 +229,67 @@ fn a_topic_decodes_to_its_message_fields() {
         assert!(decode_topic(Topic::Object, &bytes, enc).is_err());
     }
 }
+
+fn status(waiting: Vec<Waiting>) -> RunStatus {
+    RunStatus {
+        run_id: run(),
+        phase: RunPhase::Waiting,
+        object: "mug".into(),
+        param_names: vec!["approach".into()],
+        budget: 10,
+        completed: 0,
+        running: 0,
+        failed: 0,
+        best: None,
+        best_history: vec![],
+        workers: vec![],
+        errors: ErrorCounts::default(),
+        stamp_ms: 1_700_000_005_000,
+        waiting,
+    }
+}
+
+/// `RunStatus.waiting` was appended within wire version 3: a status written before it (an
+/// older coordinator's) still decodes, in both encodings, with nothing waited for.
+#[test]
+fn a_status_from_before_waiting_still_decodes() {
+    let waits = vec![
+        Waiting {
+            reason: WaitReason::ObjectEstimate,
+            since_ms: 1_700_000_000_000,
+        },
+        Waiting {
+            reason: WaitReason::Planner,
+            since_ms: 1_700_000_004_000,
+        },
+    ];
+    let s = status(waits);
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        assert_eq!(
+            decode::<RunStatus>(&encode(&s, enc).unwrap(), enc).unwrap(),
+            s
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&encode(&s, Encoding::Json).unwrap()).unwrap();
+    assert_eq!(json["waiting"][1]["reason"], "planner");
+    // The old bincode layout ends where `waiting` begins: an empty list is one 0 byte.
+    let empty = status(vec![]);
+    let mut old = encode(&empty, Encoding::Bincode).unwrap();
+    assert_eq!(old.pop(), Some(0));
+    assert_eq!(decode::<RunStatus>(&old, Encoding::Bincode).unwrap(), empty);
+    let mut old_json: serde_json::Value =
+        serde_json::from_slice(&encode(&empty, Encoding::Json).unwrap()).unwrap();
+    old_json.as_object_mut().unwrap().remove("waiting");
+    let old_json = serde_json::to_vec(&old_json).unwrap();
+    assert_eq!(
+        decode::<RunStatus>(&old_json, Encoding::Json).unwrap(),
+        empty
+    );
+    // Still refused: a payload cut anywhere else, and bytes after the message.
+    old.pop();
+    assert!(decode::<RunStatus>(&old, Encoding::Bincode).is_err());
+    let mut long = encode(&empty, Encoding::Bincode).unwrap();
+    long.push(0);
+    assert!(decode::<RunStatus>(&long, Encoding::Bincode).is_err());
+}

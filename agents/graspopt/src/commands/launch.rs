@@ -129,14 +129,11 @@ impl LaunchFile {
             toml::from_str(text).with_context(|| format!("launch file {}", origin.display()))?;
         graspopt_protocol::RunId::new(&file.run)
             .with_context(|| format!("launch file {}: run", origin.display()))?;
-        if !file.endpoint.contains('/') {
-            bail!(
-                "launch file {}: endpoint {:?} has no protocol: write e.g. tcp/{}",
-                origin.display(),
-                file.endpoint,
-                file.endpoint
-            );
-        }
+        graspopt_bus::args::check_endpoint(
+            &file.endpoint,
+            graspopt_bus::args::EndpointUse::Connect,
+        )
+        .with_context(|| format!("launch file {}", origin.display()))?;
         for a in &file.agents {
             if !KINDS.contains(&a.kind.as_str()) {
                 bail!(

@@ -140,6 +140,12 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
         "trials: {} completed, {} running, {} failed, budget {}",
         s.completed, s.running, s.failed, s.budget
     ));
+    if !s.waiting.is_empty() {
+        out.push(format!(
+            "waiting: {}",
+            graspopt_coordinator::waits::describe(&s.waiting, s.stamp_ms)
+        ));
+    }
     match &s.best {
         Some(b) => {
             let params = super::run::named_params(&s.param_names, &b.params, ", ");
@@ -240,10 +246,11 @@ pub fn draw(frame: &mut Frame, m: &Monitor, now: Instant) {
             .label(label),
         gauge,
     );
+    // Trials, what the run waits for (if anything) and the best trial.
     let summary: Vec<Line> = lines
         .iter()
         .skip(1)
-        .take(2)
+        .take_while(|l| !l.starts_with("workers alive:"))
         .map(|l| Line::from(l.clone()))
         .collect();
     frame.render_widget(
@@ -252,7 +259,7 @@ pub fn draw(frame: &mut Frame, m: &Monitor, now: Instant) {
     );
     let worker_lines: Vec<Line> = lines
         .iter()
-        .skip(3)
+        .skip_while(|l| !l.starts_with("workers alive:"))
         .take_while(|l| !l.starts_with("errors:"))
         .map(|l| Line::from(l.clone()))
         .collect();
@@ -494,6 +501,7 @@ mod tests {
                 ..Default::default()
             },
             stamp_ms: completed as i64,
+            waiting: Vec::new(),
         }
     }
 
@@ -526,6 +534,41 @@ mod tests {
             "2 duplicates",
             "best score so far: 0.21230 after 3 trials",
         ] {
+            assert!(screen.contains(want), "{want:?} not on screen:\n{screen}");
+        }
+    }
+
+    #[test]
+    fn the_dashboard_and_once_say_what_the_run_waits_for() {
+        let mut s = status(0);
+        s.best = None;
+        s.stamp_ms = 20_000;
+        s.waiting = vec![
+            graspopt_protocol::Waiting {
+                reason: graspopt_protocol::WaitReason::MetricAgent,
+                since_ms: 8_000,
+            },
+            graspopt_protocol::Waiting {
+                reason: graspopt_protocol::WaitReason::Planner,
+                since_ms: 17_000,
+            },
+        ];
+        let mut m = Monitor::default();
+        m.set_alive(&["demo".into()]);
+        m.on_status(s, Instant::now());
+        let want = "waiting: no metric agent (12 s), no planner answer (3 s)";
+        let lines = run_lines("demo", &m.runs["demo"], Instant::now());
+        assert!(lines.iter().any(|l| l == want), "{lines:?}");
+        let mut term = Terminal::new(TestBackend::new(100, 30)).unwrap();
+        term.draw(|f| draw(f, &m, Instant::now())).unwrap();
+        let screen: String = term
+            .backend()
+            .buffer()
+            .content()
+            .iter()
+            .map(|c| c.symbol())
+            .collect();
+        for want in [want, "best: none yet", "hand-1@lab  trial 14"] {
             assert!(screen.contains(want), "{want:?} not on screen:\n{screen}");
         }
     }

@@ -571,5 +571,6 @@ pub fn placeholder(e: &Embedded) -> RunStatus {
         workers: Vec::new(),
         errors: Default::default(),
         stamp_ms: 0,
+        waiting: Vec::new(),
     }
 }
