@@ -17,9 +17,13 @@ fn trial_prints_contacts_and_metrics() {
     );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(e["params"], serde_json::json!([-0.1]));
-    let m = &e["score"]["metrics"];
+    // The score and what it was computed from sit at the top level, not nested.
+    let m = &e["metrics"];
     assert_eq!(m["force_closure"], true);
-    assert_eq!(e["score"]["score"], m["bw"]);
+    assert!(e["score"].is_f64(), "{e}");
+    assert_eq!(e["score"], m["bw"]);
+    assert!(e["contacts"].as_u64().unwrap() > 0, "{e}");
+    assert_eq!(e["fingers_in_contact"], 3);
     assert_eq!(e["outcome"]["fingers"].as_array().unwrap().len(), 3);
     let text = graspopt(&["trial", "--object", "sphere", "--at", "x=-0.1"]);
     let text = String::from_utf8(text.stdout).unwrap();
