@@ -121,9 +121,58 @@ fn scan_2d_writes_a_png_heatmap_too() {
         String::from_utf8_lossy(&out.stderr)
     );
     let (width, height, _) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
-    // 4 x 3 cells of 8 px, plus the colour bar.
-    assert_eq!(height, 3 * 8);
+    // 4 x 3 cells of 8 px, plus the colour bar, the title and the legend.
+    assert!(height > 3 * 8 + 30, "{height}");
     assert!(width > 4 * 8);
+}
+
+#[test]
+fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
+    let dir = tempdir("misses");
+    let out = graspopt(&[
+        "scan",
+        "--object",
+        "sphere",
+        "--axes",
+        "x,y",
+        "--steps",
+        "6,5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // CSV: a grasp that touched nothing has empty metric cells, never NaN.
+    let csv = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.csv")).unwrap();
+    assert!(!csv.contains("NaN"), "{csv}");
+    let misses: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(6) == Some("0"))
+        .collect();
+    assert!(!misses.is_empty() && misses.len() < 30, "{csv}");
+    for l in &misses {
+        let f: Vec<&str> = l.split(',').collect();
+        assert_eq!(f[3..6], ["", "", ""], "{l}");
+    }
+    // SVG: grey cells, one per miss, and a legend saying what grey means.
+    let svg = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.svg")).unwrap();
+    assert_eq!(
+        svg.matches(r#"fill="rgb(128,128,128)"/>"#).count(),
+        misses.len(),
+        "{svg}"
+    );
+    assert!(svg.contains("grey: no contact"), "{svg}");
+    // PNG: the same grey, a title above the map and a legend below it.
+    let (w, h, px) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
+    assert!(h > 5 * 8 + 30 && w >= 6 * 8, "{w} x {h}");
+    let grey = px.iter().filter(|c| **c == [128, 128, 128]).count();
+    // 8 x 8 pixels per missing cell, and the legend's square.
+    assert_eq!(grey, 64 * misses.len() + 64);
+    assert!(px.iter().filter(|c| **c == [20, 20, 20]).count() > 200);
 }
 
 /// Runs `graspopt experiment ARGS --out DIR`, checks it succeeded and that its report has
