@@ -42,7 +42,10 @@ fn run_pictures_show_the_best_grasp_and_keep_misses_off_the_scale() {
         .skip(1)
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
-            (f[col("score")].parse().unwrap(), f[col("contacts")].parse().unwrap())
+            (
+                f[col("score")].parse().unwrap(),
+                f[col("contacts")].parse().unwrap(),
+            )
         })
         .collect();
     assert_eq!(rows.len(), 12);
@@ -61,7 +64,10 @@ fn run_pictures_show_the_best_grasp_and_keep_misses_off_the_scale() {
     let ticks = y_ticks(&best);
     assert_eq!(ticks.len(), 5, "{best}");
     let bottom = ticks.iter().copied().fold(f64::INFINITY, f64::min);
-    assert!(bottom > highest_miss, "axis from {bottom}: misses set the scale");
+    assert!(
+        bottom > highest_miss,
+        "axis from {bottom}: misses set the scale"
+    );
     assert!(
         bottom <= lowest_hit && lowest_hit - bottom < 0.1,
         "{bottom} {lowest_hit}"
@@ -82,7 +88,9 @@ fn run_pictures_show_the_best_grasp_and_keep_misses_off_the_scale() {
     // best.png: the best grasp, titled, with its contacts.
     let (w, h, px) = decode_png(&out.join("best.png"));
     assert_eq!((w, h), (1200, 560));
-    let title_text = (0..24 * w as usize).filter(|&i| px[i] == [20, 20, 20]).count();
+    let title_text = (0..24 * w as usize)
+        .filter(|&i| px[i] == [20, 20, 20])
+        .count();
     assert!(title_text > 100, "no title: {title_text} text pixels");
     assert!(px.contains(&[230, 20, 20]), "no contact dots");
     std::fs::remove_dir_all(&dir).unwrap();
