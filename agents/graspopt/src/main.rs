@@ -1,5 +1,7 @@
 //! `graspopt`: the one command users install. Each subcommand lives in `commands/` and
-//! wires a library crate to files and the terminal.
+//! wires a library crate to files and the terminal. Stdout is written only through
+//! `out::outln!` and `out::stdout`, so that a closed pipe ends a command quietly.
+#![warn(clippy::print_stdout)]
 
 use std::process::ExitCode;
 
@@ -8,6 +10,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
 mod export;
+mod out;
 mod render;
 
 #[derive(Parser, Debug)]
@@ -112,9 +115,60 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // `graspopt ... | head -1`: the reader has what it wanted.
+        Err(err) if out::reader_gone(&err) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("graspopt: {err:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The flags (and positional arguments) of `cmd` and its subcommands, recursively, that
+    /// have no help text, as `graspopt sub --flag`; subcommands without a description too.
+    fn undocumented(cmd: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        for arg in cmd.get_arguments() {
+            let id = arg.get_id().as_str();
+            if id == "help" || id == "version" {
+                continue;
+            }
+            if arg.get_help().is_none() && arg.get_long_help().is_none() {
+                let name = arg.get_long().map_or(id.to_string(), |l| format!("--{l}"));
+                missing.push(format!("{path} {name}"));
+            }
+        }
+        for sub in cmd.get_subcommands() {
+            let sub_path = format!("{path} {}", sub.get_name());
+            if sub.get_about().is_none() && sub.get_long_about().is_none() {
+                missing.push(format!("{sub_path} (the subcommand)"));
+            }
+            undocumented(sub, &sub_path, missing);
+        }
+    }
+
+    #[test]
+    fn every_flag_of_every_subcommand_has_a_help_text() {
+        let mut cmd = Cli::command();
+        cmd.build();
+        let mut missing = Vec::new();
+        undocumented(&cmd, "graspopt", &mut missing);
+        assert!(
+            missing.is_empty(),
+            "without a help text:\n{}",
+            missing.join("\n")
+        );
+        // The walk sees nested subcommands and flattened flag sets.
+        let agent = cmd.find_subcommand("agent").unwrap();
+        let coordinator = agent.find_subcommand("coordinator").unwrap();
+        assert!(
+            coordinator
+                .get_arguments()
+                .any(|a| a.get_id() == "lease_ms")
+        );
+        assert!(coordinator.get_arguments().any(|a| a.get_id() == "connect"));
     }
 }

@@ -1,6 +1,7 @@
 //! Raster pictures (PNG) of grasp scenes and scan maps: a small software rasteriser (filled
 //! triangles, z-buffer, Lambert shading from a fixed light, orthographic views), written with
-//! the pure-Rust `png` crate. No fonts: pictures carry no text.
+//! the pure-Rust `png` crate. Titles and labels use the 8 x 8 bitmap font of `font8x8` (ASCII),
+//! so no font files are needed.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -26,6 +27,48 @@ pub const MISSING_COLOUR: [u8; 3] = [128, 128, 128];
 pub const BAR_GAP: u32 = 4;
 /// Width of a heatmap's colour bar (pixels).
 pub const BAR_WIDTH: u32 = 12;
+
+/// Colour of titles and labels.
+pub const TEXT_COLOUR: [u8; 3] = [20, 20, 20];
+
+/// Width in pixels of `text` drawn at `scale` (8 x 8 font pixels per character, each a
+/// `scale` x `scale` square).
+pub fn text_width(text: &str, scale: u32) -> u32 {
+    text.chars().count() as u32 * 8 * scale
+}
+
+/// Draws `text` with its top left corner at `(x, y)`, each font pixel a `scale` x `scale`
+/// square; characters outside ASCII show as `?`, and what falls outside the picture is cut.
+pub fn draw_text(img: &mut Image, (x, y): (i64, i64), text: &str, scale: u32, c: [u8; 3]) {
+    let s = i64::from(scale.max(1));
+    for (k, ch) in text.chars().enumerate() {
+        let glyph = font8x8::legacy::BASIC_LEGACY[if ch.is_ascii() {
+            ch as usize
+        } else {
+            '?' as usize
+        }];
+        let left = x + k as i64 * 8 * s;
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8 {
+                if bits & (1 << col) == 0 {
+                    continue;
+                }
+                let (px, py) = (left + col * s, y + row as i64 * s);
+                for dy in 0..s {
+                    for dx in 0..s {
+                        img.set(px + dx, py + dy, c);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`draw_text`] centred on the column `centre`.
+pub fn draw_text_centred(img: &mut Image, centre: i64, y: i64, text: &str, scale: u32) {
+    let x = centre - i64::from(text_width(text, scale)) / 2;
+    draw_text(img, (x, y), text, scale, TEXT_COLOUR);
+}
 
 /// An RGB picture, rows from the top, `pixels[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,6 +99,16 @@ impl Image {
     pub fn set(&mut self, x: i64, y: i64, c: [u8; 3]) {
         if x >= 0 && y >= 0 && x < i64::from(self.width) && y < i64::from(self.height) {
             self.pixels[y as usize * self.width as usize + x as usize] = c;
+        }
+    }
+
+    /// Copies `other` with its top left corner at `(x, y)` (what falls outside is cut).
+    pub fn blit(&mut self, other: &Image, (x, y): (i64, i64)) {
+        for row in 0..other.height {
+            for col in 0..other.width {
+                let c = other.pixels[row as usize * other.width as usize + col as usize];
+                self.set(x + i64::from(col), y + i64::from(row), c);
+            }
         }
     }
 
@@ -263,6 +316,37 @@ pub fn render_grasp(
     img
 }
 
+/// Height of the strip above a preview's views, for its title and the views' labels.
+pub const PREVIEW_HEADER: u32 = 60;
+/// What each view of [`render_grasp`] shows, as labelled in previews.
+pub const VIEW_LABELS: [&str; 2] = ["along the approach axis", "from the side"];
+
+/// A grasp picture (`width` x `height`): `title` at the top, the two views of
+/// [`render_grasp`] below it, each labelled (see [`VIEW_LABELS`]).
+pub fn preview(
+    meshes: &[(&TriangleMesh, [u8; 3])],
+    contacts: &[ContactPoint],
+    (width, height): (u32, u32),
+    title: &str,
+) -> Image {
+    let header = PREVIEW_HEADER.min(height);
+    let scene = render_grasp(meshes, contacts, width, height - header);
+    let mut img = Image::new(width, height, BACKGROUND);
+    img.blit(&scene, (0, i64::from(header)));
+    // Large text where it fits, small where it does not.
+    let scale = |text: &str, room: u32| if text_width(text, 2) <= room { 2 } else { 1 };
+    let mid = i64::from(width / 2);
+    draw_text_centred(&mut img, mid, 8, title, scale(title, width));
+    for (i, label) in VIEW_LABELS.iter().enumerate() {
+        let centre = i64::from(width / 4) * (2 * i as i64 + 1);
+        draw_text_centred(&mut img, centre, 36, label, scale(label, width / 2));
+    }
+    for y in 32..i64::from(height) {
+        img.set(mid, y, SEPARATOR);
+    }
+    img
+}
+
 /// Fills a projected triangle (pixel x, pixel y, depth per corner) where it is nearer than
 /// the depth buffer, within the columns `cols` (half-open).
 fn fill_triangle(
@@ -393,6 +477,63 @@ pub fn heatmap_png(z: &[Vec<f64>], cell: u32) -> Image {
         for x in bx..w {
             img.set(i64::from(x), i64::from(y), c);
         }
+    }
+    img
+}
+
+/// [`heatmap_png`] as a figure: `title` above the map and a legend below it, the colour
+/// bar's range and, when some cell is not finite, a grey square with `missing` (what grey
+/// means). The figure is at least as wide as its text.
+pub fn heatmap_figure(z: &[Vec<f64>], cell: u32, title: &str, missing: &str) -> Image {
+    const MARGIN: u32 = 8;
+    const LINE: u32 = 14;
+    let map = heatmap_png(z, cell);
+    let finite = z.iter().flatten().copied().filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let bar = if lo <= hi {
+        format!("colour bar: {lo:.3} (bottom) to {hi:.3} (top)")
+    } else {
+        "no finite value".to_string()
+    };
+    let any_missing = z.iter().flatten().any(|v| !v.is_finite());
+    // The grey legend's text starts after a square and a space.
+    let swatch = 12;
+    let text_w = text_width(&bar, 1).max(if any_missing {
+        swatch + text_width(missing, 1)
+    } else {
+        0
+    });
+    let title_scale = if text_width(title, 2) <= map.width.max(text_w) {
+        2
+    } else {
+        1
+    };
+    let inner = map.width.max(text_w).max(text_width(title, title_scale));
+    let title_h = 8 * title_scale;
+    let map_y = MARGIN + title_h + MARGIN;
+    let legend_y = map_y + map.height + MARGIN;
+    let lines = if any_missing { 2 } else { 1 };
+    let mut img = Image::new(
+        inner + 2 * MARGIN,
+        legend_y + lines * LINE + MARGIN,
+        BACKGROUND,
+    );
+    let centre = i64::from(img.width / 2);
+    draw_text_centred(&mut img, centre, i64::from(MARGIN), title, title_scale);
+    img.blit(&map, (i64::from(MARGIN), i64::from(map_y)));
+    let left = i64::from(MARGIN);
+    draw_text(&mut img, (left, i64::from(legend_y)), &bar, 1, TEXT_COLOUR);
+    if any_missing {
+        let y = i64::from(legend_y + LINE);
+        for dy in 0..8 {
+            for dx in 0..8 {
+                img.set(left + dx, y + dy, MISSING_COLOUR);
+            }
+        }
+        let x = left + i64::from(swatch);
+        draw_text(&mut img, (x, y), missing, 1, TEXT_COLOUR);
     }
     img
 }

@@ -432,13 +432,23 @@ fn topic_rate_windows_below_three_messages_are_refused() {
 }
 
 #[test]
-fn router_refuses_other_modes() {
-    for mode in ["client", "peer"] {
-        let args = ["router", "--mode", mode, "--listen", "tcp/127.0.0.1:0"];
+fn router_has_no_agent_flags() {
+    // A router is always a router and never uses shared memory: those agent flags are
+    // unknown to it (clap's usage error, status 2), and it does not start.
+    for flags in [
+        vec!["--mode", "client"],
+        vec!["--mode", "router"],
+        vec!["--shm-prefix", "p"],
+        vec!["--no-shm"],
+    ] {
+        let mut args = vec!["router", "--listen", "tcp/127.0.0.1:0"];
+        args.extend(&flags);
         let out = graspopt_within(&args, Duration::from_secs(20))
-            .unwrap_or_else(|| panic!("`graspopt router --mode {mode}` kept running"));
-        assert_refused(&out, &args, &[&format!("--mode {mode}"), "router"]);
-        assert!(!String::from_utf8_lossy(&out.stderr).contains("listening"));
+            .unwrap_or_else(|| panic!("`graspopt {}` kept running", args.join(" ")));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(flags[0]), "{args:?}: {stderr}");
+        assert!(!stderr.contains("listening"), "{args:?}: {stderr}");
     }
 }
 

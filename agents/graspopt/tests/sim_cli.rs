@@ -17,9 +17,13 @@ fn trial_prints_contacts_and_metrics() {
     );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(e["params"], serde_json::json!([-0.1]));
-    let m = &e["score"]["metrics"];
+    // The score and what it was computed from sit at the top level, not nested.
+    let m = &e["metrics"];
     assert_eq!(m["force_closure"], true);
-    assert_eq!(e["score"]["score"], m["bw"]);
+    assert!(e["score"].is_f64(), "{e}");
+    assert_eq!(e["score"], m["bw"]);
+    assert!(e["contacts"].as_u64().unwrap() > 0, "{e}");
+    assert_eq!(e["fingers_in_contact"], 3);
     assert_eq!(e["outcome"]["fingers"].as_array().unwrap().len(), 3);
     let text = graspopt(&["trial", "--object", "sphere", "--at", "x=-0.1"]);
     let text = String::from_utf8(text.stdout).unwrap();
@@ -117,9 +121,58 @@ fn scan_2d_writes_a_png_heatmap_too() {
         String::from_utf8_lossy(&out.stderr)
     );
     let (width, height, _) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
-    // 4 x 3 cells of 8 px, plus the colour bar.
-    assert_eq!(height, 3 * 8);
+    // 4 x 3 cells of 8 px, plus the colour bar, the title and the legend.
+    assert!(height > 3 * 8 + 30, "{height}");
     assert!(width > 4 * 8);
+}
+
+#[test]
+fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
+    let dir = tempdir("misses");
+    let out = graspopt(&[
+        "scan",
+        "--object",
+        "sphere",
+        "--axes",
+        "x,y",
+        "--steps",
+        "6,5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // CSV: a grasp that touched nothing has empty metric cells, never NaN.
+    let csv = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.csv")).unwrap();
+    assert!(!csv.contains("NaN"), "{csv}");
+    let misses: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(6) == Some("0"))
+        .collect();
+    assert!(!misses.is_empty() && misses.len() < 30, "{csv}");
+    for l in &misses {
+        let f: Vec<&str> = l.split(',').collect();
+        assert_eq!(f[3..6], ["", "", ""], "{l}");
+    }
+    // SVG: grey cells, one per miss, and a legend saying what grey means.
+    let svg = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.svg")).unwrap();
+    assert_eq!(
+        svg.matches(r#"fill="rgb(128,128,128)"/>"#).count(),
+        misses.len(),
+        "{svg}"
+    );
+    assert!(svg.contains("grey: no contact"), "{svg}");
+    // PNG: the same grey, a title above the map and a legend below it.
+    let (w, h, px) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
+    assert!(h > 5 * 8 + 30 && w >= 6 * 8, "{w} x {h}");
+    let grey = px.iter().filter(|c| **c == [128, 128, 128]).count();
+    // 8 x 8 pixels per missing cell, and the legend's square.
+    assert_eq!(grey, 64 * misses.len() + 64);
+    assert!(px.iter().filter(|c| **c == [20, 20, 20]).count() > 200);
 }
 
 /// Runs `graspopt experiment ARGS --out DIR`, checks it succeeded and that its report has

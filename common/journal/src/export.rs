@@ -26,8 +26,10 @@ const RESULT_COLUMNS: [&str; 11] = [
 ///
 /// Header: `trial,state,attempts,worker,issued_ms,completed_ms,<param
 /// names...>,score,rank,force_closure,epsilon,volume,distance,bw,contacts,
-/// fingers_in_contact,cloud_points,error`. A `None` is an empty field, and so
-/// are the result columns of a trial without a result. Numbers are written
+/// fingers_in_contact,cloud_points,error`, without `volume` when no trial has
+/// one (only runs scored by the volume compute it). A missing value (`None`)
+/// is an empty field, and so are the result columns of a trial without a
+/// result. Numbers are written
 /// so that they parse back to the same f64. Fields containing a comma, a
 /// double quote, CR or LF are quoted per RFC 4180; lines end with `\n`.
 /// An unknown run is [`crate::JournalError::UnknownRun`].
@@ -42,13 +44,17 @@ pub fn write_csv(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result
         "completed_ms",
     ];
     header.extend(export.run.param_names.iter().map(String::as_str));
-    header.extend(RESULT_COLUMNS);
+    let volume = export
+        .trials
+        .iter()
+        .any(|t| t.metrics.as_ref().is_some_and(|m| m.volume.is_some()));
+    header.extend(RESULT_COLUMNS.iter().filter(|&&c| volume || c != "volume"));
     let mut line = String::new();
     push_record(&mut line, header.iter().map(|h| Cow::Borrowed(*h)));
     out.write_all(line.as_bytes())?;
     for trial in &export.trials {
         line.clear();
-        push_record(&mut line, trial_fields(trial));
+        push_record(&mut line, trial_fields(trial, volume));
         out.write_all(line.as_bytes())?;
     }
     out.flush()?;
@@ -76,7 +82,8 @@ fn opt<T: std::fmt::Debug>(v: Option<T>) -> Cow<'static, str> {
     v.map_or(Cow::Borrowed(""), num)
 }
 
-fn trial_fields(t: &TrialRow) -> Vec<Cow<'_, str>> {
+/// The CSV fields of `t`, with the `volume` field if `volume`.
+fn trial_fields(t: &TrialRow, volume: bool) -> Vec<Cow<'_, str>> {
     let mut f: Vec<Cow<'_, str>> = vec![
         num(t.trial_id),
         Cow::Borrowed(t.state.as_str()),
@@ -92,7 +99,9 @@ fn trial_fields(t: &TrialRow) -> Vec<Cow<'_, str>> {
     f.push(opt(m.map(|m| m.rank)));
     f.push(opt(m.map(|m| m.force_closure)));
     f.push(opt(m.map(|m| m.epsilon)));
-    f.push(opt(m.and_then(|m| m.volume)));
+    if volume {
+        f.push(opt(m.and_then(|m| m.volume)));
+    }
     f.push(opt(m.map(|m| m.distance)));
     f.push(opt(m.map(|m| m.bw)));
     f.push(opt(has_result.then_some(t.contacts)));

@@ -946,6 +946,34 @@ fn csv_export_fields() {
 }
 
 #[test]
+fn csv_export_leaves_out_a_volume_no_trial_has() {
+    // Runs not scored by the volume never compute it: no always-empty column.
+    let mut j = journal_with_run();
+    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    let mut r1 = result(RUN, 1, 1, "w1", 250, 0.5);
+    r1.metrics.as_mut().unwrap().volume = None;
+    j.record_result(&r1).unwrap();
+    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+    let mut out = Vec::new();
+    write_csv(&j, RUN, &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    let records = parse_csv(&text);
+    assert_eq!(records.len(), 3, "{text}");
+    assert!(!records[0].contains(&"volume".to_string()), "{text}");
+    assert!(records.iter().all(|r| r.len() == 19), "{records:?}");
+    let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
+    let m = metrics_for(1);
+    assert_eq!(records[1][column("epsilon")], format!("{:?}", m.epsilon));
+    assert_eq!(records[1][column("distance")], format!("{:?}", m.distance));
+    assert_eq!(records[1][column("contacts")], "7");
+    assert!(
+        records[2][column("score")..column("error")]
+            .iter()
+            .all(String::is_empty)
+    );
+}
+
+#[test]
 fn json_export_parses_back() {
     let mut j = journal_with_run();
     j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();

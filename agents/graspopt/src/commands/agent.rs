@@ -10,10 +10,12 @@ use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::RunId;
+use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use super::run::Method;
 use super::setup::{SimArgs, param_kind};
+use crate::out::outln;
 
 #[derive(Args, Debug)]
 pub struct AgentArgs {
@@ -26,8 +28,9 @@ pub struct Common {
     /// The run to join.
     #[arg(long, default_value = "run")]
     pub run: String,
-    /// Settings file (TOML).
-    #[arg(long)]
+    /// Settings file (TOML; its keys, with an example per agent: docs/agent-config.md).
+    /// Flags given win over it.
+    #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Agent id (unique per run and kind).
     #[arg(long)]
@@ -42,7 +45,8 @@ pub enum Kind {
     Perception {
         #[command(flatten)]
         common: Common,
-        /// Built-in object.
+        /// Built-in object: sphere, wine_glass, cylinder, mug, cuboid, rotated_cuboid,
+        /// star_prism (default: mug).
         #[arg(long)]
         object: Option<String>,
         /// A user mesh (OBJ/STL).
@@ -51,10 +55,14 @@ pub enum Kind {
         /// Factor from the mesh file's units to metres (0.001 for millimetres).
         #[arg(long, requires = "mesh")]
         mesh_scale: Option<f64>,
+        /// Position error of the estimate, standard deviation per axis (metres; default 0).
         #[arg(long)]
         position_noise: Option<f64>,
+        /// Orientation error of the estimate, standard deviation per axis (radians; default
+        /// 0).
         #[arg(long)]
         rotation_noise: Option<f64>,
+        /// Seed of the estimate's noise (default 0).
         #[arg(long)]
         seed: Option<u64>,
     },
@@ -104,12 +112,18 @@ pub enum Kind {
             value_delimiter = ','
         )]
         params: Vec<String>,
+        /// How trials are proposed.
         #[arg(long, value_enum, default_value_t = Method::Bo)]
         method: Method,
+        /// Size of the initial design (space-filling, not model-based) (default: the
+        /// engine's).
         #[arg(long)]
         initial: Option<u32>,
+        /// Seed of the planner's random choices (the same seed proposes the same trials).
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Lease of a trial: re-issued if no result comes within this time (milliseconds;
+        /// default 30000).
         #[arg(long)]
         lease_ms: Option<u64>,
         /// Continue the run recorded in the journal, with its recorded settings.
@@ -118,16 +132,57 @@ pub enum Kind {
     },
 }
 
-/// Reads a TOML settings file (defaults when none).
-pub fn load<T: DeserializeOwned + Default>(path: Option<&Path>) -> Result<T> {
-    match path {
-        None => Ok(T::default()),
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .with_context(|| format!("cannot read the settings file {}", p.display()))?;
-            toml::from_str(&text).with_context(|| format!("settings file {}", p.display()))
+/// Reads a TOML settings file (defaults when none): keys left out keep their defaults, and a
+/// key the settings do not have is refused, naming the keys of its table (the settings'
+/// format: docs/agent-config.md).
+pub fn load<T: DeserializeOwned + Serialize + Default>(path: Option<&Path>) -> Result<T> {
+    let Some(p) = path else {
+        return Ok(T::default());
+    };
+    let text = std::fs::read_to_string(p)
+        .with_context(|| format!("cannot read the settings file {}", p.display()))?;
+    let context = || format!("settings file {}", p.display());
+    let table: toml::Table = toml::from_str(&text).with_context(context)?;
+    // Every key, with `null` for the settings that are none by default.
+    let known = serde_json::to_value(T::default())?;
+    unknown_key(&table, &known, "")
+        .map_or(Ok(()), |e| Err(anyhow::anyhow!(e)))
+        .with_context(context)?;
+    toml::from_str(&text).with_context(context)
+}
+
+/// The first key of `table` (at `path`, a dotted table name, empty at the top) that
+/// `known` (the settings' defaults as JSON) does not have, as a message listing the keys
+/// there; tables are checked recursively where the default is a table too.
+fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Option<String> {
+    let serde_json::Value::Object(keys) = known else {
+        return None;
+    };
+    for (key, value) in table {
+        let Some(default) = keys.get(key) else {
+            let names: Vec<&str> = keys.keys().map(String::as_str).collect();
+            let place = if path.is_empty() {
+                "at the top level".to_string()
+            } else {
+                format!("in [{path}]")
+            };
+            return Some(format!(
+                "unknown key `{key}` {place}; the keys there are {}",
+                names.join(", ")
+            ));
+        };
+        if let toml::Value::Table(inner) = value {
+            let inner_path = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            if let Some(e) = unknown_key(inner, default, &inner_path) {
+                return Some(e);
+            }
         }
     }
+    None
 }
 
 /// Resolves on Ctrl-C or SIGTERM.
@@ -297,7 +352,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 shutdown_signal(),
             )
             .await?;
-            println!("{}", serde_json::to_string(&status)?);
+            outln!("{}", serde_json::to_string(&status)?)?;
             // 130: the shell's code for a command stopped by Ctrl-C.
             Ok(if status.phase == graspopt_protocol::RunPhase::Finished {
                 ExitCode::SUCCESS
@@ -312,4 +367,79 @@ async fn join(common: &Common) -> Result<(Bus, RunId)> {
     let run = RunId::new(&common.run)?;
     let bus = Bus::open(&common.bus).await?;
     Ok((bus, run))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The TOML example under the heading `## {kind}` of docs/agent-config.md.
+    fn documented(kind: &str) -> String {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/agent-config.md");
+        let doc = std::fs::read_to_string(path).unwrap();
+        let section = doc.split(&format!("\n## {kind}\n")).nth(1).unwrap();
+        let block = section.split("```toml\n").nth(1).unwrap();
+        block.split("```").next().unwrap().to_string()
+    }
+
+    fn load_text<T: DeserializeOwned + Serialize + Default>(name: &str, text: &str) -> Result<T> {
+        let dir = std::env::temp_dir().join(format!("graspopt-config-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        load(Some(&path))
+    }
+
+    #[test]
+    fn the_documented_settings_files_are_the_defaults() {
+        fn check<T>(kind: &str)
+        where
+            T: DeserializeOwned + Serialize + Default + PartialEq + std::fmt::Debug,
+        {
+            let loaded: T = load_text(&format!("{kind}.toml"), &documented(kind))
+                .unwrap_or_else(|e| panic!("{kind}: {e:#}"));
+            assert_eq!(loaded, T::default(), "{kind}");
+        }
+        check::<graspopt_perception::PerceptionConfig>("perception");
+        check::<graspopt_hand::HandConfig>("hand");
+        check::<graspopt_metric::MetricConfig>("metric");
+        check::<graspopt_planner::PlannerConfig>("planner");
+        check::<CoordinatorConfig>("coordinator");
+    }
+
+    #[test]
+    fn an_unknown_key_is_refused_with_the_keys_of_its_table() {
+        let err = load_text::<graspopt_hand::HandConfig>("h.toml", "trial_cost = 5\n").unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(msg.contains("h.toml"), "{msg}");
+        assert!(
+            msg.contains("unknown key `trial_cost` at the top level"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("hand, id, mesh, object, replay, trial_cost_ms"),
+            "{msg}"
+        );
+        // In a table, the table's own keys.
+        let text = documented("metric").replace("include_palm = true", "include_palms = true");
+        let err = load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("unknown key `include_palms` in [score]"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("contacts, frame, include_palm, metric, model, torque_scale"),
+            "{msg}"
+        );
+        let text = documented("metric").replace("spacing = ", "spaceing = ");
+        let msg = format!(
+            "{:#}",
+            load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err()
+        );
+        assert!(msg.contains("`spaceing` in [contacts.cloud]"), "{msg}");
+        // Keys left out keep their defaults; flags of other kinds are not keys.
+        let c: graspopt_hand::HandConfig = load_text("h.toml", "trial_cost_ms = 5\n").unwrap();
+        assert_eq!((c.trial_cost_ms, c.hand.as_str()), (5, "barrett"));
+    }
 }

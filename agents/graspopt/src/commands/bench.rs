@@ -19,6 +19,7 @@ use tokio::sync::watch;
 
 use super::run::{Embedded, Method, RunArgs, placeholder, run_embedded};
 use super::setup::SimArgs;
+use crate::out::outln;
 
 /// The most hand workers of one throughput run.
 pub const MAX_WORKERS: usize = 256;
@@ -207,10 +208,10 @@ async fn pipeline(
     overhead_trials: u64,
     method: Method,
 ) -> Result<()> {
-    println!("## Throughput: simulated trial cost {cost} ms, cylinder, 2D, {method:?} proposals");
-    println!();
-    println!("| workers | trials | seconds | trials/s | speed-up | speed-up / workers |");
-    println!("|---|---|---|---|---|---|");
+    outln!("## Throughput: simulated trial cost {cost} ms, cylinder, 2D, {method:?} proposals")?;
+    outln!()?;
+    outln!("| workers | trials | seconds | trials/s | speed-up | speed-up / workers |")?;
+    outln!("|---|---|---|---|---|---|")?;
     let mut base: Option<f64> = None;
     for &w in workers {
         let trials = per_worker * w as u64;
@@ -229,14 +230,14 @@ async fn pipeline(
         let span = (last - first).max(1) as f64 / 1e3;
         let rate = rows.len() as f64 / span;
         let b = *base.get_or_insert(rate);
-        println!(
+        outln!(
             "| {w} | {trials} | {span:.2} | {rate:.2} | {:.2} | {:.2} |",
             rate / b,
             rate / b / w as f64
-        );
+        )?;
     }
-    println!();
-    println!("## Overhead per trial: one worker, zero trial cost, {overhead_trials} trials");
+    outln!()?;
+    outln!("## Overhead per trial: one worker, zero trial cost, {overhead_trials} trials")?;
     let e = embedded("overhead", 1, overhead_trials, 0, Method::Random)?;
     let (_, times) = timed_run(&e).await?;
     let mut cycles: Vec<f64> = times
@@ -255,10 +256,10 @@ async fn pipeline(
         direct.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let direct = median(&mut direct);
-    println!();
-    println!("| median cycle (ms) | median direct trial (ms) | overhead (ms) |");
-    println!("|---|---|---|");
-    println!("| {cycle:.3} | {direct:.3} | {:.3} |", cycle - direct);
+    outln!()?;
+    outln!("| median cycle (ms) | median direct trial (ms) | overhead (ms) |")?;
+    outln!("|---|---|---|")?;
+    outln!("| {cycle:.3} | {direct:.3} | {:.3} |", cycle - direct)?;
     Ok(())
 }
 
@@ -334,14 +335,14 @@ async fn cloud_latency(shm: bool, points: usize, messages: usize) -> Result<(Clo
 }
 
 async fn clouds(points: usize, messages: usize) -> Result<()> {
-    println!(
+    outln!(
         "## Contact clouds, hand -> metric on one host: {points} points ({} bytes encoded), {messages} messages",
         graspopt_protocol::encode(
             &cloud_message(&RunId::new("x")?, 0, points),
             graspopt_protocol::Encoding::Bincode
         )?
         .len()
-    );
+    )?;
     // What both paths share: encoding on the hand's side, decoding (with validation) on the
     // metric's.
     let msg = cloud_message(&RunId::new("bench-clouds")?, 0, points);
@@ -358,11 +359,11 @@ async fn clouds(points: usize, messages: usize) -> Result<()> {
     }
     let (enc, dec) = (median(&mut enc), median(&mut dec));
     let codec = enc + dec;
-    println!();
-    println!("Encoding (bincode) median {enc:.0} µs, decoding with validation median {dec:.0} µs.");
-    println!();
-    println!("| path | median (µs) | p90 (µs) | median minus encode + decode ({codec:.0} µs) |");
-    println!("|---|---|---|---|");
+    outln!()?;
+    outln!("Encoding (bincode) median {enc:.0} µs, decoding with validation median {dec:.0} µs.")?;
+    outln!()?;
+    outln!("| path | median (µs) | p90 (µs) | median minus encode + decode ({codec:.0} µs) |")?;
+    outln!("|---|---|---|---|")?;
     for shm in [true, false] {
         let (path, mut lat) = cloud_latency(shm, points, messages).await?;
         let med = median(&mut lat);
@@ -370,11 +371,11 @@ async fn clouds(points: usize, messages: usize) -> Result<()> {
             .get((lat.len() * 9 / 10).min(lat.len().saturating_sub(1)))
             .copied()
             .unwrap_or(f64::NAN);
-        println!(
+        outln!(
             "| {} | {med:.0} | {p90:.0} | {:.0} |",
             path.as_str(),
             med - codec
-        );
+        )?;
     }
     Ok(())
 }

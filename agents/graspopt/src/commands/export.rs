@@ -25,6 +25,7 @@ pub struct ExportArgs {
     /// The journal (default: results/<run>/journal.sqlite).
     #[arg(long)]
     pub journal: Option<PathBuf>,
+    /// csv (one row per trial; a missing value is an empty cell) or json.
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
     /// Output file (default: standard output). Must not be the journal; an existing file is
@@ -56,7 +57,7 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
     match &args.output {
         Some(p) => write_replacing(p, &bytes)?,
         None => {
-            let mut out = std::io::stdout().lock();
+            let mut out = crate::out::stdout();
             out.write_all(&bytes)?;
             out.flush()?;
         }

@@ -21,6 +21,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::Deserialize;
 
+use crate::out::outln;
+
 #[derive(Args, Debug)]
 pub struct LaunchArgs {
     /// The launch file (TOML).
@@ -316,7 +318,7 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     }
     if args.dry_run {
         for p in &plan {
-            println!("graspopt {}", p.args.join(" "));
+            outln!("graspopt {}", p.args.join(" "))?;
         }
         return Ok(ExitCode::SUCCESS);
     }

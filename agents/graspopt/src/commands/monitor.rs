@@ -23,6 +23,8 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Gauge, Paragraph, Sparkline};
 use tokio::sync::mpsc;
 
+use crate::out::outln;
+
 #[derive(Args, Debug)]
 pub struct MonitorArgs {
     /// Only this run (default: every run with a live coordinator).
@@ -363,14 +365,14 @@ async fn once(bus: &Bus, only: Option<&RunId>) -> Result<()> {
     m.set_alive(&live_runs(bus, only).await);
     ask_states(bus, &mut m).await;
     if m.runs.is_empty() {
-        println!("no runs: no live coordinator (check --connect)");
+        outln!("no runs: no live coordinator (check --connect)")?;
     }
     let now = Instant::now();
     for (name, view) in &m.runs {
         for l in run_lines(name, view, now) {
-            println!("{l}");
+            outln!("{l}")?;
         }
-        println!();
+        outln!()?;
     }
     Ok(())
 }

@@ -10,6 +10,8 @@ use graspopt_bayesopt::benchmark::{
 };
 use serde_json::json;
 
+use crate::out::outln;
+
 /// The most seeds one command runs.
 pub const MAX_SEEDS: u64 = 1000;
 /// The most evaluations per seed.
@@ -126,14 +128,14 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                     "rounds_to": s.rounds_to,
                     "final_regret": s.final_regret,
                 });
-                println!("{line}");
+                outln!("{line}")?;
             }
             FormatArg::Text => {
                 let best: Vec<String> = trace.iter().map(|v| format!("{v:.6}")).collect();
-                println!(
+                outln!(
                     "seed {seed}: best after each evaluation: {}",
                     best.join(" ")
-                );
+                )?;
                 let levels: Vec<String> = REGRET_LEVELS
                     .iter()
                     .enumerate()
@@ -146,11 +148,11 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                         )
                     })
                     .collect();
-                println!(
+                outln!(
                     "seed {seed}: regret {} (final regret {:.3e})",
                     levels.join(", "),
                     s.final_regret
-                );
+                )?;
             }
         }
         summaries.push(s);
@@ -171,7 +173,7 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                     })
                 })
                 .collect();
-            println!(
+            outln!(
                 "{}",
                 json!({
                     "summary": {
@@ -184,7 +186,7 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                         "levels": levels,
                     }
                 })
-            );
+            )?;
         }
         FormatArg::Text => {
             let parts: Vec<String> = agg
@@ -200,12 +202,12 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                     )
                 })
                 .collect();
-            println!(
+            outln!(
                 "summary {} ({}, budget {budget}, initial {n_init}, batch {q}): {}",
                 function.name(),
                 method_name(args.method),
                 parts.join("; ")
-            );
+            )?;
         }
     }
     Ok(())

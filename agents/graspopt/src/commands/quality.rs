@@ -87,7 +87,7 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
             Solver::Clarabel => DistanceSolver::Clarabel,
         },
     };
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::out::stdout();
     let mut failed = 0;
     let written = (|| -> std::io::Result<()> {
         if args.format == Format::Table {
@@ -118,12 +118,7 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
         }
         out.flush()
     })();
-    match written {
-        // A closed pipe (`graspopt quality ... | head`) is the reader's choice, not an error.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(ExitCode::SUCCESS),
-        Err(e) => return Err(e).context("cannot write the results"),
-        Ok(()) => {}
-    }
+    written.context("cannot write the results")?;
     Ok(if failed == 0 {
         ExitCode::SUCCESS
     } else {

@@ -15,6 +15,7 @@ use graspopt_protocol::RunId;
 
 use super::scan::grid;
 use super::setup::SimArgs;
+use crate::out::outln;
 
 #[derive(Args, Debug)]
 pub struct RecordArgs {
@@ -69,10 +70,10 @@ pub fn run(args: &RecordArgs) -> Result<ExitCode> {
         .write_line(&mut out)?;
     }
     out.flush()?;
-    println!(
+    outln!(
         "{total} grasps of the {} written to {}",
         ev.object.name(),
         args.out.display()
-    );
+    )?;
     Ok(ExitCode::SUCCESS)
 }

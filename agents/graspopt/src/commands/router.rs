@@ -1,39 +1,55 @@
 //! `graspopt router`: a Zenoh router for agents on several machines (since Zenoh 1.9 peers do
-//! not relay for each other, so agents across machines connect to a router).
+//! not relay for each other, so agents across machines connect to a router). It has its own
+//! flags: the agents' `--mode` and shared-memory flags do not apply to a router.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use graspopt_bus::{Bus, BusArgs, BusMode};
 
+/// Where the router listens when neither `--listen` nor `--zenoh-config` says.
+const DEFAULT_LISTEN: &str = "tcp/0.0.0.0:7447";
+
 #[derive(Args, Debug)]
-#[command(after_help = "A router always runs in router mode: `--mode` may only be `router`.")]
 pub struct RouterArgs {
-    #[command(flatten)]
-    pub bus: BusArgs,
+    /// Endpoint to listen on, e.g. `tcp/0.0.0.0:7447` (the default); repeatable.
+    #[arg(short = 'l', long = "listen", value_name = "ENDPOINT")]
+    pub listen: Vec<String>,
+    /// Another router to connect to, e.g. `tcp/192.168.1.10:7447`; repeatable.
+    #[arg(short = 'e', long = "connect", value_name = "ENDPOINT")]
+    pub connect: Vec<String>,
+    /// A Zenoh configuration file (json5); the flags override it, and the mode is always
+    /// router.
+    #[arg(long = "zenoh-config", value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+    /// Do not look for peers by UDP multicast.
+    #[arg(long)]
+    pub no_multicast_scouting: bool,
 }
 
-/// Errors on a `--mode` other than `router`: this command is a router.
-pub fn check_mode(mode: Option<BusMode>) -> Result<()> {
-    match mode {
-        None | Some(BusMode::Router) => Ok(()),
-        Some(other) => bail!(
-            "--mode {}: `graspopt router` always runs as a router; leave out --mode (peer and \
-             client are modes of the agents)",
-            other.as_str()
-        ),
+impl RouterArgs {
+    /// The bus flags of a router: router mode, never shared memory.
+    pub fn bus(&self) -> BusArgs {
+        let mut listen = self.listen.clone();
+        if listen.is_empty() && self.zenoh_config.is_none() {
+            listen = vec![DEFAULT_LISTEN.to_string()];
+        }
+        BusArgs {
+            connect: self.connect.clone(),
+            listen,
+            mode: Some(BusMode::Router),
+            zenoh_config: self.zenoh_config.clone(),
+            no_multicast_scouting: self.no_multicast_scouting,
+            no_shm: true,
+            ..BusArgs::default()
+        }
     }
 }
 
 pub fn run(args: &RouterArgs) -> Result<ExitCode> {
-    check_mode(args.bus.mode)?;
-    let mut bus = args.bus.clone();
-    bus.mode = Some(BusMode::Router);
-    if bus.listen.is_empty() && bus.zenoh_config.is_none() {
-        bus.listen = vec!["tcp/0.0.0.0:7447".to_string()];
-    }
-    bus.no_shm = true;
+    let bus = args.bus();
     let runtime = tokio::runtime::Runtime::new()?;
     runtime.block_on(async {
         let session = Bus::open(&bus).await?;

@@ -1,8 +1,8 @@
 //! `graspopt run`: a whole optimization in one process. Every agent (perception, planner,
 //! metric, the hand workers, the coordinator) runs as a task on one Zenoh session that listens
 //! on loopback only (no router, no multicast), so `graspopt topic` and `graspopt monitor` can
-//! attach from another terminal. Results go to a folder: the journal, a CSV of every trial and
-//! a plot of the best score so far.
+//! attach from another terminal. Results go to a folder: the journal, every trial as CSV and
+//! JSON, and pictures (the best grasp, the trials on the parameter space, the scores).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -12,12 +12,14 @@ use clap::{Args, ValueEnum};
 use graspopt_bus::{Bus, BusArgs, free_loopback_port};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId, RunPhase, RunStatus};
+use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 
 use super::setup::{Contacts, Frame, SimArgs, param_kind};
 use super::svg;
+use crate::out::outln;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
@@ -63,6 +65,8 @@ pub struct RunArgs {
     /// Size of the initial design (space-filling, not model-based) (default: the engine's).
     #[arg(long)]
     pub initial: Option<u32>,
+    /// Seed of the planner's random choices and of perception's noise (the same seed
+    /// proposes the same trials).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Results folder (default: results/<run>).
@@ -103,6 +107,8 @@ pub struct Embedded {
     pub hand: graspopt_hand::HandConfig,
     pub coordinator: CoordinatorConfig,
     pub bus: BusArgs,
+    /// The trials as simulated here (for the pictures of the results).
+    pub evaluator: graspopt_trial::Evaluator,
 }
 
 /// The settings of an embedded run beyond its spec (the object's mesh, the scoring,
@@ -379,6 +385,7 @@ impl Embedded {
             out,
             run,
             bus,
+            evaluator,
         })
     }
 }
@@ -442,7 +449,7 @@ pub async fn run_embedded(
     status
 }
 
-/// Writes `trials.csv`, `trials.json` and `best.svg` from the journal.
+/// Writes `trials.csv`, `trials.json` and the pictures ([`write_pictures`]) from the journal.
 pub fn write_results(e: &Embedded, status: &RunStatus) -> Result<()> {
     let journal = graspopt_journal::Journal::open(&e.coordinator.journal)?;
     let csv = e.out.join("trials.csv");
@@ -451,16 +458,76 @@ pub fn write_results(e: &Embedded, status: &RunStatus) -> Result<()> {
     let json = e.out.join("trials.json");
     let mut f = std::io::BufWriter::new(std::fs::File::create(&json)?);
     graspopt_journal::export::write_json(&journal, e.run.as_str(), &mut f)?;
-    let xs: Vec<f64> = (1..=status.best_history.len()).map(|i| i as f64).collect();
-    let plot = svg::line_plot(
-        &format!("{}: best score so far", status.object),
-        "trial",
-        "best score",
-        &xs,
-        &status.best_history,
-    );
+    write_pictures(e, &status.object, &journal.export(e.run.as_str())?.trials)
+}
+
+/// The pictures of a run, from its trials: `best.png`, the best grasp drawn as `graspopt
+/// trial --preview` draws it (simulated again at its parameters, on the object's true pose);
+/// `trials.svg`, every trial on the parameter space (the first two parameters); `best.svg`,
+/// each trial's score and the best so far, in the order the trials completed. Trials that
+/// touched nothing are grey and never set a scale.
+fn write_pictures(e: &Embedded, object: &str, trials: &[graspopt_journal::TrialRow]) -> Result<()> {
+    let mut done: Vec<&graspopt_journal::TrialRow> =
+        trials.iter().filter(|t| t.score.is_some()).collect();
+    done.sort_by_key(|t| (t.completed_ms, t.trial_id));
+    // A trial that touched nothing scores below every grasp: `None` on the pictures.
+    let hit = |t: &graspopt_journal::TrialRow| t.score.filter(|_| t.contacts > 0);
+    let scores: Vec<Option<f64>> = done.iter().map(|t| hit(t)).collect();
+    let plot = svg::progress_plot(&format!("{object}: score by trial, best so far"), &scores);
     std::fs::write(e.out.join("best.svg"), plot)?;
-    Ok(())
+
+    let names: Vec<String> = e
+        .spec
+        .params
+        .iter()
+        .map(|k| match k {
+            ParamKind::RotX | ParamKind::RotY | ParamKind::RotZ => format!("{} (rad)", k.name()),
+            _ => format!("{} offset (m)", k.name()),
+        })
+        .collect();
+    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
+    let shown = if names.len() > 2 {
+        format!(" (the first two of {} parameters)", names.len())
+    } else {
+        String::new()
+    };
+    let points: Vec<(Vec<f64>, Option<f64>)> =
+        done.iter().map(|t| (t.params.clone(), hit(t))).collect();
+    let map = svg::trials_map(
+        &format!(
+            "{object}: {} trials on the parameter space{shown}",
+            done.len()
+        ),
+        &labels,
+        &e.evaluator.space.bounds(),
+        &points,
+    );
+    std::fs::write(e.out.join("trials.svg"), map)?;
+
+    let Some(best) = done.iter().max_by(|a, b| {
+        a.score
+            .unwrap_or(f64::NAN)
+            .total_cmp(&b.score.unwrap_or(f64::NAN))
+    }) else {
+        return Ok(());
+    };
+    let grasp = e
+        .evaluator
+        .evaluate(&best.params)
+        .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
+    let words = match (&best.metrics, best.score) {
+        (Some(m), Some(s)) if m.force_closure => format!("score {s:.4}, force closure"),
+        (Some(_), Some(s)) => format!("score {s:.4}"),
+        _ => "no contact".to_string(),
+    };
+    let short: Vec<String> = e.spec.params.iter().map(|k| k.name().to_string()).collect();
+    let title = format!(
+        "run {}, best trial {} at {}: {words}",
+        e.run,
+        best.trial_id,
+        named_params(&short, &best.params, ",")
+    );
+    super::trial::preview_image(&e.evaluator, &grasp, &title)?.save_png(&e.out.join("best.png"))
 }
 
 /// `graspopt run`; `explicit(name)` says whether `--name` was given on the command line.
@@ -514,7 +581,7 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     bar.finish_and_clear();
     write_results(&e, &status)?;
     let stopped = status.phase != RunPhase::Finished;
-    println!(
+    outln!(
         "run {}: {} trials completed, {} failed{}",
         status.run_id,
         status.completed,
@@ -527,16 +594,16 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
         } else {
             String::new()
         }
-    );
+    )?;
     if let Some(b) = &status.best {
-        println!(
+        outln!(
             "best: trial {} score {} at {}",
             b.trial_id,
             b.score,
             named_params(&status.param_names, &b.params, ",")
-        );
+        )?;
     }
-    println!("results: {}", e.out.display());
+    outln!("results: {}", e.out.display())?;
     // 130: the shell's code for a command stopped by Ctrl-C.
     Ok(if stopped {
         ExitCode::from(130)

@@ -15,6 +15,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::setup::{SimArgs, param_kind};
 use super::svg;
+use crate::out::outln;
 
 /// The most points a grid (`--steps` multiplied over the axes) may hold.
 pub const MAX_GRID_POINTS: usize = 10_000_000;
@@ -161,7 +162,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
                 })
                 .collect();
             let png_path = args.out.join(format!("{stem}.png"));
-            crate::render::heatmap_png(&z, 8).save_png(&png_path)?;
+            crate::render::heatmap_figure(&z, 8, &title, svg::MISSING_LABEL).save_png(&png_path)?;
             extra.push(png_path.display().to_string());
             Some(svg::heatmap(
                 &title,
@@ -204,7 +205,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         best.params
     );
     for w in written {
-        println!("{w}");
+        outln!("{w}")?;
     }
     Ok(std::process::ExitCode::SUCCESS)
 }
@@ -230,12 +231,14 @@ fn csv(names: &[&str], points: &[ScanPoint]) -> String {
         for v in &p.params {
             let _ = write!(out, "{v},");
         }
-        let (fc, eps, dist) = p.score.metrics.map_or((false, 0.0, f64::NAN), |m| {
-            (m.force_closure, m.epsilon, m.distance)
-        });
+        // A grasp that touched nothing has no metrics: empty fields, as in trials.csv.
+        let metrics = p.score.metrics.map_or_else(
+            || ",,".to_string(),
+            |m| format!("{},{},{}", m.force_closure, m.epsilon, m.distance),
+        );
         let _ = writeln!(
             out,
-            "{},{fc},{eps},{dist},{},{}",
+            "{},{metrics},{},{}",
             p.score.score, p.score.contacts, p.score.fingers_in_contact
         );
     }

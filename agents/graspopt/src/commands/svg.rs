@@ -481,10 +481,10 @@ pub fn heatmap(
     let ch = (H - BOTTOM - TOP) / ny;
     for (i, column) in z.iter().enumerate() {
         for (j, &v) in column.iter().enumerate() {
-            let (r, g, b) = colour((v - zr.0) / (zr.1 - zr.0));
+            let fill = fill_of(v, zr);
             let _ = writeln!(
                 out,
-                r#"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="rgb({r},{g},{b})"/>"#,
+                r#"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="{fill}"/>"#,
                 LEFT + i as f64 * cw,
                 H - BOTTOM - (j as f64 + 1.0) * ch,
                 cw + 0.3,
@@ -493,8 +493,27 @@ pub fn heatmap(
         }
     }
     axes(&mut out, xr, yr, xlabel, ylabel, width);
-    // Colour bar.
-    let bx = LEFT + width + 20.0;
+    colour_bar(&mut out, LEFT + width + 20.0, zr);
+    if z.iter().flatten().any(|v| !v.is_finite()) {
+        legend(&mut out, &[(Mark::Square(MISSING), MISSING_LABEL)]);
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+/// The SVG colour of a value on the scale `zr`, grey ([`MISSING`]) when it is not finite.
+fn fill_of(v: f64, zr: (f64, f64)) -> String {
+    if v.is_finite() {
+        let (r, g, b) = colour((v - zr.0) / (zr.1 - zr.0));
+        format!("rgb({r},{g},{b})")
+    } else {
+        MISSING.to_string()
+    }
+}
+
+/// A vertical colour bar at column `bx` beside the plot area, `zr.0` at the bottom and
+/// `zr.1` at the top, with both values written.
+fn colour_bar(out: &mut String, bx: f64, zr: (f64, f64)) {
     for k in 0..50 {
         let t = k as f64 / 49.0;
         let (r, g, b) = colour(t);
@@ -515,6 +534,250 @@ pub fn heatmap(
         H - BOTTOM + 16.0,
         zr.0
     );
+}
+
+/// The colour of grasps that touched nothing, in every chart and map (as in the PNG maps).
+pub const MISSING: &str = "rgb(128,128,128)";
+/// What grey means, in legends.
+pub const MISSING_LABEL: &str = "grey: no contact";
+
+/// A legend entry's sign.
+#[derive(Clone, Copy)]
+enum Mark<'a> {
+    /// A filled square of this colour.
+    Square(&'a str),
+    /// A line of this colour.
+    Line(&'a str),
+    /// A dot of this colour.
+    Dot(&'a str),
+    /// A ring of this colour.
+    Ring(&'a str),
+}
+
+/// A legend on one line between the title and the plot area.
+fn legend(out: &mut String, entries: &[(Mark, &str)]) {
+    let y = TOP - 6.0;
+    let mut x = LEFT;
+    for (mark, text) in entries {
+        let _ = match mark {
+            Mark::Square(c) => writeln!(
+                out,
+                r#"<rect x="{x}" y="{}" width="11" height="11" fill="{c}" stroke="black" stroke-width="0.5"/>"#,
+                y - 10.0
+            ),
+            Mark::Line(c) => writeln!(
+                out,
+                r#"<line x1="{x}" y1="{0}" x2="{1}" y2="{0}" stroke="{c}" stroke-width="2"/>"#,
+                y - 4.0,
+                x + 11.0
+            ),
+            Mark::Dot(c) => writeln!(
+                out,
+                r#"<circle cx="{}" cy="{}" r="4" fill="{c}" stroke="black" stroke-width="0.8"/>"#,
+                x + 5.5,
+                y - 4.5
+            ),
+            Mark::Ring(c) => writeln!(
+                out,
+                r#"<circle cx="{}" cy="{}" r="5" fill="none" stroke="{c}" stroke-width="2"/>"#,
+                x + 5.5,
+                y - 4.5
+            ),
+        };
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
+            x + 15.0,
+            escape(text)
+        );
+        // About 6 pixels per character at font size 11.
+        x += 15.0 + 6.0 * text.chars().count() as f64 + 14.0;
+    }
+}
+
+/// The colour of the best-so-far line and of trial dots in run charts.
+const BEST_COLOUR: &str = "rgb(31,119,180)";
+
+/// The scale of the scores of grasps that touched something (misses never set it), padded
+/// by a twentieth.
+fn hit_range(scores: impl Iterator<Item = Option<f64>>) -> (f64, f64) {
+    let (lo, hi) = range(scores.flatten());
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// A run's progress: each trial's score (dots) and the best score so far (a line), against
+/// the trials in the order they completed. `scores[k]` is `None` for a trial that touched
+/// nothing: its score is far below every grasp's, so it is drawn as a grey tick on the
+/// bottom edge and never sets the scale, which spans the scores of the grasps.
+pub fn progress_plot(title: &str, scores: &[Option<f64>]) -> String {
+    let mut out = String::new();
+    header(&mut out, title);
+    let width = W - LEFT - 30.0;
+    let n = scores.len().max(1) as f64;
+    let xr = (1.0, n.max(2.0));
+    let yr = hit_range(scores.iter().copied());
+    axes(
+        &mut out,
+        xr,
+        yr,
+        "trial (in the order completed)",
+        "score",
+        width,
+    );
+    let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
+    let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
+    let mut best: Option<f64> = None;
+    let mut line = Vec::new();
+    for (k, s) in scores.iter().enumerate() {
+        let x = px(k as f64 + 1.0);
+        match s {
+            Some(v) => {
+                best = Some(best.map_or(*v, |b| b.max(*v)));
+                let _ = writeln!(
+                    out,
+                    r#"<circle cx="{x:.2}" cy="{:.2}" r="2.5" fill="{BEST_COLOUR}" fill-opacity="0.45"/>"#,
+                    py(*v)
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    out,
+                    r#"<line x1="{x:.2}" y1="{0}" x2="{x:.2}" y2="{1}" stroke="{MISSING}" stroke-width="2"/>"#,
+                    H - BOTTOM,
+                    H - BOTTOM - 8.0
+                );
+            }
+        }
+        if let Some(b) = best {
+            line.push(format!("{x:.2},{:.2}", py(b)));
+        }
+    }
+    let _ = writeln!(
+        out,
+        r#"<polyline points="{}" fill="none" stroke="{BEST_COLOUR}" stroke-width="2"/>"#,
+        line.join(" ")
+    );
+    legend(
+        &mut out,
+        &[
+            (Mark::Line(BEST_COLOUR), "best so far"),
+            (Mark::Dot(BEST_COLOUR), "a trial's score"),
+            (
+                Mark::Square(MISSING),
+                "grey tick: no contact (below the scale)",
+            ),
+        ],
+    );
+    out.push_str("</svg>\n");
+    out
+}
+
+/// The trials of a run on its parameter space: one dot per trial at its first two
+/// parameters (`bounds` the axes' ranges), coloured by score on the scale of the grasps
+/// that touched something, grey where it touched nothing (`None`), the best ringed in red;
+/// with one parameter, the score against it instead (misses as grey ticks on the bottom edge).
+pub fn trials_map(
+    title: &str,
+    labels: &[&str],
+    bounds: &[(f64, f64)],
+    trials: &[(Vec<f64>, Option<f64>)],
+) -> String {
+    let mut out = String::new();
+    header(&mut out, title);
+    let zr = hit_range(trials.iter().map(|t| t.1));
+    let best = trials
+        .iter()
+        .filter_map(|(p, s)| s.map(|s| (p, s)))
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if bounds.len() < 2 {
+        let width = W - LEFT - 30.0;
+        let xr = bounds.first().copied().unwrap_or((0.0, 1.0));
+        let label = labels.first().copied().unwrap_or("parameter");
+        axes(&mut out, xr, zr, label, "score", width);
+        let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
+        let py = |y: f64| (H - BOTTOM) - (y - zr.0) / (zr.1 - zr.0) * (H - BOTTOM - TOP);
+        for (p, s) in trials {
+            let Some(&x) = p.first() else { continue };
+            let _ = match s {
+                Some(v) => writeln!(
+                    out,
+                    r#"<circle cx="{:.2}" cy="{:.2}" r="4" fill="{BEST_COLOUR}" stroke="black" stroke-width="0.8"/>"#,
+                    px(x),
+                    py(*v)
+                ),
+                None => writeln!(
+                    out,
+                    r#"<line x1="{0:.2}" y1="{1}" x2="{0:.2}" y2="{2}" stroke="{MISSING}" stroke-width="2"/>"#,
+                    px(x),
+                    H - BOTTOM,
+                    H - BOTTOM - 8.0
+                ),
+            };
+        }
+        if let Some((p, s)) = best {
+            let _ = writeln!(
+                out,
+                r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
+                px(p[0]),
+                py(s)
+            );
+        }
+        legend(
+            &mut out,
+            &[
+                (Mark::Dot(BEST_COLOUR), "a trial"),
+                (Mark::Ring("red"), "the best"),
+                (
+                    Mark::Square(MISSING),
+                    "grey tick: no contact (below the scale)",
+                ),
+            ],
+        );
+    } else {
+        let width = W - LEFT - RIGHT;
+        let (xr, yr) = (bounds[0], bounds[1]);
+        let xlabel = labels.first().copied().unwrap_or("parameter 1");
+        let ylabel = labels.get(1).copied().unwrap_or("parameter 2");
+        axes(&mut out, xr, yr, xlabel, ylabel, width);
+        colour_bar(&mut out, LEFT + width + 20.0, zr);
+        let px = |x: f64| LEFT + (x - xr.0) / (xr.1 - xr.0) * width;
+        let py = |y: f64| (H - BOTTOM) - (y - yr.0) / (yr.1 - yr.0) * (H - BOTTOM - TOP);
+        // Misses first, then the grasps from the lowest score up, so the best show on top.
+        let mut order: Vec<&(Vec<f64>, Option<f64>)> = trials.iter().collect();
+        order.sort_by(|a, b| {
+            let key = |t: &(Vec<f64>, Option<f64>)| t.1.unwrap_or(f64::NEG_INFINITY);
+            key(a).total_cmp(&key(b))
+        });
+        for (p, s) in order {
+            let (Some(&x), Some(&y)) = (p.first(), p.get(1)) else {
+                continue;
+            };
+            let fill = fill_of(s.unwrap_or(f64::NAN), zr);
+            let _ = writeln!(
+                out,
+                r#"<circle cx="{:.2}" cy="{:.2}" r="4.5" fill="{fill}" stroke="black" stroke-width="0.8"/>"#,
+                px(x),
+                py(y)
+            );
+        }
+        if let Some((p, _)) = best {
+            let _ = writeln!(
+                out,
+                r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
+                px(p[0]),
+                py(p[1])
+            );
+        }
+        legend(
+            &mut out,
+            &[
+                (Mark::Dot("rgb(170,220,60)"), "a trial, by score"),
+                (Mark::Ring("red"), "the best"),
+                (Mark::Square(MISSING), MISSING_LABEL),
+            ],
+        );
+    }
     out.push_str("</svg>\n");
     out
 }

@@ -25,6 +25,8 @@ use graspopt_protocol::keys::{AliveKey, ROOT};
 use graspopt_protocol::{AgentKind, RunId, Topic, decode_topic};
 use serde_json::{Value, json};
 
+use crate::out::outln;
+
 #[derive(Args, Debug)]
 pub struct TopicArgs {
     #[command(subcommand)]
@@ -61,6 +63,7 @@ pub enum TopicCommand {
         /// Only this run.
         #[arg(long)]
         run: Option<String>,
+        /// text (a table) or json.
         #[arg(long, value_enum, default_value_t = Format::Text)]
         format: Format,
     },
@@ -68,6 +71,7 @@ pub enum TopicCommand {
     Echo {
         #[command(flatten)]
         watch: Watch,
+        /// text (decoded, indented) or json (one object per line).
         #[arg(long, value_enum, default_value_t = Format::Text)]
         format: Format,
         /// Stop after this many messages.
@@ -410,7 +414,7 @@ async fn list(bus: &Bus, run: Option<&str>, format: Format) -> Result<()> {
                     json!({"run": r.run, "key": r.key, "type": r.message, "publishers": r.publishers})
                 })
                 .collect();
-            println!("{}", Value::Array(v));
+            outln!("{}", Value::Array(v))?;
         }
         Format::Text => {
             if rows.is_empty() {
@@ -419,14 +423,14 @@ async fn list(bus: &Bus, run: Option<&str>, format: Format) -> Result<()> {
             }
             let w = rows.iter().map(|r| r.key.len()).max().unwrap_or(0);
             let t = rows.iter().map(|r| r.message.len()).max().unwrap_or(0);
-            println!("{:w$}  {:t$}  PUBLISHERS", "TOPIC", "TYPE");
+            outln!("{:w$}  {:t$}  PUBLISHERS", "TOPIC", "TYPE")?;
             for r in &rows {
-                println!(
+                outln!(
                     "{:w$}  {:t$}  {}",
                     r.key,
                     r.message,
                     r.publishers.join(", ")
-                );
+                )?;
             }
         }
     }

@@ -5,9 +5,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use graspopt_sim::{LinkShape, TriangleMesh};
 use graspopt_trial::{Evaluation, Evaluator};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use serde::Serialize;
 
 use super::setup::{SimArgs, param_kind};
+use crate::out::outln;
 use crate::{export, render};
 
 /// Size of `--preview` pictures (two views side by side).
@@ -25,6 +29,7 @@ pub struct TrialArgs {
     /// radians). Parameters not given are 0.
     #[arg(long, default_value = "")]
     pub at: String,
+    /// text (for reading) or json (everything, one object).
     #[arg(long, value_enum, default_value_t = TrialFormat::Text)]
     pub format: TrialFormat,
     /// Write the scene (object, hand links, contact points and normals) for any 3D viewer:
@@ -42,6 +47,26 @@ pub struct TrialArgs {
 pub enum TrialFormat {
     Text,
     Json,
+}
+
+/// `--format json`: the parameters, the score with what it was computed from (contacts,
+/// fingers in contact, metrics) at the top level, and the simulated outcome.
+#[derive(Serialize)]
+struct TrialJson<'a> {
+    params: &'a [f64],
+    #[serde(flatten)]
+    score: &'a graspopt_trial::TrialScore,
+    outcome: &'a graspopt_sim::TrialOutcome,
+}
+
+impl<'a> TrialJson<'a> {
+    fn of(e: &'a Evaluation) -> Self {
+        TrialJson {
+            params: &e.params,
+            score: &e.score,
+            outcome: &e.outcome,
+        }
+    }
 }
 
 /// Extensions `--scene` writes (glTF 2.0 JSON, Wavefront OBJ).
@@ -156,25 +181,44 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         }
     }
     let e = ev.evaluate(&values)?;
-    let written = write_pictures(args, &ev, &e)?;
+    let at: Vec<String> = kinds
+        .iter()
+        .zip(&values)
+        .map(|(k, v)| format!("{}={v}", k.name()))
+        .collect();
+    let title = format!(
+        "{}, {} hand, {}: {}",
+        ev.object.name(),
+        ev.hand.name(),
+        if at.is_empty() {
+            "reference pose".to_string()
+        } else {
+            at.join(",")
+        },
+        score_words(&e.score)
+    );
+    let written = write_pictures(args, &ev, &e, &title)?;
     match args.format {
-        TrialFormat::Json => println!("{}", serde_json::to_string_pretty(&e)?),
+        TrialFormat::Json => outln!("{}", serde_json::to_string_pretty(&TrialJson::of(&e))?)?,
         TrialFormat::Text => {
-            println!(
+            outln!(
                 "object {}  hand {}  contacts {}  metric {}",
                 ev.object.name(),
                 ev.hand.name(),
                 ev.score.contacts,
                 args.sim.metric
-            );
+            )?;
             for (k, v) in kinds.iter().zip(&values) {
-                println!("  {} = {v}", k.name());
+                outln!("  {} = {v}", k.name())?;
             }
             let t = e.outcome.grasp.palm_pose.translation.vector;
-            println!(
+            outln!(
                 "palm at ({:.4}, {:.4}, {:.4}) m, retreated {:.4} m",
-                t.x, t.y, t.z, e.outcome.grasp.retreat
-            );
+                t.x,
+                t.y,
+                t.z,
+                e.outcome.grasp.retreat
+            )?;
             for f in e
                 .outcome
                 .fingers
@@ -186,7 +230,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                     .map_or("palm".to_string(), |i| format!("finger {}", i + 1));
                 let modelled = f.contacts(ev.score.contacts);
                 match f.mean_point {
-                    Some(m) => println!(
+                    Some(m) => outln!(
                         "  {name}: {} cloud points, {} modelled contacts, mean at ({:.4}, {:.4}, {:.4}) normal ({:.3}, {:.3}, {:.3})",
                         f.cloud.points.len(),
                         modelled.len(),
@@ -196,12 +240,12 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                         m.normal.x,
                         m.normal.y,
                         m.normal.z
-                    ),
-                    None => println!("  {name}: no contact"),
+                    )?,
+                    None => outln!("  {name}: no contact")?,
                 }
             }
             match e.score.metrics {
-                Some(m) => println!(
+                Some(m) => outln!(
                     "rank {}  force closure {}  epsilon {:.6}  distance {:.6}  bw {:.6}{}",
                     m.rank,
                     m.force_closure,
@@ -210,31 +254,127 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                     m.bw,
                     m.volume
                         .map_or(String::new(), |v| format!("  volume {v:.6e}"))
-                ),
-                None => println!("no contact: nothing to score"),
+                )?,
+                None => outln!("no contact: nothing to score")?,
             }
-            println!("score {:.6}", e.score.score);
+            outln!("score {:.6}", e.score.score)?;
         }
     }
     for path in written {
         // JSON goes to stdout alone, so it stays parseable.
         match args.format {
-            TrialFormat::Text => println!("wrote {}", path.display()),
+            TrialFormat::Text => outln!("wrote {}", path.display())?,
             TrialFormat::Json => eprintln!("wrote {}", path.display()),
         }
     }
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-/// Writes `--scene` and `--preview` (if asked for); returns the paths written.
-fn write_pictures(args: &TrialArgs, ev: &Evaluator, e: &Evaluation) -> Result<Vec<PathBuf>> {
-    if args.scene.is_none() && args.preview.is_none() {
-        return Ok(Vec::new());
+/// A trial's score in words for a picture's title: `score 0.2412, force closure`, or
+/// `no contact`.
+pub fn score_words(s: &graspopt_trial::TrialScore) -> String {
+    match s.metrics {
+        None => "no contact".to_string(),
+        Some(m) if m.force_closure => format!("score {:.4}, force closure", s.score),
+        Some(_) => format!("score {:.4}", s.score),
     }
+}
+
+/// The `--preview` picture of the evaluated trial `e` under `title`: the object (blue) and
+/// the hand's links (orange), two views (see [`render::preview`]).
+pub fn preview_image(ev: &Evaluator, e: &Evaluation, title: &str) -> Result<render::Image> {
     let meshes = graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
     let contacts = e.outcome.contacts(ev.score.contacts, true);
+    let posts = knuckles(ev.hand.as_ref(), &e.outcome.grasp);
+    let mut coloured: Vec<_> = meshes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let c = if k == 0 {
+                OBJECT_COLOUR
+            } else {
+                LINK_COLOURS[k % 2]
+            };
+            (&m.mesh, c)
+        })
+        .collect();
+    // The posts in the palm's colour.
+    coloured.extend(posts.iter().map(|m| (m, LINK_COLOURS[1])));
+    Ok(render::preview(
+        &coloured,
+        &contacts,
+        (PREVIEW_WIDTH, PREVIEW_HEIGHT),
+        title,
+    ))
+}
+
+/// Posts between the palm and each finger's first joint where the hand's model leaves a gap
+/// (the Barrett's knuckle housings are not simulated), so that pictures show one hand: for
+/// each finger, a cylinder as wide as its first link, from that link's joint end (the
+/// middle of its lowest face, in its own frame) straight down to the palm's top face.
+fn knuckles(hand: &dyn graspopt_sim::Hand, grasp: &graspopt_sim::Grasp) -> Vec<TriangleMesh> {
+    let links = hand.links();
+    let Some(palm) = links.iter().position(|l| l.finger.is_none()) else {
+        return Vec::new();
+    };
+    let Some(palm_pose) = grasp.link_poses.get(palm) else {
+        return Vec::new();
+    };
+    let top = links[palm]
+        .shape
+        .mesh()
+        .vertices
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let up = palm_pose.rotation * Vector3::z();
+    let top_centre = palm_pose * Point3::new(0.0, 0.0, top);
+    let mut posts = Vec::new();
+    let mut seen = Vec::new();
+    for (link, pose) in links.iter().zip(&grasp.link_poses) {
+        let Some(finger) = link.finger else { continue };
+        if seen.contains(&finger) {
+            continue;
+        }
+        seen.push(finger);
+        let mesh = link.shape.mesh();
+        let (mut lo, mut hi) = (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        );
+        for v in &mesh.vertices {
+            lo = lo.inf(&v.coords);
+            hi = hi.sup(&v.coords);
+        }
+        let joint = pose * Point3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, lo.z);
+        let gap = (joint - top_centre).dot(&up);
+        let radius = (hi.x - lo.x).min(hi.y - lo.y) / 2.0;
+        if !(gap > 1e-4 && radius.is_finite() && radius > 0.0) {
+            continue;
+        }
+        let centre = joint - up * (gap / 2.0);
+        let post = LinkShape::Cylinder {
+            radius,
+            half_height: gap / 2.0,
+        };
+        let at = Isometry3::from_parts(Translation3::from(centre.coords), palm_pose.rotation);
+        posts.push(post.mesh().transformed(&at));
+    }
+    posts
+}
+
+/// Writes `--scene` and `--preview` (if asked for); returns the paths written.
+fn write_pictures(
+    args: &TrialArgs,
+    ev: &Evaluator,
+    e: &Evaluation,
+    title: &str,
+) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     if let Some(path) = &args.scene {
+        let meshes =
+            graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
+        let contacts = e.outcome.contacts(ev.score.contacts, true);
         let (lo, hi) = ev.object.aabb();
         let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
         if has_extension(path, "gltf") {
@@ -248,19 +388,7 @@ fn write_pictures(args: &TrialArgs, ev: &Evaluator, e: &Evaluation) -> Result<Ve
         }
     }
     if let Some(path) = &args.preview {
-        let coloured: Vec<_> = meshes
-            .iter()
-            .enumerate()
-            .map(|(k, m)| {
-                let c = if k == 0 {
-                    OBJECT_COLOUR
-                } else {
-                    LINK_COLOURS[k % 2]
-                };
-                (&m.mesh, c)
-            })
-            .collect();
-        render::render_grasp(&coloured, &contacts, PREVIEW_WIDTH, PREVIEW_HEIGHT).save_png(path)?;
+        preview_image(ev, e, title)?.save_png(path)?;
         written.push(path.clone());
     }
     Ok(written)

@@ -27,6 +27,7 @@ use graspopt_trial::Evaluator;
 use super::{argmax, evaluator, scan, touched_grid, write};
 use crate::commands::setup::Contacts;
 use crate::commands::svg;
+use crate::out::outln;
 
 /// Thesis Table 4.1 (total, 5%, 10%, 20%), its rows read as shifted by one line (the text's
 /// table starts with an unnamed row and ends with an empty one).
@@ -277,7 +278,7 @@ pub(super) fn bo(args: &BoArgs) -> Result<()> {
     );
     let path = dir.join("report.md");
     std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
-    println!("{}", path.display());
+    outln!("{}", path.display())?;
     Ok(())
 }
 

@@ -20,6 +20,7 @@ use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
 
 use super::{argmax, evaluator, scan, touched_grid, write};
 use crate::commands::svg;
+use crate::out::outln;
 
 #[derive(Args, Debug)]
 pub struct MetricsArgs {
@@ -269,7 +270,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     }
     let path = dir.join("report.md");
     std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
-    println!("{}", path.display());
+    outln!("{}", path.display())?;
     Ok(())
 }
 
@@ -313,7 +314,8 @@ fn map_row(
             &z,
         ),
     )?;
-    crate::render::heatmap_png(&z, 8).save_png(&dir.join(format!("{stem}.png")))?;
+    crate::render::heatmap_figure(&z, 8, title, svg::MISSING_LABEL)
+        .save_png(&dir.join(format!("{stem}.png")))?;
     let best = argmax(&points);
     let closed = points
         .iter()
