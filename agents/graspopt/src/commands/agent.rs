@@ -417,7 +417,7 @@ mod tests {
             "{msg}"
         );
         assert!(
-            msg.contains("hand, id, mesh, object, replay, trial_cost_ms"),
+            msg.contains("hand, id, mesh, mesh_scale, object, replay, trial_cost_ms"),
             "{msg}"
         );
         // In a table, the table's own keys.
