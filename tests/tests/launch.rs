@@ -104,7 +104,7 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journ
         c
     };
     let journal = dir.join("results/lr/journal.sqlite");
-    let mut first = launch(&[]).spawn().unwrap();
+    let first = launch(&[]).spawn().unwrap();
     wait_until("three trials", Duration::from_secs(60), || {
         completed_now(&journal, "lr") >= 3
     });

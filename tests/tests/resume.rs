@@ -158,7 +158,6 @@ fn a_stopped_run_resumes_with_the_command_it_prints() {
     signal(&first, "INT");
     let (status, stdout) = first.wait_output(Duration::from_secs(20));
     assert_eq!(status.code(), Some(130), "{stdout}");
-    assert!(stdout.contains("run \"stopme\": "), "{stdout}");
     // "... (stopped; continue with --resume --out DIR)": run exactly that.
     let hint = stdout
         .split("continue with ")
@@ -176,11 +175,13 @@ fn a_stopped_run_resumes_with_the_command_it_prints() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(o.status.success(), "{text}");
+    check_journal(&journal, "stopme", 12);
+    // The id reads as a name in messages.
+    assert!(stdout.contains("run \"stopme\": "), "{stdout}");
     assert!(
         text.contains("run \"stopme\": 12 trials completed"),
         "{text}"
     );
-    check_journal(&journal, "stopme", 12);
 
     // A second run in the same journal: which one to resume must be said.
     let mut j = Journal::open(&journal).unwrap();
@@ -311,7 +312,9 @@ fn a_run_stopped_mid_trial_and_resumed_proposes_what_the_uninterrupted_run_does(
             &a.iter().map(String::as_str).collect::<Vec<_>>(),
             &dir,
         );
-        // Stop while a trial runs, once `done` trials are complete.
+        // Stop while a trial runs, once `done` trials are complete and this process has
+        // completed one (so that it handles Ctrl-C).
+        let done = done.max(completed_now(&journal, "run") + 1);
         let start = Instant::now();
         while completed_now(&journal, "run") < done || running().is_empty() {
             if let Some(s) = p.child.try_wait().unwrap() {
