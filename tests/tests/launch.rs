@@ -1,10 +1,13 @@
 //! `graspopt launch deploy/local.toml`: the example launch file starts a router and every agent
 //! as processes, the run completes, and nothing is left running.
 
-use std::process::Command;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use graspopt_e2e::{check_journal, free_port, graspopt_bin, journal_best, tempdir};
+use graspopt_e2e::{
+    check_journal, completed_now, free_port, graspopt_bin, journal_best, tempdir, wait_until,
+};
+use graspopt_journal::{Journal, RunStatus, TrialState};
 
 #[test]
 fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
@@ -56,4 +59,110 @@ fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
     // The router was stopped with the rest: its port is free again.
     std::thread::sleep(Duration::from_millis(200));
     assert!(std::net::TcpStream::connect(("127.0.0.1", port)).is_err());
+}
+
+/// A launch stopped by Ctrl-C is continued by `graspopt launch --resume FILE`: the trials
+/// completed before the stop are kept and the run finishes its budget. The same launch
+/// without `--resume` is refused by the coordinator, which says how to resume.
+#[test]
+fn a_stopped_launch_is_continued_by_launch_resume() {
+    let dir = tempdir("launch-resume");
+    let port = free_port();
+    let file = dir.join("run.toml");
+    std::fs::write(
+        &file,
+        format!(
+            r#"run = "lr"
+endpoint = "tcp/127.0.0.1:{port}"
+[router]
+[[agent]]
+kind = "perception"
+args = ["--object", "cylinder"]
+[[agent]]
+kind = "planner"
+[[agent]]
+kind = "metric"
+[[agent]]
+kind = "hand"
+args = ["--trial-cost-ms", "100"]
+[[agent]]
+kind = "coordinator"
+args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journal", "results/lr/journal.sqlite"]
+"#
+        ),
+    )
+    .unwrap();
+    let launch = |extra: &[&str]| {
+        let mut c = Command::new(graspopt_bin());
+        c.current_dir(&dir)
+            .env("RUST_LOG", "warn")
+            .arg("launch")
+            .arg(&file)
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        c
+    };
+    let journal = dir.join("results/lr/journal.sqlite");
+    let first = launch(&[]).spawn().unwrap();
+    wait_until("three trials", Duration::from_secs(60), || {
+        completed_now(&journal, "lr") >= 3
+    });
+    let ok = Command::new("kill")
+        .args(["-INT", &first.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok);
+    let out = first.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "continue the run with graspopt launch --resume {}",
+            file.display()
+        )),
+        "{stderr}"
+    );
+    let before: Vec<_> = Journal::open(&journal)
+        .unwrap()
+        .trials("lr")
+        .unwrap()
+        .into_iter()
+        .filter(|t| t.state == TrialState::Completed)
+        .collect();
+    assert!(
+        (3..12).contains(&before.len()),
+        "{} completed",
+        before.len()
+    );
+
+    // Launched again as it was: the coordinator refuses, naming the way to resume.
+    let out = launch(&[]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("run \"lr\" already exists") && stderr.contains("graspopt launch --resume"),
+        "{stderr}"
+    );
+
+    let out = launch(&["--resume"]).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let after = check_journal(&journal, "lr", 12);
+    for t in &before {
+        let a = &after[t.trial_id as usize - 1];
+        assert_eq!(
+            (&a.params, a.score),
+            (&t.params, t.score),
+            "trial {}",
+            t.trial_id
+        );
+    }
+    let j = Journal::open(&journal).unwrap();
+    assert_eq!(j.run("lr").unwrap().unwrap().status, RunStatus::Finished);
 }

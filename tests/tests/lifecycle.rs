@@ -87,7 +87,11 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
     taken.extend_from_slice(&base);
     let o = graspopt(&taken);
     assert!(!o.status.success());
-    assert!(text(&o).contains("holds run run already"), "{}", text(&o));
+    assert!(
+        text(&o).contains("holds run \"run\" already"),
+        "{}",
+        text(&o)
+    );
     let runs = Journal::open(&journal).unwrap().runs().unwrap();
     assert_eq!(runs.len(), 1);
 }
@@ -218,13 +222,16 @@ fn a_second_hand_with_an_id_in_use_and_a_second_coordinator_are_refused() {
     assert!(!status.success());
     let log = c.log("twin");
     assert!(
-        log.contains("run uq already has a hand with the id hand-1"),
+        log.contains("run \"uq\" already has a hand with the id hand-1"),
         "{log}"
     );
     let (status, _) = second.wait_output(Duration::from_secs(30));
     assert!(!status.success());
     let log = c.log("second");
-    assert!(log.contains("run uq already has a coordinator"), "{log}");
+    assert!(
+        log.contains("run \"uq\" already has a coordinator"),
+        "{log}"
+    );
     assert!(
         completed_now(&journal, "uq") < 30,
         "the run ended before the checks"

@@ -54,7 +54,7 @@ fn monitor_attaches_to_a_running_run_and_shows_it() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
-        text.contains("run tp  object cuboid  phase running"),
+        text.contains("run \"tp\"  object cuboid  phase running"),
         "{text}"
     );
     assert!(text.contains("workers alive: 2"), "{text}");

@@ -67,8 +67,43 @@ pub fn recorded_spec(path: &std::path::Path, run: &RunId) -> anyhow::Result<Opti
         return Ok(None);
     };
     let spec = serde_json::from_str::<RunSpec>(&record.config_json)
-        .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?;
+        .with_context(|| format!("run {run:?}: journal holds an unreadable run spec"))?;
     Ok(Some(spec))
+}
+
+/// The run ids the journal at `path` holds, oldest first (none if there is no such file).
+pub fn recorded_runs(path: &std::path::Path) -> anyhow::Result<Vec<String>> {
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    let journal = Journal::open(path)
+        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    Ok(journal.runs()?.into_iter().map(|r| r.run_id).collect())
+}
+
+/// `"a", "b"`: run ids quoted, for messages.
+pub fn quoted_runs(ids: &[String]) -> String {
+    ids.iter()
+        .map(|id| format!("{id:?}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The run a `--resume` without `--run` continues: the only run of the journal at `path`
+/// (`None` when there is no such file or it holds no run). A journal of several runs is an
+/// error that lists them.
+pub fn sole_run(path: &std::path::Path) -> anyhow::Result<Option<RunId>> {
+    let runs = recorded_runs(path)?;
+    match runs.as_slice() {
+        [] => Ok(None),
+        [one] => Ok(Some(RunId::new(one)?)),
+        _ => bail!(
+            "the journal {} holds {} runs ({}): say which to resume with --run",
+            path.display(),
+            runs.len(),
+            quoted_runs(&runs)
+        ),
+    }
 }
 
 /// Flags given on the command line that contradict the record of a run being resumed,
@@ -130,7 +165,7 @@ impl Conflicts {
     pub fn into_error(self, run: &RunId) -> Option<anyhow::Error> {
         (!self.0.is_empty()).then(|| {
             anyhow::anyhow!(
-                "run {run} was recorded with other settings: {}. Drop these flags to resume it, or start a new run (another --run id)",
+                "run {run:?} was recorded with other settings: {}. Drop these flags to resume it, or start a new run (another --run id)",
                 self.0.join("; ")
             )
         })
@@ -245,25 +280,40 @@ pub fn param_names(spec: &RunSpec) -> Vec<String> {
         .collect()
 }
 
-/// Opens (or creates) the run in the journal and rebuilds the state from it. Resuming needs
-/// the run in the journal; its recorded spec is used, with the budget raised if `spec` asks
-/// for more trials (pass the result of [`reconcile`]).
+/// Opens (or creates) the run in the journal and rebuilds the state from it. Resuming uses
+/// the recorded spec, with the budget raised if `spec` asks for more trials (pass the result
+/// of [`reconcile`]). Not resuming, a recorded run that issued no trial is started afresh
+/// with `spec`; one that has trials is an error.
 pub fn open_run(
     journal: &mut Journal,
     run: &RunId,
     spec: &RunSpec,
     resume: bool,
 ) -> anyhow::Result<(RunSpec, RunState)> {
-    let existing = journal.run(run.as_str())?;
+    let place = journal
+        .path()
+        .map_or_else(|| "the journal".to_string(), |p| p.display().to_string());
+    let mut existing = journal.run(run.as_str())?;
+    if existing.is_some() && !resume {
+        // A start that stopped before its first trial (a wrong address, say) leaves its run
+        // recorded with nothing in it: the same command starts it afresh.
+        if journal.remove_unstarted_run(run.as_str())? {
+            tracing::warn!(
+                "coordinator: run {run:?} is in {place} without any trial (an earlier start issued none): starting it afresh"
+            );
+            existing = None;
+        } else {
+            let trials = journal.trials(run.as_str())?.len();
+            bail!(
+                "run {run:?} already exists in {place} with {trials} trial{}: resume it (--resume; for a launched run, graspopt launch --resume FILE) or choose another run id",
+                if trials == 1 { "" } else { "s" }
+            );
+        }
+    }
     let spec = match existing {
         Some(record) => {
-            if !resume {
-                bail!(
-                    "run {run} already exists in the journal: resume it (--resume) or choose another run id"
-                );
-            }
             let recorded = serde_json::from_str::<RunSpec>(&record.config_json)
-                .with_context(|| format!("run {run}: journal holds an unreadable run spec"))?;
+                .with_context(|| format!("run {run:?}: journal holds an unreadable run spec"))?;
             // A resumed run keeps its record; only its budget may grow (see `reconcile`).
             let spec = if spec.trials > recorded.trials {
                 let before = recorded.trials;
@@ -273,7 +323,7 @@ pub fn open_run(
                 };
                 journal.set_run_config(run.as_str(), &serde_json::to_string(&raised)?)?;
                 tracing::warn!(
-                    "coordinator: run {run}: budget raised from {before} to {} trials",
+                    "coordinator: run {run:?}: budget raised from {before} to {} trials",
                     raised.trials
                 );
                 raised
@@ -289,10 +339,9 @@ pub fn open_run(
             if resume {
                 // A supervised coordinator is restarted with the same command line, so
                 // `--resume` also starts a run that was never recorded; it says so.
-                let place = journal
-                    .path()
-                    .map_or_else(|| "the journal".to_string(), |p| p.display().to_string());
-                tracing::warn!("coordinator: run {run} is not in {place} yet: --resume starts it");
+                tracing::warn!(
+                    "coordinator: run {run:?} is not in {place} yet: --resume starts it"
+                );
             }
             journal.create_run(&RunRecord {
                 run_id: run.as_str().to_string(),
@@ -782,7 +831,7 @@ pub async fn run_until(
                 }
                 Ok(result) => {
                     ctx.state.errors.bad_messages += 1;
-                    tracing::warn!("coordinator: result of run {} on this run's key", result.run_id);
+                    tracing::warn!("coordinator: result of run {:?} on this run's key", result.run_id);
                 }
                 Err(e) => {
                     ctx.state.errors.bad_messages += 1;
@@ -884,7 +933,7 @@ pub async fn run_until(
             )
         };
         tracing::warn!(
-            "coordinator: run {run} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; resume with --resume",
+            "coordinator: run {run:?} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; resume with --resume",
             s.completed,
             s.budget,
             s.failed,
@@ -966,8 +1015,6 @@ mod tests {
         // Resuming a run never recorded starts it (a supervised restart's command line).
         let (started, _) = open_run(&mut journal, &run, &spec(5), true).unwrap();
         assert_eq!(started.trials, 5);
-        let e = open_run(&mut journal, &run, &spec(5), false).unwrap_err();
-        assert!(e.to_string().contains("already exists"), "{e}");
         journal
             .set_run_status("r", JournalStatus::Finished, 10)
             .unwrap();
@@ -983,6 +1030,52 @@ mod tests {
         assert_eq!(again.trials, 8);
     }
 
+    /// A trial issued for run `r`, attempt 1.
+    fn issue(trial_id: u64) -> TrialIssue {
+        TrialIssue {
+            run_id: "r".into(),
+            trial_id,
+            attempt: 1,
+            params: vec![0.01],
+            worker: "a".into(),
+            at_ms: 10,
+            lease_until_ms: 1000,
+            reason: None,
+        }
+    }
+
+    /// A run stopped before its first trial (a wrong address) is started afresh by the same
+    /// command, with the settings given now; once a trial is issued, it must be resumed.
+    #[test]
+    fn a_run_without_trials_starts_afresh_and_one_with_trials_must_be_resumed() {
+        let mut journal = Journal::open_in_memory().unwrap();
+        let run = RunId::new("r").unwrap();
+        open_run(&mut journal, &run, &spec(5), false).unwrap();
+        journal.set_planner_state("r", &[1, 2, 3], 5).unwrap();
+        journal
+            .set_run_status("r", JournalStatus::Stopped, 10)
+            .unwrap();
+        let (again, state) = open_run(&mut journal, &run, &spec(7), false).unwrap();
+        assert_eq!(again, spec(7));
+        assert!(state.trials.is_empty());
+        let record = journal.run("r").unwrap().unwrap();
+        assert_eq!(record.status, JournalStatus::Running);
+        assert_eq!(
+            serde_json::from_str::<RunSpec>(&record.config_json).unwrap(),
+            spec(7)
+        );
+        assert_eq!(journal.planner_state("r").unwrap(), None);
+        journal.record_issue(&issue(1)).unwrap();
+        let e = open_run(&mut journal, &run, &spec(7), false).unwrap_err();
+        let e = e.to_string();
+        assert!(
+            e.contains("run \"r\" already exists") && e.contains("with 1 trial:"),
+            "{e}"
+        );
+        assert!(e.contains("--resume"), "{e}");
+        assert_eq!(journal.trials("r").unwrap().len(), 1);
+    }
+
     /// A coordinator restarted with `--resume` still accepts the late result of an attempt
     /// issued before the restart (who got each attempt comes back from the journal's events).
     #[test]
@@ -994,14 +1087,10 @@ mod tests {
         for (attempt, worker) in [(1, "a"), (2, "b")] {
             journal
                 .record_issue(&TrialIssue {
-                    run_id: "r".into(),
-                    trial_id: 1,
                     attempt,
-                    params: vec![0.01],
                     worker: worker.into(),
                     at_ms: 10 * attempt as i64,
-                    lease_until_ms: 1000,
-                    reason: None,
+                    ..issue(1)
                 })
                 .unwrap();
         }

@@ -150,7 +150,7 @@ fn estimate_of_run(
         Ok(e) => {
             *bad += 1;
             tracing::warn!(
-                "hand {id}: object estimate of run {} ignored ({bad} bad messages)",
+                "hand {id}: object estimate of run {:?} ignored ({bad} bad messages)",
                 e.run_id
             );
             None

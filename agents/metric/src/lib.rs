@@ -133,7 +133,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                 }
                 Ok(e) => {
                     bad += 1;
-                    tracing::warn!("metric {}: object estimate of run {} ignored ({bad} bad messages)", config.id, e.run_id);
+                    tracing::warn!("metric {}: object estimate of run {:?} ignored ({bad} bad messages)", config.id, e.run_id);
                 }
                 Err(e) => {
                     bad += 1;
@@ -144,7 +144,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                 Ok(c) if c.run_id == *run => waiting.push_back((c, r.path.as_str())),
                 Ok(c) => {
                     bad += 1;
-                    tracing::warn!("metric {}: clouds of run {} ignored ({bad} bad messages)", config.id, c.run_id);
+                    tracing::warn!("metric {}: clouds of run {:?} ignored ({bad} bad messages)", config.id, c.run_id);
                 }
                 Err(e) => {
                     bad += 1;

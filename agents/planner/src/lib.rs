@@ -272,7 +272,7 @@ impl Planner {
                     return Ok(true);
                 }
                 Err(why) => tracing::warn!(
-                    "planner: run {}: the saved engine state is not used ({why}): \
+                    "planner: run {:?}: the saved engine state is not used ({why}): \
                      rebuilding the engine from the run's history",
                     req.run_id
                 ),
@@ -307,7 +307,7 @@ impl Planner {
         let engine_state = match self.warm.as_ref().map(Warm::save) {
             Some(Ok(bytes)) => Some(bytes),
             Some(Err(e)) => {
-                tracing::warn!("planner: run {}: {e}", req.run_id);
+                tracing::warn!("planner: run {:?}: {e}", req.run_id);
                 None
             }
             None => None,
@@ -326,7 +326,7 @@ impl Planner {
         match self.propose_with_warm(req) {
             Err(e) if restored => {
                 tracing::warn!(
-                    "planner: run {}: the engine restored from the saved state fails ({e}): \
+                    "planner: run {:?}: the engine restored from the saved state fails ({e}): \
                      rebuilding it from the run's history",
                     req.run_id
                 );
@@ -387,12 +387,15 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
             Ok(r) => {
                 bad += 1;
                 tracing::warn!(
-                    "planner {}: request of run {} refused ({bad} bad messages)",
+                    "planner {}: request of run {:?} refused ({bad} bad messages)",
                     config.id,
                     r.run_id
                 );
                 let _ = incoming
-                    .reply_error(&format!("this planner serves run {run}, not {}", r.run_id))
+                    .reply_error(&format!(
+                        "this planner serves run {run:?}, not {:?}",
+                        r.run_id
+                    ))
                     .await;
                 continue;
             }

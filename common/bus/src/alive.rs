@@ -192,7 +192,7 @@ impl Bus {
                     "is taking its place at the same moment"
                 };
                 return Err(BusError::Taken(format!(
-                    "run {run}: another agent, {what}, {when}: this one gives way{}",
+                    "run {run:?}: another agent, {what}, {when}: this one gives way{}",
                     if id.is_some() {
                         " (give it another --id)"
                     } else {
@@ -263,7 +263,7 @@ impl Bus {
                             None => format!("a {} ({})", kind.as_str(), holder.id),
                         };
                         return Err(BusError::Taken(format!(
-                            "run {run} already has {what}, alive on host {}: stop it first{}",
+                            "run {run:?} already has {what}, alive on host {}: stop it first{}",
                             holder.host,
                             if id.is_some() {
                                 ", or give this one another --id"

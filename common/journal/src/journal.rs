@@ -182,6 +182,29 @@ impl Journal {
         Ok(())
     }
 
+    /// Removes a run that issued no trial (a start that stopped before its first trial),
+    /// with its planner state, so that the run can be created afresh. Returns whether it
+    /// was removed: `false`, with nothing changed, when the run is not in the journal or
+    /// has a trial.
+    pub fn remove_unstarted_run(&mut self, run_id: &str) -> Result<bool> {
+        let tx = self.write_tx()?;
+        let trials: Option<i64> = tx
+            .query_row(
+                "SELECT (SELECT count(*) FROM trials WHERE run_id = ?1) FROM runs
+                 WHERE run_id = ?1",
+                [run_id],
+                |r| r.get(0),
+            )
+            .optional()?;
+        if trials != Some(0) {
+            return Ok(false);
+        }
+        tx.execute("DELETE FROM planner_state WHERE run_id = ?1", [run_id])?;
+        tx.execute("DELETE FROM runs WHERE run_id = ?1", [run_id])?;
+        tx.commit()?;
+        Ok(true)
+    }
+
     /// Keeps `state`, the planner's engine after its last reply for the run (opaque
     /// bytes), replacing the previous one.
     pub fn set_planner_state(&mut self, run_id: &str, state: &[u8], at_ms: i64) -> Result<()> {

@@ -1153,6 +1153,32 @@ fn planner_state_is_kept_per_run_replaced_and_reopened() {
 }
 
 #[test]
+fn only_a_run_without_trials_is_removed_for_a_fresh_start() {
+    let mut j = Journal::open_in_memory().unwrap();
+    j.create_run(&run_record(RUN)).unwrap();
+    j.create_run(&run_record("started")).unwrap();
+    j.set_planner_state(RUN, &[1, 2], 10).unwrap();
+    j.record_issue(&issue("started", 1, 1, "w1", 100)).unwrap();
+    // A run with a trial, and one never recorded, stay as they are.
+    assert!(!j.remove_unstarted_run("started").unwrap());
+    assert!(!j.remove_unstarted_run("nobody").unwrap());
+    assert_eq!(j.trials("started").unwrap().len(), 1);
+    // The run without trials goes, with its planner state; it can be created again with
+    // another config and other parameter names.
+    assert!(j.remove_unstarted_run(RUN).unwrap());
+    assert!(j.run(RUN).unwrap().is_none());
+    assert_eq!(j.planner_state(RUN).unwrap(), None);
+    let other = RunRecord {
+        config_json: "{}".into(),
+        param_names: vec!["x".into()],
+        ..run_record(RUN)
+    };
+    j.create_run(&other).unwrap();
+    assert_eq!(j.run(RUN).unwrap().unwrap().param_names, ["x"]);
+    assert!(j.integrity_check().unwrap());
+}
+
+#[test]
 fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
     let dir = TempDir::new("upgrade");
     let db = dir.db();

@@ -82,8 +82,9 @@ pub fn sanitize_chunk(text: &str) -> String {
     s
 }
 
-/// A run id: one key chunk.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+/// A run id: one key chunk. Messages print it quoted (`{run:?}`, `run "mug"`), so that the
+/// default id reads as a name (`run "run"`, not `run run`).
+#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub struct RunId(String);
 
@@ -179,6 +180,12 @@ impl RunId {
     /// The name of the shared-memory service that carries this run's contact clouds on a host.
     pub fn shm_clouds_service(&self) -> String {
         format!("{}/clouds", self.prefix())
+    }
+}
+
+impl fmt::Debug for RunId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.0.as_str(), f)
     }
 }
 

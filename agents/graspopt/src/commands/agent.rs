@@ -126,7 +126,9 @@ pub enum Kind {
         /// default 30000).
         #[arg(long)]
         lease_ms: Option<u64>,
-        /// Continue the run recorded in the journal, with its recorded settings.
+        /// Continue the run recorded in the journal (its only run, unless --run names one),
+        /// with its recorded settings. Without --resume, a run recorded with no trial (a
+        /// start that stopped before its first) starts afresh.
         #[arg(long)]
         resume: bool,
     },
@@ -308,7 +310,14 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 .map(|p| param_kind(p))
                 .collect::<Result<Vec<_>>>()?;
             anyhow::ensure!(*trials >= 1, "--trials must be at least 1");
-            let run_id = RunId::new(&common.run)?;
+            let mut run_id = RunId::new(&common.run)?;
+            // `--resume --journal FILE` continues the run of FILE: its id need not be given.
+            if *resume
+                && !explicit("run")
+                && let Some(only) = graspopt_coordinator::sole_run(&c.journal_path(&run_id))?
+            {
+                run_id = only;
+            }
             let given = RunSpec {
                 object: sim.object()?.name().to_string(),
                 hand: sim.hand.clone(),
@@ -341,10 +350,10 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 std::fs::create_dir_all(dir)
                     .with_context(|| format!("cannot create the folder {}", dir.display()))?;
             }
-            let (bus, run) = join(common).await?;
+            let bus = Bus::open(&common.bus).await?;
             let status = graspopt_coordinator::run_until(
                 &bus,
-                &run,
+                &run_id,
                 &spec,
                 &c,
                 *resume,

@@ -40,6 +40,10 @@ pub struct LaunchArgs {
     /// Print the commands this machine would run, and exit.
     #[arg(long)]
     pub dry_run: bool,
+    /// Continue the file's run from its journal (a launch stopped by Ctrl-C, say): the
+    /// coordinator starts with --resume. Give it on the machine that runs the coordinator.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 /// A launch file.
@@ -237,6 +241,20 @@ impl LaunchFile {
     }
 }
 
+/// Makes the coordinator of `plan` resume its run (`--resume`, once). An error if `plan`
+/// has no coordinator: only the machine that runs it can resume the run.
+fn resume_coordinator(plan: &mut [Planned], host: &str) -> Result<()> {
+    let Some(c) = plan.iter_mut().find(|p| p.coordinator) else {
+        bail!(
+            "--resume: no coordinator runs on host {host:?}; resume the run on the machine that runs the coordinator"
+        );
+    };
+    if !c.args.iter().any(|a| a == "--resume") {
+        c.args.push("--resume".into());
+    }
+    Ok(())
+}
+
 /// Where this machine reaches a router listening on `tcp/<address>:<port>`: that address,
 /// or loopback for a wildcard one. `None` for other protocols.
 fn reachable_addr(endpoint: &str) -> Option<String> {
@@ -309,12 +327,15 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_default();
-    let plan = file.plan(&host, &base)?;
+    let mut plan = file.plan(&host, &base)?;
     if plan.is_empty() {
         bail!(
             "launch file {}: nothing runs on host {host:?} (use --host to pick an entry's host)",
             args.file.display()
         );
+    }
+    if args.resume {
+        resume_coordinator(&mut plan, &host)?;
     }
     if args.dry_run {
         for p in &plan {
@@ -415,7 +436,10 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
             tail(&log, 20)
         ),
         Outcome::Interrupted => {
-            eprintln!("graspopt launch: interrupted, every process stopped");
+            eprintln!(
+                "graspopt launch: interrupted, every process stopped; continue the run with graspopt launch --resume {}",
+                args.file.display()
+            );
             Ok(ExitCode::from(130))
         }
     }
@@ -509,6 +533,26 @@ mod tests {
                     .unwrap_or_else(|e| panic!("{}: {e}", w[1]));
             }
         }
+    }
+
+    #[test]
+    fn resume_adds_one_resume_flag_to_the_coordinator_only() {
+        let (file, path) = deploy("local.toml");
+        let mut plan = file.plan("any-host", path.parent().unwrap()).unwrap();
+        resume_coordinator(&mut plan, "any-host").unwrap();
+        resume_coordinator(&mut plan, "any-host").unwrap();
+        for p in &plan {
+            let n = p.args.iter().filter(|a| *a == "--resume").count();
+            assert_eq!(n, usize::from(p.coordinator), "{}", p.name);
+        }
+        let (file, path) = deploy("two-machines.toml");
+        let mut robot = file.plan("robot-pc", path.parent().unwrap()).unwrap();
+        let e = resume_coordinator(&mut robot, "robot-pc").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("no coordinator runs on host \"robot-pc\""),
+            "{e}"
+        );
     }
 
     #[test]

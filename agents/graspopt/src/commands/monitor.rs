@@ -130,11 +130,11 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
         "coordinator gone"
     };
     let Some(s) = &view.status else {
-        out.push(format!("run {name}: no status yet ({coord})"));
+        out.push(format!("run {name:?}: no status yet ({coord})"));
         return out;
     };
     out.push(format!(
-        "run {name}  object {}  phase {}  updated {age}  ({coord})",
+        "run {name:?}  object {}  phase {}  updated {age}  ({coord})",
         s.object,
         phase_name(s.phase)
     ));
@@ -335,7 +335,7 @@ async fn ask_states(bus: &Bus, m: &mut Monitor) {
             .await
         {
             Ok(s) => m.on_status(s, Instant::now()),
-            Err(e) => tracing::warn!("monitor: state of run {r}: {e}"),
+            Err(e) => tracing::warn!("monitor: state of run {r:?}: {e}"),
         }
     }
 }

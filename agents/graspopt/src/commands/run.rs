@@ -72,8 +72,9 @@ pub struct RunArgs {
     /// Results folder (default: results/<run>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Continue the run recorded in the results folder's journal, with its recorded
-    /// settings (a larger --trials raises its budget).
+    /// Continue the run recorded in the results folder's journal (its only run, unless
+    /// --run names one), with its recorded settings and workers (a larger --trials raises
+    /// its budget).
     #[arg(long)]
     pub resume: bool,
     /// Minimum duration of a simulated trial, to model a robot (milliseconds).
@@ -125,6 +126,15 @@ struct EmbeddedSettings {
     torque_scale: Option<f64>,
     position_noise: f64,
     rotation_noise: f64,
+    /// How the run was executed (absent in runs recorded before they were kept): the
+    /// proposals depend on the number of workers, so a resumed run keeps it unless
+    /// `--workers` is given.
+    #[serde(default)]
+    workers: Option<usize>,
+    #[serde(default)]
+    trial_cost_ms: Option<u64>,
+    #[serde(default)]
+    lease_ms: Option<u64>,
 }
 
 fn unit_scale() -> f64 {
@@ -151,6 +161,9 @@ impl EmbeddedSettings {
             torque_scale: args.sim.torque_scale,
             position_noise: args.position_noise,
             rotation_noise: args.rotation_noise,
+            workers: Some(args.workers),
+            trial_cost_ms: Some(args.trial_cost_ms),
+            lease_ms: Some(args.lease_ms),
         }
     }
 }
@@ -166,12 +179,20 @@ fn resumed_args(args: &RunArgs, out: &Path, explicit: &dyn Fn(&str) -> bool) -> 
             journal.display()
         );
     }
-    let recorded = graspopt_coordinator::recorded_spec(&journal, &run)?.with_context(|| {
-        format!(
-            "run {run} is not in {}: there is nothing to resume (start it without --resume)",
-            journal.display()
-        )
-    })?;
+    let Some(recorded) = graspopt_coordinator::recorded_spec(&journal, &run)? else {
+        let runs = graspopt_coordinator::recorded_runs(&journal)?;
+        if runs.is_empty() {
+            bail!(
+                "run {run:?} is not in {}: there is nothing to resume (start it without --resume)",
+                journal.display()
+            );
+        }
+        bail!(
+            "run {run:?} is not in {}, which holds run {}: resume one of those (--run ID, or no --run if there is one), or start {run:?} without --resume",
+            journal.display(),
+            graspopt_coordinator::quoted_runs(&runs),
+        );
+    };
     let given = RunSpec {
         object: args.sim.object.clone(),
         hand: args.sim.hand.clone(),
@@ -227,13 +248,26 @@ fn resumed_args(args: &RunArgs, out: &Path, explicit: &dyn Fn(&str) -> bool) -> 
         out_args.sim.object = spec.object.clone();
     }
     out_args.sim.contacts = Contacts::from_str(&recorded_settings.contacts, true)
-        .map_err(|e| anyhow::anyhow!("run {run}: recorded contact model: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("run {run:?}: recorded contact model: {e}"))?;
     out_args.sim.metric = recorded_settings.metric.clone();
     out_args.sim.frame = Frame::from_str(&recorded_settings.frame, true)
-        .map_err(|e| anyhow::anyhow!("run {run}: recorded frame: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("run {run:?}: recorded frame: {e}"))?;
     out_args.sim.torque_scale = recorded_settings.torque_scale;
     out_args.position_noise = recorded_settings.position_noise;
     out_args.rotation_noise = recorded_settings.rotation_noise;
+    // The workers, trial cost and lease the run was started with, unless given now.
+    if let Some(v) = recorded_settings.workers.filter(|_| !explicit("workers")) {
+        out_args.workers = v;
+    }
+    if let Some(v) = recorded_settings
+        .trial_cost_ms
+        .filter(|_| !explicit("trial_cost_ms"))
+    {
+        out_args.trial_cost_ms = v;
+    }
+    if let Some(v) = recorded_settings.lease_ms.filter(|_| !explicit("lease_ms")) {
+        out_args.lease_ms = v;
+    }
     Ok(out_args)
 }
 
@@ -285,10 +319,12 @@ fn check_folder_is_free(out: &Path, run: &RunId) -> Result<()> {
         .collect();
     if !others.is_empty() {
         bail!(
-            "the results folder {} holds run {} already (its trials.csv, trials.json and best.svg would be overwritten): choose another --out, or resume that run with --run {} --resume",
+            "the results folder {} holds run {} already (its trials.csv, trials.json and best.svg would be overwritten): choose another --out, or resume {} with --resume --out {}{}",
             out.display(),
-            others.join(", "),
-            others[0]
+            graspopt_coordinator::quoted_runs(&others),
+            if others.len() == 1 { "it" } else { "one" },
+            out.display(),
+            if others.len() == 1 { "" } else { " --run ID" }
         );
     }
     Ok(())
@@ -304,14 +340,25 @@ impl Embedded {
     /// The run the flags describe. With `--resume`, the run's recorded settings replace the
     /// flags' defaults; `explicit(name)` says whether `--name` was given on the command line.
     pub fn from_args_with(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<Embedded> {
-        let run = RunId::new(&args.run)?;
+        let mut run = RunId::new(&args.run)?;
         let out = args
             .out
             .clone()
             .unwrap_or_else(|| Path::new("results").join(run.as_str()));
+        // `--resume --out DIR` continues the run of DIR's journal: its id need not be given.
+        if args.resume
+            && !explicit("run")
+            && let Some(only) = graspopt_coordinator::sole_run(&out.join("journal.sqlite"))?
+        {
+            run = only;
+        }
         let resumed;
         let args = if args.resume {
-            resumed = resumed_args(args, &out, explicit)?;
+            let named = RunArgs {
+                run: run.as_str().to_string(),
+                ..args.clone()
+            };
+            resumed = resumed_args(&named, &out, explicit)?;
             &resumed
         } else {
             check_folder_is_free(&out, &run)?;
@@ -548,7 +595,7 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     let endpoint = e.bus.listen.join(", ");
     if !args.quiet && !endpoint.is_empty() {
         eprintln!(
-            "graspopt: run {} on {endpoint} (attach with --connect)",
+            "graspopt: run {:?} on {endpoint} (attach with --connect)",
             e.run
         );
     }
@@ -582,7 +629,7 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     write_results(&e, &status)?;
     let stopped = status.phase != RunPhase::Finished;
     outln!(
-        "run {}: {} trials completed, {} failed{}",
+        "run {:?}: {} trials completed, {} failed{}",
         status.run_id,
         status.completed,
         status.failed,
