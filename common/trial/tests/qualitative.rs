@@ -476,6 +476,7 @@ fn argmax_of_the_2d_sphere_scan_is_the_same_in_the_object_and_hand_frames() {
 /// centre, tilted by the torques about the world origin (the sphere's footprint, 35 mm below
 /// its centre). The thesis's invariance is empirical and holds here only up to the width of
 /// a flat maximum.
+#[test]
 #[ignore = "not reproduced: the world frame moves the argmax two cells (12.9 mm) down the ridge of best grasps (see the doc comment)"]
 fn argmax_of_the_2d_sphere_scan_is_the_same_in_the_world_and_object_frames() {
     let (object, top) = argmax_cells(ReferenceFrame::Object);
