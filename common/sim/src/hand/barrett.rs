@@ -28,7 +28,7 @@
 //! the flexion joints and the 0.003 m lateral offset of the distal joint are not modelled;
 //! links are boxes.
 
-use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use parry3d_f64::math::Pose;
 
 use super::{
@@ -43,8 +43,8 @@ use crate::object::Object;
 pub const PALM_RADIUS: f64 = 0.045;
 /// Palm disc thickness (below the finger bases).
 pub const PALM_THICKNESS: f64 = 0.02;
-/// Height of the palm's top face (the finger bases' plane).
-pub const PALM_TOP: f64 = 0.0415;
+/// Height of the palm disc's centre: its top face (the finger bases' plane) is at 0.0415.
+pub const PALM_CENTRE: f64 = 0.0315;
 /// F1 spread-joint base on the palm (F2 mirrored in `x`).
 pub const F1_BASE: [f64; 3] = [-0.025, 0.0, 0.0415];
 /// F3 base (its flexion joint; F3 has no spread).
@@ -144,45 +144,62 @@ impl BarrettHand {
         Self::frame_at(f, self.spread)
     }
 
+    /// The flexion joint frame of finger `f` at `spread`. The frames are composed joint by
+    /// joint (a fixed offset, then the joint's motion), in the order and with the operations a
+    /// URDF chain uses, so that the URDF description of this hand gives the same poses to the
+    /// last bit.
     fn frame_at(f: usize, spread: f64) -> Isometry3<f64> {
-        let (joint, out) = match f {
+        match f {
             0 | 1 => {
+                // F1 spreads about -z, F2 (mirrored in x) about +z; both knuckle frames are
+                // turned half a turn so that their y points out along the finger.
                 let sign = if f == 0 { -1.0 } else { 1.0 };
-                let base = Vector3::new(sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]);
-                let out =
-                    Rotation3::from_axis_angle(&Vector3::z_axis(), sign * spread) * -Vector3::y();
-                (base + KNUCKLE_OUT * out + KNUCKLE_UP * Vector3::z(), out)
+                let knuckle = offset(
+                    [sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]],
+                    std::f64::consts::PI,
+                ) * turn(Vector3::new(0.0, 0.0, sign), spread);
+                knuckle * offset([0.0, KNUCKLE_OUT, KNUCKLE_UP], 0.0)
             }
-            _ => (
-                Vector3::new(F3_BASE[0], F3_BASE[1], F3_BASE[2]),
-                Vector3::y(),
-            ),
-        };
-        let axis = out.cross(&Vector3::z());
-        let rot =
-            Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[axis, out, Vector3::z()]));
-        Isometry3::from_parts(
-            Translation3::from(joint),
-            UnitQuaternion::from_rotation_matrix(&rot),
-        )
+            _ => offset(F3_BASE, 0.0),
+        }
     }
 
-    /// Medial and distal link frames relative to the finger frame.
-    fn finger_links(medial: f64, distal: f64) -> (Isometry3<f64>, Isometry3<f64>) {
-        let r1 = Isometry3::rotation(Vector3::x() * medial);
-        let m = r1 * Translation3::new(0.0, 0.0, MEDIAL_LENGTH / 2.0);
-        let d = r1
-            * Translation3::new(0.0, 0.0, MEDIAL_LENGTH)
-            * Isometry3::rotation(Vector3::x() * distal)
-            * Translation3::new(0.0, 0.0, DISTAL_LENGTH / 2.0);
-        (m, d)
+    /// Medial and distal link frames (box centres) in the palm frame, for the flexion joint
+    /// frame `flex`.
+    fn finger_links(
+        flex: &Isometry3<f64>,
+        medial: f64,
+        distal: f64,
+    ) -> (Isometry3<f64>, Isometry3<f64>) {
+        let m = flex * turn(Vector3::x(), medial);
+        let d = (m * offset([0.0, 0.0, MEDIAL_LENGTH], 0.0)) * turn(Vector3::x(), distal);
+        (
+            m * offset([0.0, 0.0, MEDIAL_LENGTH / 2.0], 0.0),
+            d * offset([0.0, 0.0, DISTAL_LENGTH / 2.0], 0.0),
+        )
     }
 
     /// Fingertip (centre of the distal link's end face) in the palm frame.
     pub fn fingertip(&self, f: usize, medial: f64, distal: f64) -> Point3<f64> {
-        let (_, d) = Self::finger_links(medial, distal);
-        self.finger_frame(f) * d * Point3::new(0.0, 0.0, DISTAL_LENGTH / 2.0)
+        let (_, d) = Self::finger_links(&self.finger_frame(f), medial, distal);
+        d * Point3::new(0.0, 0.0, DISTAL_LENGTH / 2.0)
     }
+}
+
+/// A fixed offset: a translation and a turn about `z` (URDF's `<origin xyz rpy="0 0 yaw">`).
+fn offset(xyz: [f64; 3], yaw: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(xyz[0], xyz[1], xyz[2]),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, yaw),
+    )
+}
+
+/// A revolute joint's motion: `angle` about the unit `axis`.
+fn turn(axis: Vector3<f64>, angle: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle),
+    )
 }
 
 impl Hand for BarrettHand {
@@ -230,14 +247,13 @@ impl Hand for BarrettHand {
             )));
         }
         ensure_finite(joints, "Barrett joint values")?;
-        let palm = Isometry3::translation(0.0, 0.0, PALM_TOP - PALM_THICKNESS / 2.0);
-        let mut out = vec![palm];
+        let mut out = vec![offset([0.0, 0.0, PALM_CENTRE], 0.0)];
         // The spread value of the joint vector is used for F1/F2 (it may differ from self.spread).
         for f in 0..3 {
             let frame = Self::frame_at(f, joints[0]);
-            let (m, d) = Self::finger_links(joints[1 + 2 * f], joints[2 + 2 * f]);
-            out.push(frame * m);
-            out.push(frame * d);
+            let (m, d) = Self::finger_links(&frame, joints[1 + 2 * f], joints[2 + 2 * f]);
+            out.push(m);
+            out.push(d);
         }
         Ok(out)
     }
@@ -249,11 +265,11 @@ impl Hand for BarrettHand {
         let r_medial = (half + Vector3::z() * MEDIAL_LENGTH).norm();
         let r_distal = (half + Vector3::z() * DISTAL_LENGTH).norm();
         for f in 0..3 {
-            let frame = palm * self.finger_frame(f);
+            let frame = self.finger_frame(f);
             let (im, id) = (1 + 2 * f, 2 + 2 * f);
             let poses = |m: f64, d: f64| -> (Pose, Pose) {
-                let (lm, ld) = Self::finger_links(m, d);
-                (iso2pose(&(frame * lm)), iso2pose(&(frame * ld)))
+                let (lm, ld) = Self::finger_links(&frame, m, d);
+                (iso2pose(&(palm * lm)), iso2pose(&(palm * ld)))
             };
             // Phase 1: medial and distal coupled (distal = medial / 3 + 0.8727, at most 90 deg).
             let adv = advance_until_contact(
