@@ -17,7 +17,8 @@ pub struct SimArgs {
     /// A user mesh (OBJ or STL, closed) instead of a built-in object.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
-    /// Hand: barrett or parallel_jaw.
+    /// Hand: a built-in name (barrett, parallel_jaw, franka_hand; see `graspopt hands`) or a
+    /// URDF file (FILE.urdf, settings in FILE.toml beside it).
     #[arg(long, default_value = "barrett")]
     pub hand: String,
     /// Contact model: surface (thesis 2.3), patch (circular patch) or mean (mean point).
