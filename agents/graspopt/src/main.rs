@@ -31,6 +31,8 @@ enum Command {
     Quality(commands::quality::QualityArgs),
     /// Run one simulated trial and print its contacts and metrics.
     Trial(commands::trial::TrialArgs),
+    /// List the built-in hands (or describe one, or a URDF file).
+    Hands(commands::hands::HandsArgs),
     /// Grid-scan a metric over trial parameters (CSV; SVG and PNG images for one or two).
     Scan(commands::scan::ScanArgs),
     /// Record a grid of simulated grasps' contact clouds (for `agent hand --replay`).
@@ -96,6 +98,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Quality(args) => commands::quality::run(args),
         Command::Trial(args) => commands::trial::run(args),
+        Command::Hands(args) => commands::hands::run(args),
         Command::Scan(args) => commands::scan::run(args),
         Command::Record(args) => commands::record::run(args),
         Command::Experiment(args) => commands::experiment::run(args),

@@ -8,7 +8,9 @@ use support::{decode_png, graspopt, tempdir};
 #[test]
 fn trial_prints_contacts_and_metrics() {
     let out = graspopt(&[
-        "trial", "--object", "sphere", "--at", "x=-0.1", "--format", "json",
+        // x = 0.01: inside the sphere's force-closure window (+0.005 to +0.02 with the corrected
+        // BH8, whose bent fingertips meet the sphere first when farther).
+        "trial", "--object", "sphere", "--at", "x=0.01", "--format", "json",
     ]);
     assert!(
         out.status.success(),
@@ -16,7 +18,7 @@ fn trial_prints_contacts_and_metrics() {
         String::from_utf8_lossy(&out.stderr)
     );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(e["params"], serde_json::json!([-0.1]));
+    assert_eq!(e["params"], serde_json::json!([0.01]));
     // The score and what it was computed from sit at the top level, not nested.
     let m = &e["metrics"];
     assert_eq!(m["force_closure"], true);
@@ -25,7 +27,7 @@ fn trial_prints_contacts_and_metrics() {
     assert!(e["contacts"].as_u64().unwrap() > 0, "{e}");
     assert_eq!(e["fingers_in_contact"], 3);
     assert_eq!(e["outcome"]["fingers"].as_array().unwrap().len(), 3);
-    let text = graspopt(&["trial", "--object", "sphere", "--at", "x=-0.1"]);
+    let text = graspopt(&["trial", "--object", "sphere", "--at", "x=0.01"]);
     let text = String::from_utf8(text.stdout).unwrap();
     assert!(
         text.contains("finger 3:") && text.contains("force closure true"),
@@ -373,4 +375,96 @@ fn a_mesh_in_millimetres_is_refused_until_scaled() {
     let out = graspopt(&["trial", "--mesh-scale", "0.001"]);
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn hands_lists_the_built_in_hands_and_describes_one() {
+    let out = graspopt(&["hands"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    for (name, fingers, joints, source) in [
+        ("barrett", 3, 8, "common/sim/hands/bh8_280.urdf"),
+        ("parallel_jaw", 2, 2, "common/sim/hands/parallel_jaw.urdf"),
+        ("franka_hand", 2, 2, "common/sim/hands/franka_hand.urdf"),
+    ] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_else(|| panic!("no {name}: {text}"));
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(
+            (cols[1], cols[2]),
+            (&*fingers.to_string(), &*joints.to_string()),
+            "{line}"
+        );
+        assert!(line.contains(source), "{line}");
+    }
+    let out = graspopt(&["hands", "bh8"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("barrett: 3 fingers"), "{text}");
+    assert!(
+        text.contains("f1_distal") && text.contains("open 0.8727"),
+        "{text}"
+    );
+}
+
+/// A two-jaw gripper in URDF, written by the test: two prismatic jaws, the second mimicking
+/// the first, so they close together.
+const JAWS_URDF: &str = r#"<robot name="two_jaws">
+  <link name="base"><collision><origin xyz="0 0 -0.01"/><geometry><box size="0.04 0.16 0.02"/></geometry></collision></link>
+  <link name="left"><collision><origin xyz="0 -0.005 0.03"/><geometry><box size="0.02 0.01 0.06"/></geometry></collision></link>
+  <link name="right"><collision><origin xyz="0 0.005 0.03"/><geometry><box size="0.02 0.01 0.06"/></geometry></collision></link>
+  <joint name="left" type="prismatic"><parent link="base"/><child link="left"/><origin xyz="0 -0.06 0"/><axis xyz="0 1 0"/><limit lower="0" upper="0.06" effort="1" velocity="1"/></joint>
+  <joint name="right" type="prismatic"><parent link="base"/><child link="right"/><origin xyz="0 0.06 0"/><axis xyz="0 -1 0"/><limit lower="0" upper="0.06" effort="1" velocity="1"/><mimic joint="left"/></joint>
+</robot>"#;
+
+#[test]
+fn trial_takes_a_urdf_hand_file_and_names_a_bad_one() {
+    let dir = tempdir("urdf-hand");
+    let path = dir.join("two_jaws.urdf");
+    std::fs::write(&path, JAWS_URDF).unwrap();
+    let hand = path.to_str().unwrap();
+    let out = graspopt(&[
+        "trial", "--object", "cuboid", "--hand", hand, "--format", "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let e: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(e["outcome"]["grasp"]["hand"], "two_jaws");
+    // The cuboid is 0.05 wide across the jaws: each jaw travels 0.06 - 0.025 less the gap.
+    let joints = e["outcome"]["grasp"]["joints"].as_array().unwrap();
+    let left = joints[0].as_f64().unwrap();
+    assert!((0.035 - 2e-4..0.035).contains(&left), "{joints:?}");
+    assert_eq!(joints[1], joints[0]);
+    assert_eq!(e["outcome"]["fingers"].as_array().unwrap().len(), 2);
+    // A missing file, and a bad one, are named.
+    let missing = dir.join("nope.urdf");
+    let out = graspopt(&["trial", "--hand", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("nope.urdf"), "{err}");
+    std::fs::write(
+        &path,
+        JAWS_URDF.replace("type=\"prismatic\"", "type=\"continuous\""),
+    )
+    .unwrap();
+    let out = graspopt(&["trial", "--hand", hand]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("two_jaws.urdf") && err.contains("`left`") && err.contains("continuous"),
+        "{err}"
+    );
+    let out = graspopt(&["trial", "--hand", "shadow"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown hand `shadow`") && err.contains("franka_hand"),
+        "{err}"
+    );
 }

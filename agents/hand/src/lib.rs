@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 #[serde(default, deny_unknown_fields)]
 pub struct HandConfig {
     pub id: String,
-    /// `barrett` or `parallel_jaw`.
+    /// A built-in hand (`barrett`, `parallel_jaw`, `franka_hand`) or a URDF file.
     pub hand: String,
     /// The world's object; `None`: the one perception names.
     pub object: Option<String>,

@@ -22,6 +22,15 @@ pub enum SimError {
         /// The valid names, comma separated.
         valid: String,
     },
+    /// A hand description (URDF and its settings) that cannot be used; names the file and the
+    /// joint, link or mesh at fault.
+    #[error("hand `{file}`: {reason}")]
+    BadHand {
+        /// The URDF (or settings) file, or the built-in hand's source.
+        file: String,
+        /// What is wrong, naming the joint, link or file.
+        reason: String,
+    },
     /// A pose, parameter or setting with a NaN or infinite component.
     #[error("non-finite value in {what}")]
     NonFinite {

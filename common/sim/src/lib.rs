@@ -1,8 +1,8 @@
 //! # graspopt-sim: simulated grasp trials
 //!
 //! The geometric core of graspopt's simulator: the seven test objects of the thesis (and user
-//! meshes), hands that close their fingers until contact (a Barrett BH8-style hand and a
-//! parallel-jaw gripper, both implementations of one [`hand::Hand`] trait), the raw contact clouds
+//! meshes), hands that close their fingers until contact (read from URDF: the Barrett BH8-280, a
+//! parallel-jaw gripper, the Franka hand, or the user's own; one [`hand::Hand`] trait), the raw contact clouds
 //! per finger and the three contact models of thesis section 4.3 (mean point, circular patch and
 //! the surface model of section 2.3), trial parameter spaces, and scene meshes for export.
 //!
@@ -43,8 +43,8 @@ pub mod trial;
 pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint, NoiseSettings};
 pub use error::SimError;
 pub use hand::{
-    BarrettHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec, ParallelJawGripper,
-    hand_by_name, hand_names,
+    BarrettHand, BuiltinHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec,
+    ParallelJawGripper, UrdfHand, builtin_hands, hand_by_name, hand_names,
 };
 pub use mesh::TriangleMesh;
 pub use object::{Object, ObjectKind, RayHit, SurfacePoint};

@@ -474,6 +474,25 @@ pub fn extrude_star_shaped(polygon: &[(f64, f64)], z0: f64, z1: f64) -> Triangle
     TriangleMesh::new(vertices, triangles).oriented_outward()
 }
 
+/// The convex hull of `points` as a closed mesh oriented outward, `None` when the points span
+/// no volume (fewer than four, or all in a plane).
+pub fn convex_hull(points: &[Point3<f64>]) -> Option<TriangleMesh> {
+    if points.len() < 4
+        || points
+            .iter()
+            .any(|p| !p.coords.iter().all(|c| c.is_finite()))
+    {
+        return None;
+    }
+    let pts: Vec<_> = points.iter().map(crate::convert::p2g).collect();
+    let (vertices, triangles) = parry3d_f64::transformation::convex_hull(&pts);
+    let hull = TriangleMesh::new(
+        vertices.into_iter().map(crate::convert::g2p).collect(),
+        triangles,
+    );
+    (hull.triangles.len() >= 4 && hull.signed_volume().abs() > 0.0).then(|| hull.oriented_outward())
+}
+
 // ---------------------------------------------------------------------------------------------
 // Loading
 // ---------------------------------------------------------------------------------------------

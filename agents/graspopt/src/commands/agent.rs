@@ -70,7 +70,7 @@ pub enum Kind {
     Hand {
         #[command(flatten)]
         common: Common,
-        /// barrett or parallel_jaw.
+        /// A built-in hand (see `graspopt hands`) or a URDF file.
         #[arg(long)]
         hand: Option<String>,
         /// Minimum trial duration (milliseconds).

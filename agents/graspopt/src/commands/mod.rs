@@ -4,6 +4,7 @@ pub mod agent;
 pub mod bench;
 pub mod experiment;
 pub mod export;
+pub mod hands;
 pub mod launch;
 pub mod monitor;
 pub mod optimize_function;

@@ -1,18 +1,34 @@
-//! A Barrett BH8-style hand: a palm disc and three fingers (F1, F2 spreading about the palm
+//! A Barrett BH8-280 hand: a palm disc and three fingers (F1, F2 spreading about the palm
 //! normal in opposite senses, F3 fixed), two links each, sizes and limits from the BH8-280
-//! kinematic description (see the constants).
+//! kinematic description (`shared/spec/barrett-hand.md`) and OpenRAVE's model of the hand (the
+//! one the thesis used), see the constants.
 //!
 //! Palm frame: `z` out of the palm (the approach direction), F1/F2 bases on the `x` axis, F3 on
 //! `+y`. With spread 0, F1 and F2 stand side by side at `y = -0.05` facing F3 at `y = +0.05`.
 //!
-//! Closing: the medial (proximal) joint advances from 0 with the distal joint coupled at one
-//! third of it. If the medial link touches, it stops and the distal joint continues alone (the
-//! TorqueSwitch breakaway) until the distal link touches or reaches its limit. If the distal link
-//! touches first, the whole finger stops. Simplifications: the knuckle housings between the palm
-//! and the flexion joints, the 0.003 m lateral offset of the distal joint and the fixed distal
-//! bend of the real hand are not modelled; links are boxes.
+//! Facts taken from OpenRAVE's `src/robots/barretthand.kinbody.xml` (rdiankov/openrave):
+//! - spread bases 0.025 m either side of the palm centre, the flexion joint 0.05 m out along the
+//!   finger from the spread axis, all three flexion joints in one plane (here 0.0754 m above
+//!   the palm's underside, as the spec says);
+//! - medial link 0.07 m from the flexion joint to the distal joint (`Translation 0.07 0 0`);
+//! - flexion joints `JF1..JF3` over `[0, 140]` degrees;
+//! - distal joints `JF1mimic..JF3mimic`: `mimic="JFk 0.33333 0.8727"`, i.e.
+//!   `distal = medial / 3 + 0.8727` rad, with limits `[0, 90]` degrees; the distal angle is
+//!   measured from the medial link's line, in the closing sense, so at rest (medial 0) the
+//!   distal link is bent 50 degrees inwards and the fingertips point towards the object.
+//!
+//! The distal length (0.059 m, joint to fingertip) is the spec's: OpenRAVE gives that link as a
+//! mesh only.
+//!
+//! Closing: the medial (proximal) joint advances from 0 with the distal joint coupled at
+//! `medial / 3 + 0.8727`, held at its 90 degree limit once the coupling reaches it. If the
+//! medial link touches, it stops and the distal joint continues alone (the TorqueSwitch
+//! breakaway) until the distal link touches or reaches its limit. If the distal link touches
+//! first, the whole finger stops. Simplifications: the knuckle housings between the palm and
+//! the flexion joints and the 0.003 m lateral offset of the distal joint are not modelled;
+//! links are boxes.
 
-use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use parry3d_f64::math::Pose;
 
 use super::{
@@ -27,8 +43,8 @@ use crate::object::Object;
 pub const PALM_RADIUS: f64 = 0.045;
 /// Palm disc thickness (below the finger bases).
 pub const PALM_THICKNESS: f64 = 0.02;
-/// Height of the palm's top face (the finger bases' plane).
-pub const PALM_TOP: f64 = 0.0415;
+/// Height of the palm disc's centre: its top face (the finger bases' plane) is at 0.0415.
+pub const PALM_CENTRE: f64 = 0.0315;
 /// F1 spread-joint base on the palm (F2 mirrored in `x`).
 pub const F1_BASE: [f64; 3] = [-0.025, 0.0, 0.0415];
 /// F3 base (its flexion joint; F3 has no spread).
@@ -37,8 +53,8 @@ pub const F3_BASE: [f64; 3] = [0.0, 0.05, 0.0754];
 pub const KNUCKLE_OUT: f64 = 0.05;
 /// From the spread-joint frame to the flexion joint: up (palm `z`).
 pub const KNUCKLE_UP: f64 = 0.0339;
-/// Medial link, joint to joint.
-pub const MEDIAL_LENGTH: f64 = 0.06994;
+/// Medial link, joint to joint (OpenRAVE's 0.07; the spec's measured 0.06994 differs by 0.06 mm).
+pub const MEDIAL_LENGTH: f64 = 0.07;
 /// Distal link, joint to fingertip.
 pub const DISTAL_LENGTH: f64 = 0.059;
 /// Finger width (along the flexion axis).
@@ -47,8 +63,13 @@ pub const FINGER_WIDTH: f64 = 0.025;
 pub const FINGER_THICKNESS: f64 = 0.02;
 /// Flexion range of the medial joint: `[0, FLEX_MAX]` (140 degrees).
 pub const FLEX_MAX: f64 = 2.44346;
-/// Distal joint range `[0, FLEX_MAX / 3]` (the coupled motion's end; breakaway stays within it).
-pub const DISTAL_MAX: f64 = FLEX_MAX / 3.0;
+/// Distal joint upper limit (90 degrees, OpenRAVE's `limitsdeg 0 90`); the lower limit is 0.
+pub const DISTAL_MAX: f64 = std::f64::consts::FRAC_PI_2;
+/// The distal joint's coupling ratio to the medial joint (OpenRAVE: 0.33333).
+pub const DISTAL_RATIO: f64 = 1.0 / 3.0;
+/// The fixed distal bend: the coupled distal angle at medial 0 (OpenRAVE's mimic offset, 50
+/// degrees).
+pub const DISTAL_OFFSET: f64 = 0.8727;
 /// Spread range `[0, pi]`.
 pub const SPREAD_MAX: f64 = std::f64::consts::PI;
 
@@ -123,45 +144,62 @@ impl BarrettHand {
         Self::frame_at(f, self.spread)
     }
 
+    /// The flexion joint frame of finger `f` at `spread`. The frames are composed joint by
+    /// joint (a fixed offset, then the joint's motion), in the order and with the operations a
+    /// URDF chain uses, so that the URDF description of this hand gives the same poses to the
+    /// last bit.
     fn frame_at(f: usize, spread: f64) -> Isometry3<f64> {
-        let (joint, out) = match f {
+        match f {
             0 | 1 => {
+                // F1 spreads about -z, F2 (mirrored in x) about +z; both knuckle frames are
+                // turned half a turn so that their y points out along the finger.
                 let sign = if f == 0 { -1.0 } else { 1.0 };
-                let base = Vector3::new(sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]);
-                let out =
-                    Rotation3::from_axis_angle(&Vector3::z_axis(), sign * spread) * -Vector3::y();
-                (base + KNUCKLE_OUT * out + KNUCKLE_UP * Vector3::z(), out)
+                let knuckle = offset(
+                    [sign * -F1_BASE[0], F1_BASE[1], F1_BASE[2]],
+                    std::f64::consts::PI,
+                ) * turn(Vector3::new(0.0, 0.0, sign), spread);
+                knuckle * offset([0.0, KNUCKLE_OUT, KNUCKLE_UP], 0.0)
             }
-            _ => (
-                Vector3::new(F3_BASE[0], F3_BASE[1], F3_BASE[2]),
-                Vector3::y(),
-            ),
-        };
-        let axis = out.cross(&Vector3::z());
-        let rot =
-            Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[axis, out, Vector3::z()]));
-        Isometry3::from_parts(
-            Translation3::from(joint),
-            UnitQuaternion::from_rotation_matrix(&rot),
-        )
+            _ => offset(F3_BASE, 0.0),
+        }
     }
 
-    /// Medial and distal link frames relative to the finger frame.
-    fn finger_links(medial: f64, distal: f64) -> (Isometry3<f64>, Isometry3<f64>) {
-        let r1 = Isometry3::rotation(Vector3::x() * medial);
-        let m = r1 * Translation3::new(0.0, 0.0, MEDIAL_LENGTH / 2.0);
-        let d = r1
-            * Translation3::new(0.0, 0.0, MEDIAL_LENGTH)
-            * Isometry3::rotation(Vector3::x() * distal)
-            * Translation3::new(0.0, 0.0, DISTAL_LENGTH / 2.0);
-        (m, d)
+    /// Medial and distal link frames (box centres) in the palm frame, for the flexion joint
+    /// frame `flex`.
+    fn finger_links(
+        flex: &Isometry3<f64>,
+        medial: f64,
+        distal: f64,
+    ) -> (Isometry3<f64>, Isometry3<f64>) {
+        let m = flex * turn(Vector3::x(), medial);
+        let d = (m * offset([0.0, 0.0, MEDIAL_LENGTH], 0.0)) * turn(Vector3::x(), distal);
+        (
+            m * offset([0.0, 0.0, MEDIAL_LENGTH / 2.0], 0.0),
+            d * offset([0.0, 0.0, DISTAL_LENGTH / 2.0], 0.0),
+        )
     }
 
     /// Fingertip (centre of the distal link's end face) in the palm frame.
     pub fn fingertip(&self, f: usize, medial: f64, distal: f64) -> Point3<f64> {
-        let (_, d) = Self::finger_links(medial, distal);
-        self.finger_frame(f) * d * Point3::new(0.0, 0.0, DISTAL_LENGTH / 2.0)
+        let (_, d) = Self::finger_links(&self.finger_frame(f), medial, distal);
+        d * Point3::new(0.0, 0.0, DISTAL_LENGTH / 2.0)
     }
+}
+
+/// A fixed offset: a translation and a turn about `z` (URDF's `<origin xyz rpy="0 0 yaw">`).
+fn offset(xyz: [f64; 3], yaw: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(xyz[0], xyz[1], xyz[2]),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, yaw),
+    )
+}
+
+/// A revolute joint's motion: `angle` about the unit `axis`.
+fn turn(axis: Vector3<f64>, angle: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle),
+    )
 }
 
 impl Hand for BarrettHand {
@@ -197,7 +235,8 @@ impl Hand for BarrettHand {
     }
 
     fn open_configuration(&self) -> Vec<f64> {
-        vec![self.spread, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        let d = coupled_distal(0.0);
+        vec![self.spread, 0.0, d, 0.0, d, 0.0, d]
     }
 
     fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>> {
@@ -208,14 +247,13 @@ impl Hand for BarrettHand {
             )));
         }
         ensure_finite(joints, "Barrett joint values")?;
-        let palm = Isometry3::translation(0.0, 0.0, PALM_TOP - PALM_THICKNESS / 2.0);
-        let mut out = vec![palm];
+        let mut out = vec![offset([0.0, 0.0, PALM_CENTRE], 0.0)];
         // The spread value of the joint vector is used for F1/F2 (it may differ from self.spread).
         for f in 0..3 {
             let frame = Self::frame_at(f, joints[0]);
-            let (m, d) = Self::finger_links(joints[1 + 2 * f], joints[2 + 2 * f]);
-            out.push(frame * m);
-            out.push(frame * d);
+            let (m, d) = Self::finger_links(&frame, joints[1 + 2 * f], joints[2 + 2 * f]);
+            out.push(m);
+            out.push(d);
         }
         Ok(out)
     }
@@ -227,16 +265,16 @@ impl Hand for BarrettHand {
         let r_medial = (half + Vector3::z() * MEDIAL_LENGTH).norm();
         let r_distal = (half + Vector3::z() * DISTAL_LENGTH).norm();
         for f in 0..3 {
-            let frame = palm * self.finger_frame(f);
+            let frame = self.finger_frame(f);
             let (im, id) = (1 + 2 * f, 2 + 2 * f);
             let poses = |m: f64, d: f64| -> (Pose, Pose) {
-                let (lm, ld) = Self::finger_links(m, d);
-                (iso2pose(&(frame * lm)), iso2pose(&(frame * ld)))
+                let (lm, ld) = Self::finger_links(&frame, m, d);
+                (iso2pose(&(palm * lm)), iso2pose(&(palm * ld)))
             };
-            // Phase 1: medial and distal coupled (distal = medial / 3).
+            // Phase 1: medial and distal coupled (distal = medial / 3 + 0.8727, at most 90 deg).
             let adv = advance_until_contact(
                 |t| {
-                    let (pm, pd) = poses(t, t / 3.0);
+                    let (pm, pd) = poses(t, coupled_distal(t));
                     Ok(vec![
                         self.geometry.distance_g(object, im, &pm, 0.05)?,
                         self.geometry.distance_g(object, id, &pd, 0.05)?,
@@ -244,10 +282,10 @@ impl Hand for BarrettHand {
                 },
                 0.0,
                 FLEX_MAX,
-                &[r_medial, MEDIAL_LENGTH + r_distal + r_distal / 3.0],
+                &[r_medial, MEDIAL_LENGTH + r_distal + r_distal * DISTAL_RATIO],
             )?;
             let medial = adv.t;
-            let mut distal = adv.t / 3.0;
+            let mut distal = coupled_distal(adv.t);
             if adv.touched == Some(0) {
                 // Phase 2: medial blocked, distal continues alone (unless already touching).
                 let (_, pm) = poses(medial, distal);
@@ -278,4 +316,10 @@ impl Hand for BarrettHand {
             joints,
         )
     }
+}
+
+/// The distal angle coupled to the medial one before the breakaway: `medial / 3 + 0.8727`,
+/// held at the distal limit once it reaches it.
+pub fn coupled_distal(medial: f64) -> f64 {
+    (DISTAL_RATIO * medial + DISTAL_OFFSET).min(DISTAL_MAX)
 }

@@ -1,10 +1,13 @@
 //! Hands: the [`Hand`] trait (links as collision shapes, their poses as a function of the joint
-//! values, an open configuration and an auto-grasp `close`), the shared closing machinery, and two
-//! implementations: [`BarrettHand`] (BH8-style, three fingers) and [`ParallelJawGripper`].
+//! values, an open configuration and an auto-grasp `close`), the shared closing machinery, and
+//! [`UrdfHand`], a hand read from URDF (see [`urdf`] for the conventions). The built-in hands
+//! ([`builtin_hands`]: the Barrett BH8-280, a parallel-jaw gripper, the Franka hand) are URDF
+//! files in `common/sim/hands/`, embedded in the binary.
 //!
-//! A new hand is a new implementation of [`Hand`]; the public helpers here ([`LinkGeometry`],
-//! [`clear_hand`], [`advance_until_contact`], [`finish_grasp`]) do the collision work (see the
-//! `Pusher` hand in this crate's tests for a complete example in 50 lines).
+//! [`BarrettHand`] and [`ParallelJawGripper`] are the same hands written in Rust; they stay as
+//! test oracles that the URDF versions must match. A hand can also be a new implementation of
+//! [`Hand`]; the public helpers here ([`LinkGeometry`], [`clear_hand`], [`advance_until_contact`],
+//! [`finish_grasp`]) do the collision work (see the `Pusher` hand in this crate's tests).
 //!
 //! Placing: if the open hand intersects the object at the requested palm pose, it is retreated
 //! along its approach axis (palm `-z`) until clear and advanced back until a link is within
@@ -21,15 +24,17 @@
 
 mod barrett;
 mod gripper;
+pub mod urdf;
 
 pub use barrett::BarrettHand;
 pub use gripper::ParallelJawGripper;
+pub use urdf::UrdfHand;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::math::Pose;
-use parry3d_f64::shape::{Cuboid, Cylinder, Shape};
+use parry3d_f64::shape::{Ball, ConvexPolyhedron, Cuboid, Cylinder, Shape};
 
-use crate::convert::{iso2pose, v2g};
+use crate::convert::{iso2pose, p2g, v2g};
 use crate::error::{Result, SimError, ensure_finite};
 use crate::mesh::{self, TriangleMesh};
 use crate::object::Object;
@@ -50,7 +55,7 @@ pub const MAX_OVERSHOOT: f64 = 1e-3;
 pub const MAX_RETREAT: f64 = 0.5;
 
 /// Collision shape of a link, centred in the link frame.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum LinkShape {
     /// A box with these half extents along the link frame's axes.
     Box {
@@ -63,6 +68,16 @@ pub enum LinkShape {
         radius: f64,
         /// Half of the height along `z`.
         half_height: f64,
+    },
+    /// A ball centred on the link frame's origin.
+    Sphere {
+        /// Radius.
+        radius: f64,
+    },
+    /// A convex mesh in the link frame (a URDF mesh link is stored as its convex hull).
+    Mesh {
+        /// The closed convex mesh, triangles counter-clockwise seen from outside.
+        mesh: TriangleMesh,
     },
 }
 
@@ -83,6 +98,16 @@ impl LinkShape {
                 ],
                 48,
             ),
+            LinkShape::Sphere { radius } => {
+                let profile: Vec<(f64, f64)> = (0..=24)
+                    .map(|i| {
+                        let a = std::f64::consts::PI * (i as f64 / 24.0 - 0.5);
+                        (radius * a.cos(), radius * a.sin())
+                    })
+                    .collect();
+                mesh::revolve(&profile, 48)
+            }
+            LinkShape::Mesh { mesh } => mesh.clone(),
         }
     }
 
@@ -94,6 +119,29 @@ impl LinkShape {
                 radius,
                 half_height,
             } => radius.hypot(*half_height),
+            LinkShape::Sphere { radius } => *radius,
+            LinkShape::Mesh { mesh } => mesh
+                .vertices
+                .iter()
+                .map(|v| v.coords.norm())
+                .fold(0.0, f64::max),
+        }
+    }
+
+    /// Largest distance from the point `p` (link frame) to a point of the shape.
+    pub fn farthest_from(&self, p: &nalgebra::Point3<f64>) -> f64 {
+        match self {
+            LinkShape::Box { half_extents } => (p.coords.abs() + half_extents).norm(),
+            LinkShape::Cylinder {
+                radius,
+                half_height,
+            } => (p.x.hypot(p.y) + radius).hypot(p.z.abs() + half_height),
+            LinkShape::Sphere { radius } => p.coords.norm() + radius,
+            LinkShape::Mesh { mesh } => mesh
+                .vertices
+                .iter()
+                .map(|v| (v - p).norm())
+                .fold(0.0, f64::max),
         }
     }
 }
@@ -160,19 +208,84 @@ pub trait Hand: Send + Sync + std::fmt::Debug {
     fn close(&self, object: &Object, palm_pose: &Isometry3<f64>) -> Result<Grasp>;
 }
 
-/// The built-in hand names.
-pub fn hand_names() -> Vec<&'static str> {
-    vec!["barrett", "parallel_jaw"]
+/// A hand shipped with graspopt: a URDF file (and its settings) in `common/sim/hands/`, embedded
+/// in the binary.
+#[derive(Clone, Copy, Debug)]
+pub struct BuiltinHand {
+    /// The name `--hand` takes.
+    pub name: &'static str,
+    /// Other names accepted for it.
+    pub aliases: &'static [&'static str],
+    /// The URDF file in the repository.
+    pub source: &'static str,
+    /// The settings file beside it, if any.
+    pub settings_source: Option<&'static str>,
+    urdf: &'static str,
+    settings: Option<&'static str>,
 }
 
-/// A built-in hand by name (`barrett`, `parallel_jaw`).
+impl BuiltinHand {
+    /// Builds the hand from its embedded description.
+    pub fn build(&self) -> Result<UrdfHand> {
+        UrdfHand::from_strs(self.source, self.urdf, self.settings, None)
+    }
+}
+
+const BUILTIN_HANDS: [BuiltinHand; 3] = [
+    BuiltinHand {
+        name: "barrett",
+        aliases: &["bh8", "bh8_280"],
+        source: "common/sim/hands/bh8_280.urdf",
+        settings_source: Some("common/sim/hands/bh8_280.toml"),
+        urdf: include_str!("../../hands/bh8_280.urdf"),
+        settings: Some(include_str!("../../hands/bh8_280.toml")),
+    },
+    BuiltinHand {
+        name: "parallel_jaw",
+        aliases: &["gripper"],
+        source: "common/sim/hands/parallel_jaw.urdf",
+        settings_source: None,
+        urdf: include_str!("../../hands/parallel_jaw.urdf"),
+        settings: None,
+    },
+    BuiltinHand {
+        name: "franka_hand",
+        aliases: &["franka", "panda_hand"],
+        source: "common/sim/hands/franka_hand.urdf",
+        settings_source: Some("common/sim/hands/franka_hand.toml"),
+        urdf: include_str!("../../hands/franka_hand.urdf"),
+        settings: Some(include_str!("../../hands/franka_hand.toml")),
+    },
+];
+
+/// The hands shipped with graspopt.
+pub fn builtin_hands() -> &'static [BuiltinHand] {
+    &BUILTIN_HANDS
+}
+
+/// The built-in hand names.
+pub fn hand_names() -> Vec<&'static str> {
+    BUILTIN_HANDS.iter().map(|h| h.name).collect()
+}
+
+/// A built-in hand by name (see [`builtin_hands`]; `-` and `_` alike, any case), or a hand read
+/// from a URDF file (a name ending in `.urdf`, see [`urdf`]).
 pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
-    match name.trim().to_ascii_lowercase().replace('-', "_").as_str() {
-        "barrett" | "bh8" => Ok(Box::new(BarrettHand::default())),
-        "parallel_jaw" | "gripper" => Ok(Box::new(ParallelJawGripper::default())),
-        _ => Err(SimError::UnknownHand {
+    let trimmed = name.trim();
+    if trimmed.to_ascii_lowercase().ends_with(".urdf") {
+        return Ok(Box::new(UrdfHand::from_file(std::path::Path::new(
+            trimmed,
+        ))?));
+    }
+    let key = trimmed.to_ascii_lowercase().replace('-', "_");
+    match BUILTIN_HANDS
+        .iter()
+        .find(|h| h.name == key || h.aliases.contains(&key.as_str()))
+    {
+        Some(h) => Ok(Box::new(h.build()?)),
+        None => Err(SimError::UnknownHand {
             name: name.to_string(),
-            valid: hand_names().join(", "),
+            valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
         }),
     }
 }
@@ -195,9 +308,9 @@ impl LinkGeometry {
             .iter()
             .map(|l| {
                 let r = l.shape.bounding_radius();
-                match l.shape {
+                match &l.shape {
                     LinkShape::Box { half_extents } => (
-                        Box::new(Cuboid::new(v2g(&half_extents))) as Box<dyn Shape>,
+                        Box::new(Cuboid::new(v2g(half_extents))) as Box<dyn Shape>,
                         Pose::IDENTITY,
                         r,
                     ),
@@ -205,7 +318,7 @@ impl LinkGeometry {
                         radius,
                         half_height,
                     } => (
-                        Box::new(Cylinder::new(half_height, radius)) as Box<dyn Shape>,
+                        Box::new(Cylinder::new(*half_height, *radius)) as Box<dyn Shape>,
                         // parry cylinders are along y; the link's axis is z.
                         iso2pose(&Isometry3::from_parts(
                             Translation3::identity(),
@@ -216,6 +329,22 @@ impl LinkGeometry {
                         )),
                         r,
                     ),
+                    LinkShape::Sphere { radius } => (
+                        Box::new(Ball::new(*radius)) as Box<dyn Shape>,
+                        Pose::IDENTITY,
+                        r,
+                    ),
+                    LinkShape::Mesh { mesh } => {
+                        let points: Vec<_> = mesh.vertices.iter().map(p2g).collect();
+                        // A mesh that is no convex solid falls back to a ball of its radius
+                        // (meshes built by this crate are convex hulls, see mesh::convex_hull).
+                        let shape: Box<dyn Shape> =
+                            match ConvexPolyhedron::from_convex_hull(&points) {
+                                Some(c) => Box::new(c),
+                                None => Box::new(Ball::new(r)),
+                            };
+                        (shape, Pose::IDENTITY, r)
+                    }
                 }
             })
             .collect();

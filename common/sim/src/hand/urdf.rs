@@ -1,0 +1,1028 @@
+//! Hands described by URDF (parsed with the `urdf-rs` crate), with an optional TOML file of
+//! settings that URDF cannot say.
+//!
+//! # Conventions
+//! - The root link (the one link that is no joint's child) is the palm; the palm frame is the
+//!   root link's frame and the approach direction is its `+z`.
+//! - Every `revolute` or `prismatic` joint without `<mimic>` *closes*: from its lower limit (open)
+//!   towards its upper limit (closed). A `<mimic>` joint follows its joint as
+//!   `multiplier * value + offset`, clamped to its own limits when it has a range. `fixed` joints
+//!   are rigid.
+//! - Closing is GraspIt!/OpenRAVE's auto-grasp, generalised to a kinematic tree: each closing
+//!   joint in turn (parents before children, then file order) advances with
+//!   [`advance_until_contact`] over the links it moves (its subtree and the subtrees of the joints
+//!   that mimic it). When a link touches the object, that joint stops, and so does every joint
+//!   between it and the palm (a later joint whose links include a touching one does not move);
+//!   joints after the touching link still close.
+//! - Collision geometry: `<collision>` elements with `box`, `cylinder`, `sphere` or `mesh` (OBJ or
+//!   STL, with `scale`) and their `<origin>`. A link may have several; each is one collision body
+//!   of the hand (named `link`, then `link#2`, ...). A mesh is used as its convex hull. `<visual>`
+//!   and `<inertial>` are ignored, and so are other top-level elements (`<transmission>`,
+//!   `<gazebo>`, ...).
+//! - Fingers: by default, the links after the same first moving joint (on the path from the palm)
+//!   form one finger, numbered in file order of those joints; links fixed to the palm are palm.
+//!   Mesh paths are relative to the URDF file's folder; `package://NAME/rest` is looked up in the
+//!   ancestor folder named `NAME`.
+//!
+//! Errors name the joint, link or file: a closing or mimic joint with no limits (URDF's default
+//! `lower = upper = 0`) or of type `continuous`, `floating`, `planar` or `spherical`; a link that
+//! is the child of two joints, a loop or several roots; a joint naming an unknown link; a missing
+//! or unreadable mesh; capsule geometry or a mesh format other than OBJ/STL; a mimic joint whose
+//! joint is missing, fixed or itself a mimic.
+//!
+//! # Settings (TOML)
+//! A file beside the URDF with the same stem and the extension `.toml` (read by
+//! [`UrdfHand::from_file`] when it exists; the URDF alone must and does work):
+//! ```toml
+//! name = "barrett"              # the hand's name (default: the URDF robot's name)
+//! fingers = [["f1_medial", "f1_distal"], ["f2_medial", "f2_distal"]]  # links per finger
+//!
+//! [joints.spread]
+//! hold = true                   # not a closing joint: stays at its open value
+//! open = 0.0                    # open value (default: the limit it closes from)
+//!
+//! [joints.f1_distal]
+//! breakaway = true              # a mimic joint that, once its joint stops on a link that is
+//!                               # not one of its own, continues alone to its upper limit
+//!                               # (the BH8's TorqueSwitch)
+//!
+//! [joints.finger_joint1]
+//! close = "lower"               # closes from its upper limit towards its lower limit
+//! ```
+//! With `fingers`, links listed nowhere belong to the palm. Unknown keys, joints or links are
+//! errors.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
+
+use super::{
+    Grasp, Hand, LinkGeometry, LinkShape, LinkSpec, advance_until_contact, clear_hand, finish_grasp,
+};
+use crate::convert::iso2pose;
+use crate::error::{Result, SimError, ensure_finite};
+use crate::mesh::{self, TriangleMesh};
+use crate::object::Object;
+
+/// Per-hand settings that URDF cannot say (the TOML file beside the URDF).
+#[derive(Clone, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HandSettings {
+    /// The hand's name (default: the URDF robot's name).
+    pub name: Option<String>,
+    /// Links of each finger, in finger order (default: see the module doc).
+    pub fingers: Option<Vec<Vec<String>>>,
+    /// Settings per joint name.
+    #[serde(default)]
+    pub joints: BTreeMap<String, JointSettings>,
+}
+
+/// Settings of one joint.
+#[derive(Clone, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSettings {
+    /// Open value (default: the limit the joint closes from).
+    pub open: Option<f64>,
+    /// The joint does not close: it stays at its open value.
+    #[serde(default)]
+    pub hold: bool,
+    /// Which limit the joint closes towards (default `upper`).
+    pub close: Option<CloseTowards>,
+    /// For a mimic joint: continue alone once its joint stops on a link that is not its own.
+    #[serde(default)]
+    pub breakaway: bool,
+}
+
+/// The limit a joint closes towards.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CloseTowards {
+    /// From the lower limit to the upper (the default).
+    Upper,
+    /// From the upper limit to the lower (e.g. the Franka hand's fingers).
+    Lower,
+}
+
+impl HandSettings {
+    /// Parses the TOML text of a settings file; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self> {
+        toml::from_str(text).map_err(|e| bad(file, format!("settings: {e}")))
+    }
+}
+
+fn bad(file: &str, reason: impl Into<String>) -> SimError {
+    SimError::BadHand {
+        file: file.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// How a joint moves.
+#[derive(Clone, Copy, Debug)]
+enum Motion {
+    Fixed,
+    Revolute(Unit<Vector3<f64>>),
+    Prismatic(Unit<Vector3<f64>>),
+}
+
+/// What a joint with a value does while the hand closes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    /// Closes: +1 towards the upper limit, -1 towards the lower.
+    Closing(f64),
+    /// Stays at its open value.
+    Held,
+    /// Follows `master` (a degree-of-freedom index) as `multiplier * value + offset`.
+    Mimic {
+        master: usize,
+        multiplier: f64,
+        offset: f64,
+        breakaway: bool,
+    },
+}
+
+#[derive(Clone, Debug)]
+struct JointModel {
+    parent: usize,
+    child: usize,
+    origin: Isometry3<f64>,
+    motion: Motion,
+    /// Index into the joint vector (`None` for fixed joints).
+    dof: Option<usize>,
+}
+
+#[derive(Clone, Debug)]
+struct Dof {
+    name: String,
+    joint: usize,
+    limits: (f64, f64),
+    role: Role,
+    open: f64,
+}
+
+/// A collision body: one `<collision>` element of a link.
+#[derive(Clone, Debug)]
+struct Body {
+    link: usize,
+    origin: Isometry3<f64>,
+}
+
+/// Geometry of a `<collision>` element before meshes are loaded.
+#[derive(Clone, Debug)]
+enum RawShape {
+    Ready(LinkShape),
+    Mesh { filename: String, scale: [f64; 3] },
+}
+
+/// A parsed URDF hand description, meshes not yet loaded (see [`UrdfHand::new`]).
+#[derive(Clone, Debug)]
+pub struct HandDescription {
+    file: String,
+    name: String,
+    link_names: Vec<String>,
+    /// Joints in an order where parents come before children.
+    joints: Vec<JointModel>,
+    dofs: Vec<Dof>,
+    bodies: Vec<(Body, String, Option<usize>, RawShape)>,
+    finger_count: usize,
+}
+
+fn pose_of(p: &urdf_rs::Pose) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]),
+        UnitQuaternion::from_euler_angles(p.rpy[0], p.rpy[1], p.rpy[2]),
+    )
+}
+
+impl HandDescription {
+    /// Parses URDF text and optional settings; `file` names the URDF in errors.
+    pub fn parse(file: &str, urdf: &str, settings: Option<&HandSettings>) -> Result<Self> {
+        let robot = urdf_rs::read_from_string(urdf).map_err(|e| bad(file, e.to_string()))?;
+        let default_settings = HandSettings::default();
+        let settings = settings.unwrap_or(&default_settings);
+        let link_names: Vec<String> = robot.links.iter().map(|l| l.name.clone()).collect();
+        let link_index = |name: &str, joint: &str| -> Result<usize> {
+            link_names.iter().position(|l| l == name).ok_or_else(|| {
+                bad(
+                    file,
+                    format!("joint `{joint}` names the link `{name}`, which is not defined"),
+                )
+            })
+        };
+        if link_names.is_empty() {
+            return Err(bad(file, "no links"));
+        }
+        for (i, l) in link_names.iter().enumerate() {
+            if link_names[..i].contains(l) {
+                return Err(bad(file, format!("link `{l}` is defined twice")));
+            }
+        }
+        // The tree: every link is the child of at most one joint; one root; no loop.
+        let mut parent_joint: Vec<Option<usize>> = vec![None; link_names.len()];
+        let mut ends = Vec::with_capacity(robot.joints.len());
+        for (j, joint) in robot.joints.iter().enumerate() {
+            if robot.joints[..j].iter().any(|o| o.name == joint.name) {
+                return Err(bad(
+                    file,
+                    format!("joint `{}` is defined twice", joint.name),
+                ));
+            }
+            let p = link_index(&joint.parent.link, &joint.name)?;
+            let c = link_index(&joint.child.link, &joint.name)?;
+            if let Some(other) = parent_joint[c] {
+                return Err(bad(
+                    file,
+                    format!(
+                        "kinematic loop: link `{}` is the child of joints `{}` and `{}` (a hand must be a tree)",
+                        link_names[c], robot.joints[other].name, joint.name
+                    ),
+                ));
+            }
+            parent_joint[c] = Some(j);
+            ends.push((p, c));
+        }
+        let roots: Vec<usize> = (0..link_names.len())
+            .filter(|&l| parent_joint[l].is_none())
+            .collect();
+        let root = match roots.as_slice() {
+            [r] => *r,
+            [] => {
+                return Err(bad(
+                    file,
+                    "kinematic loop: every link is the child of a joint, so there is no root (palm) link",
+                ));
+            }
+            many => {
+                let names: Vec<&str> = many.iter().map(|&l| link_names[l].as_str()).collect();
+                return Err(bad(
+                    file,
+                    format!(
+                        "several root links ({}): a hand has one palm link that every other link hangs from",
+                        names.join(", ")
+                    ),
+                ));
+            }
+        };
+        // Joint order: file order, except that a joint comes after the joint that places its
+        // parent link.
+        let mut order: Vec<usize> = Vec::new();
+        let mut seen = vec![false; link_names.len()];
+        seen[root] = true;
+        let mut placed = vec![false; ends.len()];
+        while let Some(j) = (0..ends.len()).find(|&j| !placed[j] && seen[ends[j].0]) {
+            let c = ends[j].1;
+            if seen[c] {
+                return Err(bad(
+                    file,
+                    format!("kinematic loop through link `{}`", link_names[c]),
+                ));
+            }
+            seen[c] = true;
+            placed[j] = true;
+            order.push(j);
+        }
+        if let Some(l) = seen.iter().position(|s| !s) {
+            return Err(bad(
+                file,
+                format!(
+                    "kinematic loop: link `{}` cannot be reached from the root link `{}`",
+                    link_names[l], link_names[root]
+                ),
+            ));
+        }
+        // Degrees of freedom in file order.
+        let mut dof_of_joint: Vec<Option<usize>> = vec![None; robot.joints.len()];
+        let mut dofs: Vec<Dof> = Vec::new();
+        let mut motions = Vec::with_capacity(robot.joints.len());
+        for (j, joint) in robot.joints.iter().enumerate() {
+            let name = &joint.name;
+            let axis = || -> Result<Unit<Vector3<f64>>> {
+                let a = Vector3::new(joint.axis.xyz[0], joint.axis.xyz[1], joint.axis.xyz[2]);
+                Unit::try_new(a, 1e-12)
+                    .filter(|_| a.iter().all(|v| v.is_finite()))
+                    .ok_or_else(|| bad(file, format!("joint `{name}` has a zero or invalid axis")))
+            };
+            let motion = match joint.joint_type {
+                urdf_rs::JointType::Fixed => Motion::Fixed,
+                urdf_rs::JointType::Revolute => Motion::Revolute(axis()?),
+                urdf_rs::JointType::Prismatic => Motion::Prismatic(axis()?),
+                urdf_rs::JointType::Continuous => {
+                    return Err(bad(
+                        file,
+                        format!(
+                            "joint `{name}` is continuous: it has no limits, so it has no open and closed ends (make it revolute with limits)"
+                        ),
+                    ));
+                }
+                ref other => {
+                    return Err(bad(
+                        file,
+                        format!(
+                            "joint `{name}` has the unsupported type {other:?} (revolute, prismatic and fixed joints are supported)"
+                        ),
+                    ));
+                }
+            };
+            motions.push(motion);
+            if matches!(motion, Motion::Fixed) {
+                continue;
+            }
+            let (lo, hi) = (joint.limit.lower, joint.limit.upper);
+            if !(lo.is_finite() && hi.is_finite()) || lo > hi {
+                return Err(bad(
+                    file,
+                    format!("joint `{name}` has invalid limits [{lo}, {hi}]"),
+                ));
+            }
+            dof_of_joint[j] = Some(dofs.len());
+            dofs.push(Dof {
+                name: name.clone(),
+                joint: j,
+                limits: (lo, hi),
+                role: Role::Held,
+                open: lo,
+            });
+        }
+        // Roles, with the settings.
+        for (name, _) in settings.joints.iter() {
+            if !dofs.iter().any(|d| &d.name == name) {
+                return Err(bad(
+                    file,
+                    format!(
+                        "settings name the joint `{name}`, which is not a revolute or prismatic joint of the URDF"
+                    ),
+                ));
+            }
+        }
+        for dof in dofs.iter_mut() {
+            let joint = &robot.joints[dof.joint];
+            let name = joint.name.clone();
+            let s = settings.joints.get(&name).cloned().unwrap_or_default();
+            let (lo, hi) = dof.limits;
+            match &joint.mimic {
+                Some(m) => {
+                    let master_joint = robot
+                        .joints
+                        .iter()
+                        .position(|o| o.name == m.joint)
+                        .ok_or_else(|| {
+                            bad(
+                                file,
+                                format!(
+                                    "joint `{name}` mimics `{}`, which is not defined",
+                                    m.joint
+                                ),
+                            )
+                        })?;
+                    let master = dof_of_joint[master_joint].ok_or_else(|| {
+                        bad(
+                            file,
+                            format!("joint `{name}` mimics the fixed joint `{}`", m.joint),
+                        )
+                    })?;
+                    if robot.joints[master_joint].mimic.is_some() {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "joint `{name}` mimics `{}`, which is itself a mimic joint (not supported)",
+                                m.joint
+                            ),
+                        ));
+                    }
+                    if s.open.is_some() || s.hold || s.close.is_some() {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "settings of the mimic joint `{name}`: only `breakaway` applies (it follows `{}`)",
+                                m.joint
+                            ),
+                        ));
+                    }
+                    let multiplier = m.multiplier.unwrap_or(1.0);
+                    let offset = m.offset.unwrap_or(0.0);
+                    ensure_finite(
+                        &[multiplier, offset],
+                        &format!("the mimic of joint `{name}`"),
+                    )?;
+                    dof.role = Role::Mimic {
+                        master,
+                        multiplier,
+                        offset,
+                        breakaway: s.breakaway,
+                    };
+                }
+                None => {
+                    if lo >= hi {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "joint `{name}` has no limits (lower {lo}, upper {hi}): a closing joint needs <limit lower=.. upper=..> with lower < upper"
+                            ),
+                        ));
+                    }
+                    if s.breakaway {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "settings: `breakaway` applies to mimic joints only, and `{name}` is not one"
+                            ),
+                        ));
+                    }
+                    let dir = match s.close.unwrap_or(CloseTowards::Upper) {
+                        CloseTowards::Upper => 1.0,
+                        CloseTowards::Lower => -1.0,
+                    };
+                    dof.role = if s.hold {
+                        Role::Held
+                    } else {
+                        Role::Closing(dir)
+                    };
+                    let open = s.open.unwrap_or(if dir > 0.0 || s.hold { lo } else { hi });
+                    if !(lo..=hi).contains(&open) {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "settings: the open value {open} of joint `{name}` is outside its limits [{lo}, {hi}]"
+                            ),
+                        ));
+                    }
+                    dof.open = open;
+                }
+            }
+        }
+        for d in 0..dofs.len() {
+            if let Role::Mimic {
+                master,
+                multiplier,
+                offset,
+                ..
+            } = dofs[d].role
+            {
+                let v = multiplier * dofs[master].open + offset;
+                dofs[d].open = clamp_to(v, dofs[d].limits);
+            }
+        }
+        let joints: Vec<JointModel> = order
+            .iter()
+            .map(|&j| JointModel {
+                parent: ends[j].0,
+                child: ends[j].1,
+                origin: pose_of(&robot.joints[j].origin),
+                motion: motions[j],
+                dof: dof_of_joint[j],
+            })
+            .collect();
+        // Fingers.
+        let first_moving = |link: usize| -> Option<usize> {
+            // The first moving joint on the path from the root to `link`.
+            let mut found = None;
+            let mut l = link;
+            while let Some(j) = parent_joint[l] {
+                if !matches!(motions[j], Motion::Fixed) {
+                    found = Some(j);
+                }
+                l = ends[j].0;
+            }
+            found
+        };
+        let mut finger_of_link: Vec<Option<usize>> = vec![None; link_names.len()];
+        let finger_count;
+        match &settings.fingers {
+            Some(groups) => {
+                for (f, group) in groups.iter().enumerate() {
+                    for l in group {
+                        let i = link_names.iter().position(|n| n == l).ok_or_else(|| {
+                            bad(
+                                file,
+                                format!("settings: finger {} names the link `{l}`, which is not defined", f + 1),
+                            )
+                        })?;
+                        if i == root {
+                            return Err(bad(
+                                file,
+                                format!("settings: the root link `{l}` is the palm, not a finger"),
+                            ));
+                        }
+                        if finger_of_link[i].is_some() {
+                            return Err(bad(
+                                file,
+                                format!("settings: link `{l}` is in two fingers"),
+                            ));
+                        }
+                        finger_of_link[i] = Some(f);
+                    }
+                }
+                finger_count = groups.len();
+            }
+            None => {
+                let mut starts: Vec<usize> =
+                    (0..link_names.len()).filter_map(first_moving).collect();
+                starts.sort_unstable();
+                starts.dedup();
+                for (l, f) in finger_of_link.iter_mut().enumerate() {
+                    *f = first_moving(l).and_then(|j| starts.iter().position(|&s| s == j));
+                }
+                finger_count = starts.len();
+            }
+        }
+        // Collision bodies: the root's first, then the links in file order.
+        let mut link_order: Vec<usize> = vec![root];
+        link_order.extend((0..link_names.len()).filter(|&l| l != root));
+        let mut bodies = Vec::new();
+        for l in link_order {
+            let link = &robot.links[l];
+            for (k, c) in link.collision.iter().enumerate() {
+                let body_name = if k == 0 {
+                    link.name.clone()
+                } else {
+                    format!("{}#{}", link.name, k + 1)
+                };
+                let positive = |v: f64, what: &str| -> Result<f64> {
+                    if v.is_finite() && v > 0.0 {
+                        Ok(v)
+                    } else {
+                        Err(bad(
+                            file,
+                            format!(
+                                "link `{}`: collision {what} {v} is not a positive length",
+                                link.name
+                            ),
+                        ))
+                    }
+                };
+                let shape = match &c.geometry {
+                    urdf_rs::Geometry::Box { size } => RawShape::Ready(LinkShape::Box {
+                        half_extents: Vector3::new(
+                            positive(size[0], "box size")? / 2.0,
+                            positive(size[1], "box size")? / 2.0,
+                            positive(size[2], "box size")? / 2.0,
+                        ),
+                    }),
+                    urdf_rs::Geometry::Cylinder { radius, length } => {
+                        RawShape::Ready(LinkShape::Cylinder {
+                            radius: positive(*radius, "cylinder radius")?,
+                            half_height: positive(*length, "cylinder length")? / 2.0,
+                        })
+                    }
+                    urdf_rs::Geometry::Sphere { radius } => RawShape::Ready(LinkShape::Sphere {
+                        radius: positive(*radius, "sphere radius")?,
+                    }),
+                    urdf_rs::Geometry::Mesh { filename, scale } => {
+                        let scale = scale.map_or([1.0; 3], |s| s.0);
+                        for s in scale {
+                            positive(s, "mesh scale")?;
+                        }
+                        RawShape::Mesh {
+                            filename: filename.clone(),
+                            scale,
+                        }
+                    }
+                    urdf_rs::Geometry::Capsule { .. } => {
+                        return Err(bad(
+                            file,
+                            format!(
+                                "link `{}`: capsule collision geometry is not supported (box, cylinder, sphere and mesh are)",
+                                link.name
+                            ),
+                        ));
+                    }
+                };
+                let origin = pose_of(&c.origin);
+                ensure_finite(
+                    origin.to_homogeneous().as_slice(),
+                    &format!("the collision origin of link `{}`", link.name),
+                )?;
+                bodies.push((
+                    Body { link: l, origin },
+                    body_name,
+                    finger_of_link[l],
+                    shape,
+                ));
+            }
+        }
+        if bodies.is_empty() {
+            return Err(bad(file, "no link has collision geometry"));
+        }
+        for jm in &joints {
+            ensure_finite(jm.origin.to_homogeneous().as_slice(), "a joint origin")?;
+        }
+        Ok(Self {
+            file: file.to_string(),
+            name: settings.name.clone().unwrap_or_else(|| robot.name.clone()),
+            link_names,
+            joints,
+            dofs,
+            bodies,
+            finger_count,
+        })
+    }
+
+    /// Mesh files the description refers to, as written in the URDF.
+    pub fn mesh_files(&self) -> Vec<String> {
+        self.bodies
+            .iter()
+            .filter_map(|b| match &b.3 {
+                RawShape::Mesh { filename, .. } => Some(filename.clone()),
+                RawShape::Ready(_) => None,
+            })
+            .collect()
+    }
+}
+
+fn clamp_to(v: f64, (lo, hi): (f64, f64)) -> f64 {
+    if lo < hi { v.max(lo).min(hi) } else { v }
+}
+
+/// Resolves a URDF mesh file name against the URDF's folder.
+fn resolve_mesh(filename: &str, dir: &Path) -> PathBuf {
+    if let Some(rest) = filename.strip_prefix("file://") {
+        return PathBuf::from(rest);
+    }
+    if let Some(rest) = filename.strip_prefix("package://") {
+        let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
+        for a in dir.ancestors() {
+            if a.file_name().is_some_and(|n| n == package) {
+                return a.join(inner);
+            }
+        }
+        return dir.join(inner);
+    }
+    dir.join(filename)
+}
+
+/// Loads a link mesh (OBJ or STL, scaled) as the triangle mesh of its convex hull.
+fn load_link_mesh(path: &Path, scale: [f64; 3], link: &str, file: &str) -> Result<TriangleMesh> {
+    let shown = path.display().to_string();
+    let m = mesh::read(path).map_err(|e| bad(file, format!("link `{link}`: {e}")))?;
+    let points: Vec<Point3<f64>> = m
+        .vertices
+        .iter()
+        .map(|v| Point3::new(v.x * scale[0], v.y * scale[1], v.z * scale[2]))
+        .collect();
+    mesh::convex_hull(&points).ok_or_else(|| {
+        bad(
+            file,
+            format!("link `{link}`: the mesh `{shown}` encloses no volume (its points are flat or fewer than four)"),
+        )
+    })
+}
+
+/// A hand built from a URDF description: see the module doc.
+#[derive(Debug)]
+pub struct UrdfHand {
+    name: String,
+    file: String,
+    links: Vec<LinkSpec>,
+    bodies: Vec<Body>,
+    joints: Vec<JointModel>,
+    dofs: Vec<Dof>,
+    link_count: usize,
+    finger_count: usize,
+    geometry: LinkGeometry,
+    /// `levers[d][b]`: bound on how far a point of body `b` moves per unit of dof `d` (when the
+    /// dof moves the body).
+    levers: Vec<Vec<Option<f64>>>,
+}
+
+impl UrdfHand {
+    /// A hand from a parsed description; mesh file names are resolved against `mesh_dir` (a hand
+    /// with meshes and no folder is an error naming the first mesh).
+    pub fn new(desc: HandDescription, mesh_dir: Option<&Path>) -> Result<Self> {
+        let mut links = Vec::with_capacity(desc.bodies.len());
+        let mut bodies = Vec::with_capacity(desc.bodies.len());
+        for (body, name, finger, raw) in desc.bodies {
+            let link = &desc.link_names[body.link];
+            let shape = match raw {
+                RawShape::Ready(s) => s,
+                RawShape::Mesh { filename, scale } => {
+                    let dir = mesh_dir.ok_or_else(|| {
+                        bad(
+                            &desc.file,
+                            format!("link `{link}`: the mesh `{filename}` has no folder to be found in (load the URDF from a file)"),
+                        )
+                    })?;
+                    LinkShape::Mesh {
+                        mesh: load_link_mesh(
+                            &resolve_mesh(&filename, dir),
+                            scale,
+                            link,
+                            &desc.file,
+                        )?,
+                    }
+                }
+            };
+            links.push(LinkSpec {
+                name,
+                finger,
+                shape,
+            });
+            bodies.push(body);
+        }
+        let geometry = LinkGeometry::new(&links);
+        let mut hand = Self {
+            name: desc.name,
+            file: desc.file,
+            links,
+            bodies,
+            joints: desc.joints,
+            dofs: desc.dofs,
+            link_count: desc.link_names.len(),
+            finger_count: desc.finger_count,
+            geometry,
+            levers: Vec::new(),
+        };
+        hand.levers = hand.compute_levers();
+        Ok(hand)
+    }
+
+    /// Parses URDF text (and optional settings text) without touching files; meshes are looked
+    /// up in `mesh_dir`. `file` names the hand in errors.
+    pub fn from_strs(
+        file: &str,
+        urdf: &str,
+        settings: Option<&str>,
+        mesh_dir: Option<&Path>,
+    ) -> Result<Self> {
+        let settings = settings
+            .map(|s| HandSettings::parse(s, &format!("{file} (settings)")))
+            .transpose()?;
+        Self::new(
+            HandDescription::parse(file, urdf, settings.as_ref())?,
+            mesh_dir,
+        )
+    }
+
+    /// Reads a URDF file, the settings file beside it (same stem, `.toml`) if there is one, and
+    /// its meshes.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let file = path.display().to_string();
+        let urdf = std::fs::read_to_string(path)
+            .map_err(|e| bad(&file, format!("cannot read it: {e}")))?;
+        let toml_path = path.with_extension("toml");
+        let settings = if toml_path.is_file() {
+            Some(std::fs::read_to_string(&toml_path).map_err(|e| {
+                bad(
+                    &toml_path.display().to_string(),
+                    format!("cannot read it: {e}"),
+                )
+            })?)
+        } else {
+            None
+        };
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_strs(&file, &urdf, settings.as_deref(), Some(&dir))
+    }
+
+    /// The file (or built-in source) the hand was read from.
+    pub fn source(&self) -> &str {
+        &self.file
+    }
+
+    /// Which degrees of freedom close (their names), in closing order.
+    pub fn closing_joints(&self) -> Vec<String> {
+        self.closing_order()
+            .into_iter()
+            .map(|d| self.dofs[d].name.clone())
+            .collect()
+    }
+
+    fn closing_order(&self) -> Vec<usize> {
+        self.joints
+            .iter()
+            .filter_map(|j| j.dof)
+            .filter(|&d| matches!(self.dofs[d].role, Role::Closing(_)))
+            .collect()
+    }
+
+    /// Link frames (indexed by link) in the palm frame for the joint values `q`.
+    fn link_frames(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let mut frames = vec![Isometry3::identity(); self.link_count];
+        // The root is the only link no joint sets; joints come parents first.
+        for j in &self.joints {
+            let motion = match (j.motion, j.dof) {
+                (Motion::Revolute(axis), Some(d)) => Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&axis, q[d]),
+                ),
+                (Motion::Prismatic(axis), Some(d)) => Isometry3::from_parts(
+                    Translation3::from(axis.into_inner() * q[d]),
+                    UnitQuaternion::identity(),
+                ),
+                _ => Isometry3::identity(),
+            };
+            frames[j.child] = frames[j.parent] * j.origin * motion;
+        }
+        frames
+    }
+
+    /// Body frames in the palm frame for the joint values `q`.
+    fn body_poses(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let frames = self.link_frames(q);
+        self.bodies
+            .iter()
+            .map(|b| frames[b.link] * b.origin)
+            .collect()
+    }
+
+    /// For each dof and body: a bound on how far any point of the body moves per unit of the
+    /// dof's value, whatever the other joints do (`None` when the dof does not move the body).
+    ///
+    /// Revolute dof: the distance from its axis's origin to the farthest point of the body,
+    /// bounded by the lengths of the joint offsets between them (plus the travel of prismatic
+    /// joints) and the farthest point of the body from the last moving joint's frame.
+    /// Prismatic dof: 1.
+    fn compute_levers(&self) -> Vec<Vec<Option<f64>>> {
+        // The joint (index into self.joints) whose child each link is.
+        let mut joint_of_link: Vec<Option<usize>> = vec![None; self.link_count];
+        for (k, j) in self.joints.iter().enumerate() {
+            joint_of_link[j.child] = Some(k);
+        }
+        let mut levers = vec![vec![None; self.bodies.len()]; self.dofs.len()];
+        for (b, body) in self.bodies.iter().enumerate() {
+            // Joints from the body's link up to the root (nearest first).
+            let mut path = Vec::new();
+            let mut l = body.link;
+            while let Some(k) = joint_of_link[l] {
+                path.push(k);
+                l = self.joints[k].parent;
+            }
+            for (pos, &k) in path.iter().enumerate() {
+                let Some(d) = self.joints[k].dof else {
+                    continue;
+                };
+                levers[d][b] = Some(match self.joints[k].motion {
+                    Motion::Prismatic(_) => 1.0,
+                    _ => {
+                        // Joints after k towards the body: path[..pos], farthest first.
+                        let after: Vec<usize> = path[..pos].iter().rev().copied().collect();
+                        let last_moving = after
+                            .iter()
+                            .rposition(|&a| !matches!(self.joints[a].motion, Motion::Fixed));
+                        let mut sum = 0.0;
+                        let upto = last_moving.map_or(0, |i| i + 1);
+                        for &a in &after[..upto] {
+                            sum += self.joints[a].origin.translation.vector.norm();
+                            if let (Motion::Prismatic(_), Some(da)) =
+                                (self.joints[a].motion, self.joints[a].dof)
+                            {
+                                let (lo, hi) = self.dofs[da].limits;
+                                sum += lo.abs().max(hi.abs());
+                            }
+                        }
+                        // The body's frame in the last moving joint's child frame.
+                        let mut rigid = Isometry3::identity();
+                        for &a in &after[upto..] {
+                            rigid *= self.joints[a].origin;
+                        }
+                        rigid *= body.origin;
+                        let joint_in_body = rigid.inverse_transform_point(&Point3::origin());
+                        sum + self.links[b].shape.farthest_from(&joint_in_body)
+                    }
+                });
+            }
+        }
+        levers
+    }
+
+    /// Advances dof `a` (with the joints that mimic it) towards its closed limit until one of
+    /// the bodies it moves touches the object or it reaches the limit; then releases its
+    /// breakaway followers. `dir`: +1 towards the upper limit, -1 towards the lower.
+    fn advance(
+        &self,
+        object: &Object,
+        palm: &Isometry3<f64>,
+        q: &mut Vec<f64>,
+        detached: &mut [bool],
+        a: usize,
+        dir: f64,
+    ) -> Result<()> {
+        let followers: Vec<(usize, f64, f64, bool)> = self
+            .dofs
+            .iter()
+            .enumerate()
+            .filter_map(|(f, d)| match d.role {
+                Role::Mimic {
+                    master,
+                    multiplier,
+                    offset,
+                    breakaway,
+                } if master == a && !detached[f] => Some((f, multiplier, offset, breakaway)),
+                _ => None,
+            })
+            .collect();
+        let mut moved: Vec<(usize, f64)> = Vec::new();
+        for b in 0..self.bodies.len() {
+            let mut rate = 0.0;
+            let mut moves = false;
+            let movers =
+                std::iter::once((a, 1.0)).chain(followers.iter().map(|&(f, m, _, _)| (f, m)));
+            for (j, m) in movers {
+                if let Some(l) = self.levers[j][b] {
+                    rate += m.abs() * l;
+                    moves = true;
+                }
+            }
+            if moves {
+                moved.push((b, rate));
+            }
+        }
+        let (lo, hi) = self.dofs[a].limits;
+        let config = |base: &[f64], t: f64| -> Vec<f64> {
+            let mut c = base.to_vec();
+            c[a] = dir * t;
+            for &(f, m, off, _) in &followers {
+                c[f] = clamp_to(m * c[a] + off, self.dofs[f].limits);
+            }
+            c
+        };
+        let t0 = dir * q[a];
+        let t1 = (dir * if dir > 0.0 { hi } else { lo }).max(t0);
+        let touched = if moved.is_empty() {
+            *q = config(q, t1);
+            None
+        } else {
+            let rates: Vec<f64> = moved.iter().map(|m| m.1).collect();
+            let base = q.clone();
+            let adv = advance_until_contact(
+                |t| {
+                    let poses = self.body_poses(&config(&base, t));
+                    moved
+                        .iter()
+                        .map(|&(b, _)| {
+                            self.geometry
+                                .distance_g(object, b, &iso2pose(&(palm * poses[b])), 0.05)
+                        })
+                        .collect()
+                },
+                t0,
+                t1,
+                &rates,
+            )?;
+            *q = config(&base, adv.t);
+            adv.touched.map(|k| moved[k].0)
+        };
+        for &(f, m, _, breakaway) in &followers {
+            // A follower continues alone unless the link that stopped its joint is its own.
+            if !breakaway || touched.is_some_and(|b| self.levers[f][b].is_some()) {
+                continue;
+            }
+            detached[f] = true;
+            self.advance(object, palm, q, detached, f, dir * m.signum())?;
+        }
+        Ok(())
+    }
+}
+
+impl Hand for UrdfHand {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn links(&self) -> &[LinkSpec] {
+        &self.links
+    }
+
+    fn finger_count(&self) -> usize {
+        self.finger_count
+    }
+
+    /// The revolute and prismatic joints, in URDF file order.
+    fn joint_names(&self) -> Vec<String> {
+        self.dofs.iter().map(|d| d.name.clone()).collect()
+    }
+
+    fn joint_limits(&self) -> Vec<(f64, f64)> {
+        self.dofs.iter().map(|d| d.limits).collect()
+    }
+
+    fn open_configuration(&self) -> Vec<f64> {
+        self.dofs.iter().map(|d| d.open).collect()
+    }
+
+    fn link_poses(&self, joints: &[f64]) -> Result<Vec<Isometry3<f64>>> {
+        if joints.len() != self.dofs.len() {
+            return Err(SimError::InvalidInput(format!(
+                "hand `{}` needs {} joint values, got {}",
+                self.name,
+                self.dofs.len(),
+                joints.len()
+            )));
+        }
+        ensure_finite(joints, "joint values")?;
+        Ok(self.body_poses(joints))
+    }
+
+    fn close(&self, object: &Object, palm_pose: &Isometry3<f64>) -> Result<Grasp> {
+        let (palm, retreat) = clear_hand(self, &self.geometry, object, palm_pose)?;
+        let mut q = self.open_configuration();
+        let mut detached = vec![false; self.dofs.len()];
+        for a in self.closing_order() {
+            let Role::Closing(dir) = self.dofs[a].role else {
+                continue;
+            };
+            self.advance(object, &palm, &mut q, &mut detached, a, dir)?;
+        }
+        finish_grasp(self, &self.geometry, object, palm_pose, palm, retreat, q)
+    }
+}
