@@ -304,8 +304,16 @@ fn surface_patches(geom: &PartGeom) -> Vec<SurfacePatch> {
                     let y0 = -hh + 2.0 * hh * j as f64 / rows as f64;
                     let y1 = -hh + 2.0 * hh * (j + 1) as f64 / rows as f64;
                     let (a, b, c2, d) = (at(k, y0), at(k + 1, y0), at(k + 1, y1), at(k, y1));
-                    out.push(SurfacePatch::new([a, b, c2], PatchMap::CylinderSide(r), Vector::X));
-                    out.push(SurfacePatch::new([a, c2, d], PatchMap::CylinderSide(r), Vector::X));
+                    out.push(SurfacePatch::new(
+                        [a, b, c2],
+                        PatchMap::CylinderSide(r),
+                        Vector::X,
+                    ));
+                    out.push(SurfacePatch::new(
+                        [a, c2, d],
+                        PatchMap::CylinderSide(r),
+                        Vector::X,
+                    ));
                 }
                 let a = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
                 let map = PatchMap::CylinderCap {
