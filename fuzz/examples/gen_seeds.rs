@@ -88,6 +88,7 @@ fn main() {
     let point = |x: f64| CloudPoint {
         p: [x, 0.02, -0.01],
         n: [0.0, 0.6, 0.8],
+        w: 1.0,
     };
     let mut clouds = ContactClouds {
         run_id: run.clone(),

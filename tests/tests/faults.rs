@@ -138,6 +138,7 @@ fn nan_clouds(run: &RunId) -> ContactClouds {
             points: vec![CloudPoint {
                 p: [0.0, f64::NAN, 0.0],
                 n: [1.0, 0.0, 0.0],
+                w: 1.0,
             }],
         }],
         min_gap: None,

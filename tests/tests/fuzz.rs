@@ -149,6 +149,7 @@ fn templates() -> (
                 points: vec![CloudPoint {
                     p: [0.03, 0.0, 0.01 * k as f64],
                     n: [1.0, 0.0, 0.0],
+                    w: 1.0,
                 }],
             })
             .collect(),

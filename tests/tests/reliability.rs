@@ -293,7 +293,7 @@ fn the_run_survives_a_router_restart() {
 /// can produce. The second value says whether the trial should complete (a defined score)
 /// rather than fail (a clear error).
 fn degenerate(i: usize, cmd: &TrialCommand) -> (ContactClouds, bool, &'static str) {
-    let point = |p: [f64; 3], n: [f64; 3]| CloudPoint { p, n };
+    let point = |p: [f64; 3], n: [f64; 3]| CloudPoint { p, n, w: 1.0 };
     let finger = |k: u32, points: Vec<CloudPoint>| FingerCloud {
         finger: Some(k),
         links: vec![format!("f{k}")],

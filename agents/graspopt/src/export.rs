@@ -369,10 +369,12 @@ mod tests {
             ContactPoint {
                 position: Point3::new(1.0, 2.0, 3.0),
                 normal: Vector3::z(),
+                weight: 1.0,
             },
             ContactPoint {
                 position: Point3::new(0.0, 0.0, 0.0),
                 normal: -Vector3::x(),
+                weight: 1.0,
             },
         ];
         write_obj(&path, &meshes, &contacts, 0.5).unwrap();
@@ -473,6 +475,7 @@ mod tests {
         let contacts = vec![ContactPoint {
             position: Point3::new(1.0, 2.0, 3.0),
             normal: Vector3::z(),
+            weight: 1.0,
         }];
         write_gltf(&path, &meshes, &contacts, 0.5).unwrap();
         let doc: serde_json::Value =

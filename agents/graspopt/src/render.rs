@@ -581,6 +581,7 @@ mod tests {
         let contacts = [ContactPoint {
             position: Point3::new(-0.04, 0.0, 0.0),
             normal: Vector3::x(),
+            weight: 1.0,
         }];
         let meshes = [(&object, [90, 140, 220]), (&finger, [230, 150, 60])];
         let img = render_grasp(&meshes, &contacts, 400, 200);
@@ -633,6 +634,7 @@ mod tests {
         let contacts = [ContactPoint {
             position: Point3::new(f64::INFINITY, 0.0, 0.0),
             normal: Vector3::x(),
+            weight: 1.0,
         }];
         let img = render_grasp(&[(&bad, [1, 2, 3])], &contacts, 1, 1);
         assert_eq!(img.pixels.len(), 1);

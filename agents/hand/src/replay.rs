@@ -213,6 +213,7 @@ mod tests {
                 points: vec![CloudPoint {
                     p: [0.0, 0.0, 0.05],
                     n: [0.0, 0.0, -1.0],
+                    w: 1.0,
                 }],
             }],
             min_gap: None,

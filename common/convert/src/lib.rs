@@ -61,6 +61,7 @@ fn cloud_point(c: &ContactPoint) -> CloudPoint {
     CloudPoint {
         p: [c.position.x, c.position.y, c.position.z],
         n: [c.normal.x, c.normal.y, c.normal.z],
+        w: c.weight,
     }
 }
 
@@ -68,6 +69,7 @@ fn contact_point(c: &CloudPoint) -> ContactPoint {
     ContactPoint {
         position: Point3::new(c.p[0], c.p[1], c.p[2]),
         normal: Vector3::new(c.n[0], c.n[1], c.n[2]),
+        weight: c.w,
     }
 }
 

@@ -163,12 +163,19 @@ impl Message for TrialCommand {
     }
 }
 
-/// One raw contact point: a position on the object's surface and the unit normal pointing
-/// into the object (world frame).
+/// One raw contact point: a position on the object's surface, the unit normal pointing
+/// into the object (world frame) and the area it stands for (`w`, > 0; 1 when absent, so that
+/// clouds of equal points need not send it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CloudPoint {
     pub p: [f64; 3],
     pub n: [f64; 3],
+    #[serde(default = "unit_weight")]
+    pub w: f64,
+}
+
+fn unit_weight() -> f64 {
+    1.0
 }
 
 /// The raw contact cloud of one finger (`finger: None` for the palm).
@@ -236,6 +243,12 @@ impl Message for ContactClouds {
                 if !ok {
                     finite(&format!("fingers[{f}].points[{i}].p"), &pt.p)?;
                     finite(&format!("fingers[{f}].points[{i}].n"), &pt.n)?;
+                }
+                if !(pt.w.is_finite() && pt.w > 0.0) {
+                    return Err(format!(
+                        "fingers[{f}].points[{i}].w must be finite and > 0, got {}",
+                        pt.w
+                    ));
                 }
                 let n2 = pt.n.iter().map(|v| v * v).sum::<f64>();
                 // |n| within 1e-3 of 1 (compared squared, without a square root).

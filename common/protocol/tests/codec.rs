@@ -25,6 +25,7 @@ fn clouds() -> ContactClouds {
                 points: vec![CloudPoint {
                     p: [0.01, 0.1 + 0.2, 1e-300],
                     n: [0.0, 0.6, 0.8],
+                    w: 1.0,
                 }],
             },
             FingerCloud {

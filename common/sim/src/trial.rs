@@ -104,10 +104,10 @@ pub fn run_trial(
     let d_c = settings.cloud.contact_distance;
     // Raw points per link (only links within the contact distance are sampled).
     let mut per_link: Vec<Vec<ContactPoint>> = Vec::with_capacity(links.len());
-    for (i, (spec, pose)) in links.iter().zip(&grasp.link_poses).enumerate() {
+    for (i, pose) in grasp.link_poses.iter().enumerate() {
         let near = grasp.link_distances.get(i).is_some_and(|&d| d <= d_c);
         per_link.push(if near {
-            link_cloud(object, &geometry, i, spec, pose, &settings.cloud)?
+            link_cloud(object, &geometry, i, pose, &settings.cloud)?
         } else {
             Vec::new()
         });

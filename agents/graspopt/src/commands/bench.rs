@@ -275,6 +275,7 @@ fn cloud_message(run: &RunId, trial: u64, points: usize) -> ContactClouds {
                     CloudPoint {
                         p: [a.cos() * 0.04, a.sin() * 0.04, f as f64 * 0.01],
                         n: [-a.cos(), -a.sin(), 0.0],
+                        w: 1.0,
                     }
                 })
                 .collect(),
