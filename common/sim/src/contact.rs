@@ -564,44 +564,6 @@ impl RegionBuilder<'_> {
                 }
             }
         }
-        LinkShape::Sphere { radius: r } => {
-            // Rings of latitude about h apart, points on each about h apart.
-            let rings = ((std::f64::consts::PI * r / h).ceil() as usize).max(2);
-            for i in 0..=rings {
-                let lat = std::f64::consts::PI * (i as f64 / rings as f64 - 0.5);
-                let n = ((std::f64::consts::TAU * r * lat.cos() / h).ceil() as usize).max(1);
-                for k in 0..n {
-                    let lon = std::f64::consts::TAU * k as f64 / n as f64;
-                    let normal =
-                        Vector3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin());
-                    let p = Point3::from(normal * *r);
-                    if (p - centre).norm() <= radius {
-                        out.push((p, normal));
-                    }
-                }
-            }
-        }
-        LinkShape::Mesh { mesh } => {
-            // A barycentric grid of spacing about h on each triangle, with its normal.
-            for (t, tri) in mesh.triangles.iter().enumerate() {
-                let corner = |k: usize| mesh.vertices.get(tri[k] as usize).copied();
-                let (Some(a), Some(b), Some(c)) = (corner(0), corner(1), corner(2)) else {
-                    continue;
-                };
-                let normal = mesh.triangle_normal(t);
-                let longest = (b - a).norm().max((c - a).norm()).max((c - b).norm());
-                let m = ((longest / h).ceil() as usize).max(1);
-                for i in 0..=m {
-                    for j in 0..=(m - i) {
-                        let p =
-                            a + (b - a) * (i as f64 / m as f64) + (c - a) * (j as f64 / m as f64);
-                        if (p - centre).norm() <= radius {
-                            out.push((p, normal));
-                        }
-                    }
-                }
-            }
-        }
     }
 
     fn refine(
