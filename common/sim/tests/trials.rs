@@ -253,14 +253,16 @@ fn every_object_is_touched_at_its_reference_pose() {
         // Every raw contact lies on the object's surface; on the round objects its normal is the
         // opposite of the outward surface normal there, and each finger's mean normal points
         // into the object (on the faceted round objects a point's normal may be the link face's,
-        // where a facet edge or the rim touches it).
+        // where a facet edge or the rim touches it). A finger touching with two links averages
+        // two regions' normals: on the wine glass a finger of the bent BH8 meets it with its
+        // medial and distal links, 26 degrees from the normal under its mean point.
         let round = matches!(name, "sphere" | "cylinder");
         let smooth = matches!(name, "sphere" | "cylinder" | "mug" | "wine_glass");
         for f in &out.fingers {
             if smooth && let Some(m) = f.mean_point {
                 let sp = o.closest_point(&m.position).unwrap();
                 assert!(
-                    m.normal.dot(&sp.outward_normal) < -0.9,
+                    m.normal.dot(&sp.outward_normal) < -0.8,
                     "{name}: mean normal {:?} against {:?}",
                     m.normal,
                     sp.outward_normal
