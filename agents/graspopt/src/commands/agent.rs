@@ -441,12 +441,12 @@ mod tests {
             msg.contains("contacts, frame, include_palm, metric, model, torque_scale"),
             "{msg}"
         );
-        let text = documented("metric").replace("spacing = ", "spaceing = ");
+        let text = documented("metric").replace("resolution = ", "resolutoin = ");
         let msg = format!(
             "{:#}",
             load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err()
         );
-        assert!(msg.contains("`spaceing` in [contacts.cloud]"), "{msg}");
+        assert!(msg.contains("`resolutoin` in [contacts.cloud]"), "{msg}");
         // Keys left out keep their defaults; flags of other kinds are not keys.
         let c: graspopt_hand::HandConfig = load_text("h.toml", "trial_cost_ms = 5\n").unwrap();
         assert_eq!((c.trial_cost_ms, c.hand.as_str()), (5, "barrett"));
