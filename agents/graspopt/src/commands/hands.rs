@@ -13,11 +13,11 @@ pub struct HandsArgs {
 
 pub fn run(args: &HandsArgs) -> Result<std::process::ExitCode> {
     match &args.hand {
-        None => print!("{}", table()?),
+        None => crate::out::print(format_args!("{}", table()?))?,
         Some(name) => {
             let hand =
                 hand_by_name(name).with_context(|| format!("cannot load the hand {name:?}"))?;
-            print!("{}", describe(hand.as_ref()));
+            crate::out::print(format_args!("{}", describe(hand.as_ref())))?;
         }
     }
     Ok(std::process::ExitCode::SUCCESS)
