@@ -468,3 +468,40 @@ fn trial_takes_a_urdf_hand_file_and_names_a_bad_one() {
         "{err}"
     );
 }
+
+#[test]
+fn experiment_takes_the_hand_flag() {
+    let dir = tempdir("experiment-hand");
+    let csv = |hand: &str, tag: &str| {
+        let out_dir = dir.join(tag);
+        let out = graspopt(&[
+            "experiment",
+            "metrics",
+            "--steps",
+            "4",
+            "--steps-2d",
+            "3",
+            "--hand",
+            hand,
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read_to_string(out_dir.join("fig4.3-sphere.csv")).unwrap()
+    };
+    let barrett = csv("barrett", "a");
+    assert_eq!(barrett, csv("bh8", "b"), "the same hand, the same scan");
+    assert_ne!(
+        barrett,
+        csv("parallel_jaw", "c"),
+        "another hand, another scan"
+    );
+    let out = graspopt(&["experiment", "bo", "--hand", "teapot"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown hand `teapot`"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -52,6 +52,9 @@ pub struct BoArgs {
     /// Output folder.
     #[arg(long, default_value = "results/experiment-bo")]
     pub out: PathBuf,
+    /// Hand: a built-in name (see `graspopt hands`) or a URDF file.
+    #[arg(long, default_value = "barrett")]
+    pub hand: String,
     /// Seeds per method and object.
     #[arg(long, default_value_t = 10)]
     pub seeds: u64,
@@ -137,8 +140,13 @@ fn display(object: &str) -> String {
 }
 
 /// The evaluator of `object` over `kinds` with the chosen contact model.
-fn object_evaluator(object: &str, kinds: &[ParamKind], contacts: Contacts) -> Result<Evaluator> {
-    let mut ev = evaluator(object, kinds)?;
+fn object_evaluator(
+    hand: &str,
+    object: &str,
+    kinds: &[ParamKind],
+    contacts: Contacts,
+) -> Result<Evaluator> {
+    let mut ev = evaluator(hand, object, kinds)?;
     ev.score.contacts = contacts.into();
     Ok(ev)
 }
@@ -293,7 +301,7 @@ fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Resu
          | object | trials until the engine stopped | best found | scan maximum | files |\n|---|---|---|---|---|\n",
     );
     for (fig, object) in [("4.16", "sphere"), ("4.17", "star_prism")] {
-        let ev = object_evaluator(object, &[ParamKind::Approach], args.contacts)?;
+        let ev = object_evaluator(&args.hand, object, &[ParamKind::Approach], args.contacts)?;
         let (_, truth) = scan(&ev, &[201], args.threads)?;
         let settings = SearchSettings {
             method: Method::Bo,
@@ -539,7 +547,7 @@ fn two_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<
     let kinds = [ParamKind::Approach, ParamKind::Vertical];
     for object in &plan.objects {
         let name = display(object);
-        let ev = object_evaluator(object, &kinds, args.contacts)?;
+        let ev = object_evaluator(&args.hand, object, &kinds, args.contacts)?;
         let (axes, grid) = scan(&ev, &plan.steps, args.threads)?;
         let reference = argmax(&grid).score.score;
         let cmp = bo_and_random(
@@ -665,7 +673,7 @@ fn six_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<
     ];
     for object in &plan.objects {
         let name = display(object);
-        let ev = object_evaluator(object, &kinds, args.contacts)?;
+        let ev = object_evaluator(&args.hand, object, &kinds, args.contacts)?;
         let cmp = bo_and_random(&ev, plan.engine, args.budget_6d, seeds, None, args.threads)?;
         let medians_at = |m: &MethodSummary| -> String {
             let curves: Vec<Vec<f64>> = m.traces.iter().map(|t| t.best_so_far()).collect();

@@ -36,6 +36,9 @@ pub struct MetricsArgs {
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Hand: a built-in name (see `graspopt hands`) or a URDF file.
+    #[arg(long, default_value = "barrett")]
+    pub hand: String,
 }
 
 /// The most points of a 1D scan.
@@ -116,7 +119,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
         ("4.4", "rotated_cuboid"),
         ("4.5", "star_prism"),
     ] {
-        let mut ev = evaluator(object, &[ParamKind::Approach])?;
+        let mut ev = evaluator(&args.hand, object, &[ParamKind::Approach])?;
         ev.score.contacts = ContactModel::MeanPoint;
         ev.score.metric = Metric::Volume;
         let (axes, points) = scan(&ev, &[steps], args.threads)?;
@@ -169,7 +172,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
             ("circular patch", ContactModel::CircularPatch),
             ("surface", ContactModel::Surface),
         ] {
-            let mut ev = evaluator(object, &[ParamKind::Approach])?;
+            let mut ev = evaluator(&args.hand, object, &[ParamKind::Approach])?;
             ev.score.contacts = model;
             variants.push((name, ev));
         }
@@ -202,7 +205,11 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
         ("mean-point", ContactModel::MeanPoint),
         ("surface", ContactModel::Surface),
     ] {
-        let mut ev = evaluator("sphere", &[ParamKind::Approach, ParamKind::Vertical])?;
+        let mut ev = evaluator(
+            &args.hand,
+            "sphere",
+            &[ParamKind::Approach, ParamKind::Vertical],
+        )?;
         ev.score.contacts = model;
         report.push_str(&map_row(
             dir,
@@ -216,7 +223,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
 
     // 4.8: reference frames with the torque scale fixed.
     report.push_str("\n## Figure 4.8: reference-frame independence (sphere, approach axis, torque scale 0.05 m)\n\n| frame | BW max | at approach |\n|---|---|---|\n");
-    let reference = evaluator("sphere", &[ParamKind::Approach])?
+    let reference = evaluator(&args.hand, "sphere", &[ParamKind::Approach])?
         .space
         .reference
         .translation
@@ -230,7 +237,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
             ReferenceFrame::Point([reference.x, reference.y, reference.z]),
         ),
     ] {
-        let mut ev = evaluator("sphere", &[ParamKind::Approach])?;
+        let mut ev = evaluator(&args.hand, "sphere", &[ParamKind::Approach])?;
         ev.score.frame = frame;
         ev.score.torque_scale = Some(0.05);
         variants.push((name, ev));
@@ -258,7 +265,11 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
     report.push_str(MAP_TABLE);
     // The seven objects of the thesis, in its order.
     for object in graspopt_sim::Object::names() {
-        let ev = evaluator(object, &[ParamKind::Approach, ParamKind::Vertical])?;
+        let ev = evaluator(
+            &args.hand,
+            object,
+            &[ParamKind::Approach, ParamKind::Vertical],
+        )?;
         report.push_str(&map_row(
             dir,
             &format!("fig4.9-4.15-{object}"),

@@ -41,11 +41,12 @@ pub fn run(args: &ExperimentArgs) -> Result<std::process::ExitCode> {
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-/// The Barrett hand on a built-in object, over the given parameters.
-fn evaluator(object: &str, kinds: &[ParamKind]) -> Result<Evaluator> {
+/// `hand` (a built-in name or a URDF file) on a built-in object, over the given parameters.
+fn evaluator(hand: &str, object: &str, kinds: &[ParamKind]) -> Result<Evaluator> {
     let object = Object::by_name(object)?;
     let space = space_for(&object, kinds)?;
-    Ok(Evaluator::new(object, hand_by_name("barrett")?, space))
+    let hand = hand_by_name(hand).with_context(|| format!("cannot load the hand {hand:?}"))?;
+    Ok(Evaluator::new(object, hand, space))
 }
 
 /// A grid scan over the whole trial space with `steps[k]` points on axis `k`.
