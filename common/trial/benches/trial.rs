@@ -13,7 +13,11 @@ use graspopt_trial::Evaluator;
 fn bench(c: &mut Criterion) {
     let object = Object::by_name("mug").expect("mug");
     let space = TrialSpace::approach_vertical_2d(&object);
-    let ev = Evaluator::new(object, hand_by_name("barrett").expect("hand"), space);
+    let ev = Evaluator::new(
+        object,
+        hand_by_name("barrett").expect("hand"),
+        space.clone(),
+    );
     let x = [-0.09, 0.0];
     let e = ev.evaluate(&x).expect("trial");
     assert!(
@@ -23,6 +27,18 @@ fn bench(c: &mut Criterion) {
     c.bench_function("scored trial, mug, barrett, surface model, BW", |b| {
         b.iter(|| ev.evaluate(black_box(&x)))
     });
+    // The same trial with the hand-written BH8 (the URDF hand's test oracle): what the
+    // URDF hand's general kinematics cost.
+    let object = Object::by_name("mug").expect("mug");
+    let oracle = Evaluator::new(
+        object,
+        Box::new(graspopt_sim::BarrettHand::default()),
+        space,
+    );
+    c.bench_function(
+        "scored trial, mug, barrett oracle, surface model, BW",
+        |b| b.iter(|| oracle.evaluate(black_box(&x))),
+    );
 }
 
 criterion_group!(benches, bench);
