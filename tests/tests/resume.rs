@@ -224,6 +224,13 @@ fn a_run_stopped_before_its_first_trial_starts_afresh_with_the_same_command() {
     signal(&first, "INT");
     let (status, _) = first.wait_output(Duration::from_secs(20));
     assert_eq!(status.code(), Some(130), "{}", c.log("coordinator"));
+    // The stop says what will work, not --resume.
+    assert!(
+        c.log("coordinator")
+            .contains("no trial was issued: the same command starts it afresh"),
+        "{}",
+        c.log("coordinator")
+    );
     let j = Journal::open(&journal).unwrap();
     assert_eq!(j.run("q").unwrap().unwrap().status, RunStatus::Stopped);
     assert!(j.trials("q").unwrap().is_empty());

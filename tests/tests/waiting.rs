@@ -15,7 +15,7 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
         Duration::from_secs(20),
         || {
             c.log("coordinator")
-                .contains("run wait is waiting: no object estimate yet (")
+                .contains("run \"wait\" is waiting: no object estimate yet (")
                 && c.log("coordinator").contains("no metric agent (")
                 && c.log("coordinator").contains("no hand (")
         },
@@ -63,7 +63,7 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
         Duration::from_secs(30),
         || {
             c.log("coordinator")
-                .contains("run wait is waiting: no planner answer (")
+                .contains("run \"wait\" is waiting: no planner answer (")
         },
     );
     let _planner = c.agent("planner", &["planner"]);
@@ -71,5 +71,5 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
     assert_eq!(status["completed"], 3, "{status}");
     assert_eq!(status["waiting"], serde_json::json!([]), "{status}");
     let log = c.log("coordinator");
-    assert!(log.contains("run wait is no longer waiting"), "{log}");
+    assert!(log.contains("run \"wait\" is no longer waiting"), "{log}");
 }

@@ -908,7 +908,7 @@ pub async fn run_until(
                 let phase = if ctx.space.is_some() { RunPhase::Running } else { RunPhase::Waiting };
                 let s = status(run, &spec, &ctx.state, phase, &ctx.waits);
                 if let Some(m) = ctx.waits.message(s.stamp_ms) {
-                    tracing::warn!("coordinator: run {run} {m}");
+                    tracing::warn!("coordinator: run {run:?} {m}");
                 }
                 let _ = bus.put_droppable(&status_key, &s, Encoding::Bincode).await;
                 if let Some(p) = &progress { let _ = p.send(s); }
@@ -932,8 +932,16 @@ pub async fn run_until(
                 waits::describe(&s.waiting, s.stamp_ms)
             )
         };
+        // A run that issued no trial is started afresh by the same command (see `create`).
+        let unstarted = s.completed + s.failed + s.running == 0
+            && ctx.journal.trials(run.as_str()).is_ok_and(|t| t.is_empty());
+        let next = if unstarted {
+            "no trial was issued: the same command starts it afresh"
+        } else {
+            "resume with --resume"
+        };
         tracing::warn!(
-            "coordinator: run {run:?} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; resume with --resume",
+            "coordinator: run {run:?} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; {next}",
             s.completed,
             s.budget,
             s.failed,
