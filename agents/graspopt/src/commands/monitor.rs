@@ -469,6 +469,21 @@ mod tests {
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
 
+    /// The dashboard drawn on a 100 x 30 terminal, one line per row.
+    fn screen(m: &Monitor) -> String {
+        let mut term = Terminal::new(TestBackend::new(100, 30)).unwrap();
+        term.draw(|f| draw(f, m, Instant::now())).unwrap();
+        term.backend()
+            .buffer()
+            .content()
+            .iter()
+            .map(|c| c.symbol())
+            .collect::<Vec<_>>()
+            .chunks(100)
+            .map(|row| row.concat() + "\n")
+            .collect()
+    }
+
     fn status(completed: u64) -> RunStatus {
         RunStatus {
             run_id: RunId::new("demo").unwrap(),
@@ -514,18 +529,7 @@ mod tests {
         m.on_status(status(30), Instant::now());
         // An older status arriving late does not go back in time.
         m.on_status(status(20), Instant::now());
-        let mut term = Terminal::new(TestBackend::new(100, 30)).unwrap();
-        term.draw(|f| draw(f, &m, Instant::now())).unwrap();
-        let screen: String = term
-            .backend()
-            .buffer()
-            .content()
-            .iter()
-            .map(|c| c.symbol())
-            .collect::<Vec<_>>()
-            .chunks(100)
-            .map(|row| row.concat() + "\n")
-            .collect();
+        let screen = screen(&m);
         for want in [
             "demo (running)",
             "30/60 trials",
@@ -561,15 +565,7 @@ mod tests {
         let want = "waiting: no metric agent (12 s), no planner answer (3 s)";
         let lines = run_lines("demo", &m.runs["demo"], Instant::now());
         assert!(lines.iter().any(|l| l == want), "{lines:?}");
-        let mut term = Terminal::new(TestBackend::new(100, 30)).unwrap();
-        term.draw(|f| draw(f, &m, Instant::now())).unwrap();
-        let screen: String = term
-            .backend()
-            .buffer()
-            .content()
-            .iter()
-            .map(|c| c.symbol())
-            .collect();
+        let screen = screen(&m);
         for want in [want, "best: none yet", "hand-1@lab  trial 14"] {
             assert!(screen.contains(want), "{want:?} not on screen:\n{screen}");
         }
