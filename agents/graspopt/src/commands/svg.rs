@@ -425,15 +425,18 @@ pub fn samples_map(
         );
     }
     if let Some(&(x, y, _)) = samples.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
-        let _ = writeln!(
-            out,
-            r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
-            px(x),
-            py(y)
-        );
+        best_ring(&mut out, px(x), py(y));
     }
     out.push_str("</svg>\n");
     out
+}
+
+/// The red ring that marks the best sample or trial at pixel `(x, y)`.
+fn best_ring(out: &mut String, x: f64, y: f64) {
+    let _ = writeln!(
+        out,
+        r#"<circle cx="{x:.2}" cy="{y:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#
+    );
 }
 
 /// A colour for `t` in [0, 1]: dark blue, through white-ish green, to yellow.
@@ -716,12 +719,7 @@ pub fn trials_map(
             };
         }
         if let Some((p, s)) = best {
-            let _ = writeln!(
-                out,
-                r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
-                px(p[0]),
-                py(s)
-            );
+            best_ring(&mut out, px(p[0]), py(s));
         }
         legend(
             &mut out,
@@ -762,12 +760,7 @@ pub fn trials_map(
             );
         }
         if let Some((p, _)) = best {
-            let _ = writeln!(
-                out,
-                r#"<circle cx="{:.2}" cy="{:.2}" r="9" fill="none" stroke="red" stroke-width="2"/>"#,
-                px(p[0]),
-                py(p[1])
-            );
+            best_ring(&mut out, px(p[0]), py(p[1]));
         }
         legend(
             &mut out,
