@@ -1,0 +1,713 @@
+//! Raw clouds (contact regions): a link's cloud is the part of the object's surface within
+//! [`CloudSettings::contact_distance`] (default 1 mm) of the link, computed from the two shapes
+//! with no sampling of the link. Each object part's surface is a set of triangles that are exact
+//! (meshes, boxes) or map exactly onto the curved surface (sphere, cylinder side and caps, see
+//! `SurfacePatch`).
+//!
+//! - A **box link over a flat triangle** (every link of the built-in hands against meshes,
+//!   boxes, prisms): the region in closed form, exact to round-off (`cuboid.rs`).
+//! - Otherwise (a ball, cylinder or mesh link, a curved object, a triangle partly inside another
+//!   part of a union) each triangle near the link is subdivided adaptively. A triangle is
+//!   dropped when its centre is farther from the link than the contact distance plus the
+//!   triangle's radius; kept whole when it is within the contact distance (its corners are, on a
+//!   flat triangle: the distance to a convex link is convex) and one face of the link is closest
+//!   over it; clipped exactly where the corners see one face of the link (the distance is linear
+//!   there); elsewhere subdivided down to [`CloudSettings::resolution`] (default 0.2 mm) and
+//!   clipped on the linear interpolation of the distance, an error second order in the
+//!   resolution. How much halving it moves BW on the 67 x 33 grids of the seven objects is in
+//!   docs/benchmarks.md.
+//!
+//! The distance to a box or a ball is computed in closed form, to a convex mesh link and any
+//! other shape by parry's point projection.
+//!
+//! Each kept piece is a point with a weight, its area; on a flat triangle the pieces with the
+//! same normal are merged into one point (the area-weighted centroid, the summed area), so the
+//! mean-point model is the region's area-weighted centroid. On a curved patch the pieces within
+//! one sub-triangle of at most 16 resolutions across are merged and moved onto the surface (by
+//! their sag, second order in the resolution) with the object's normal there.
+//!
+//! Normals (into the object): on a curved object surface (sphere, cylinder), the object's normal
+//! (face against face). On a flat object triangle, where the link's surface is smooth at its
+//! point closest to a region point (a face of a box, the side of a cylinder, a sphere), the
+//! normal is the link's there,
+//! the direction from the link to the point; so an object edge or vertex touching a link face
+//! gets the link face's normal, the only well-defined one. Where the closest link point is on a
+//! link edge or vertex, the normal is the object's face normal: a link edge touching an object
+//! face gets the object's. Face against face, the two agree (the object's face normal). Not
+//! resolved: a link face tilted against an object face whose closest feature is the link's edge
+//! gives the part of the region under the link face the link's normal, which differs from the
+//! object's by the tilt angle.
+
+use parry3d_f64::math::{Matrix, Pose, Vector};
+use parry3d_f64::query::Ray;
+
+use super::{CloudSettings, ContactPoint, cuboid};
+use crate::convert::{g2p, g2v, iso2pose};
+use crate::error::{Result, SimError};
+use crate::hand::LinkGeometry;
+use crate::object::{Object, SurfacePatch};
+
+/// The deepest subdivision of an object triangle (a safety net: leaves reach
+/// [`CloudSettings::resolution`] long before).
+const MAX_DEPTH: usize = 30;
+
+/// Two link directions closer than this are the same (the same face of the link).
+const SAME_DIRECTION: f64 = 1e-12;
+
+/// A link surface normal within this of the direction to the link is smooth there.
+const SMOOTH_TOLERANCE: f64 = 1e-6;
+
+/// What the link looks like from one surface point of the object.
+#[derive(Clone, Copy, Debug)]
+struct Probe {
+    /// The point of the patch's corner triangle (pre-image).
+    pre: Vector,
+    /// The surface point (part frame).
+    q: Vector,
+    /// Distance to the link (0 inside it).
+    d: f64,
+    /// Unit direction from the link's closest point to `q` (zero when `d` is 0).
+    u: Vector,
+    /// Inside another part of a union (not a surface point of the object).
+    hidden: bool,
+    /// Whether the link is smooth where it is closest (computed for probes within the contact
+    /// distance only; see [`RegionBuilder::link_smooth`]).
+    smooth: bool,
+}
+
+/// Region pieces of one object triangle (or of one small piece of a curved one): on a flat
+/// patch merged when their normals agree, on a curved one all merged.
+#[derive(Default)]
+struct PatchSums {
+    /// Normal of the first piece, area, area-weighted position, area-weighted normal.
+    sums: Vec<(Vector, f64, Vector, Vector)>,
+    /// Set inside a curved patch's merged piece.
+    merging: Option<()>,
+}
+
+/// On curved patches, pieces within one sub-triangle of at most this many resolutions across are
+/// merged into one point (and whole sub-triangles this small within the contact distance are
+/// kept whole).
+const CURVED_MERGE: f64 = 16.0;
+
+/// Computes the region of one link against one part of the object.
+struct RegionBuilder<'a> {
+    object: &'a Object,
+    part: usize,
+    part_pose: Pose,
+    shape: &'a dyn parry3d_f64::shape::Shape,
+    /// The link shape's pose in the part frame.
+    link: Pose,
+    query: LinkQuery,
+    d_c: f64,
+    h: f64,
+}
+
+/// How the distance to a link is computed. A box or a ball (every link of the built-in hands) in
+/// closed form: the distance, the direction and whether the closest link point lies on a face
+/// come from the point's coordinates in the link frame. Any other shape through parry's point
+/// projection and a ray cast to its surface. The closed forms made the scored mug trial about
+/// N times faster (docs/benchmarks.md): the region's probes are the trial's main cost.
+enum LinkQuery {
+    /// A box: the link frame's rotation (columns: its axes in the part frame), its origin and
+    /// the half extents.
+    Cuboid {
+        axes: Matrix,
+        origin: Vector,
+        half: Vector,
+    },
+    /// A ball.
+    Ball { centre: Vector, radius: f64 },
+    /// A convex polyhedron (a mesh link): distances by parry; the link is smooth where the
+    /// direction to the point is one of its face normals (here in the part frame). Parry's ray
+    /// cast returns a normal equal to the ray's direction at an edge or a vertex, so it cannot
+    /// tell.
+    Polyhedron { normals: Vec<Vector> },
+    /// Any other shape (parry).
+    General,
+}
+
+impl LinkQuery {
+    fn new(shape: &dyn parry3d_f64::shape::Shape, link: &Pose) -> Self {
+        if let Some(c) = shape.as_cuboid() {
+            LinkQuery::Cuboid {
+                axes: Matrix::from_quat(link.rotation),
+                origin: link.translation,
+                half: c.half_extents,
+            }
+        } else if let Some(b) = shape.as_ball() {
+            LinkQuery::Ball {
+                centre: link.translation,
+                radius: b.radius,
+            }
+        } else if let Some(c) = shape.as_convex_polyhedron() {
+            LinkQuery::Polyhedron {
+                normals: c.faces().iter().map(|f| link.rotation * f.normal).collect(),
+            }
+        } else {
+            LinkQuery::General
+        }
+    }
+}
+
+impl RegionBuilder<'_> {
+    fn probe(&self, patch: &SurfacePatch, pre: Vector) -> Probe {
+        let q = patch.point(pre);
+        let hidden = self.object.is_union()
+            && self
+                .object
+                .inside_other_part(self.part, self.part_pose.transform_point(q));
+        let mut p = Probe {
+            pre,
+            q,
+            d: 0.0,
+            u: Vector::ZERO,
+            hidden,
+            smooth: false,
+        };
+        match &self.query {
+            LinkQuery::Cuboid { axes, origin, half } => {
+                let local = axes.transpose() * (q - *origin);
+                let excess = (local.abs() - *half).max(Vector::ZERO);
+                let d2 = excess.length_squared();
+                if d2 > 0.0 {
+                    p.d = d2.sqrt();
+                    p.u = *axes * (excess * local.signum() / p.d);
+                    // Smooth where one axis holds the excess: the face's normal then differs
+                    // from the direction by the other axes' share (the ray test's tolerance).
+                    let largest = excess.max_element();
+                    p.smooth = d2 - largest * largest
+                        < (SMOOTH_TOLERANCE * p.d) * (SMOOTH_TOLERANCE * p.d);
+                }
+            }
+            LinkQuery::Ball { centre, radius } => {
+                let v = q - *centre;
+                let l = v.length();
+                if l > *radius {
+                    p.d = l - radius;
+                    p.u = v / l;
+                    p.smooth = true;
+                }
+            }
+            LinkQuery::Polyhedron { .. } | LinkQuery::General => {
+                let proj = self.shape.project_point(&self.link, q, true);
+                if !proj.is_inside {
+                    let v = q - proj.point;
+                    p.d = v.length();
+                    p.u = if p.d > 0.0 { v / p.d } else { Vector::ZERO };
+                }
+                if let LinkQuery::Polyhedron { normals } = &self.query {
+                    p.smooth = p.d > 0.0
+                        && normals
+                            .iter()
+                            .any(|n| (*n - p.u).length() < SMOOTH_TOLERANCE);
+                } else if p.d <= self.d_c {
+                    p.smooth = self.smooth_at(&p);
+                }
+            }
+        }
+        p
+    }
+
+    /// Whether the link is smooth where it is closest to `p` (computed with the probe in closed
+    /// form, or by parry within the contact distance).
+    fn link_smooth(&self, p: &Probe) -> bool {
+        if p.d <= self.d_c || !matches!(self.query, LinkQuery::General) {
+            p.smooth
+        } else {
+            self.smooth_at(p)
+        }
+    }
+
+    /// Whether the link's surface is smooth (a face, not an edge or vertex) where it is closest
+    /// to the probe: its own normal there is the direction to the probe.
+    fn smooth_at(&self, p: &Probe) -> bool {
+        if p.d <= 0.0 {
+            return false;
+        }
+        let ray = Ray::new(p.q, -p.u);
+        self.shape
+            .cast_ray_and_get_normal(&self.link, &ray, p.d * (1.0 + 1e-6) + 1e-12, true)
+            .is_some_and(|hit| (hit.normal - p.u).length() < SMOOTH_TOLERANCE)
+    }
+
+    /// The contact normal (into the object) at a probe (see the module doc).
+    fn normal(&self, patch: &SurfacePatch, p: &Probe) -> Vector {
+        if patch.is_flat() && self.link_smooth(p) {
+            p.u
+        } else {
+            -patch.outward_normal(p.q)
+        }
+    }
+
+    fn add(&self, sums: &mut PatchSums, n: Vector, area: f64, at: Vector) {
+        if area > 0.0 {
+            let k = match sums
+                .sums
+                .iter()
+                .position(|s| sums.merging.is_some() || (s.0 - n).length() <= SAME_DIRECTION)
+            {
+                Some(k) => k,
+                None => {
+                    sums.sums.push((n, 0.0, Vector::ZERO, Vector::ZERO));
+                    sums.sums.len() - 1
+                }
+            };
+            let s = &mut sums.sums[k];
+            s.1 += area;
+            s.2 += at * area;
+            s.3 += n * area;
+        }
+    }
+
+    /// The region of a patch (or sub-triangle) with corner probes `v`, as points: one per normal
+    /// rule on a flat patch; on a curved patch one per sub-triangle of diameter at most
+    /// [`CURVED_MERGE`] resolutions, moved onto the surface.
+    fn region(&self, patch: &SurfacePatch, v: [Probe; 3], out: &mut Vec<ContactPoint>) {
+        let mut sums = PatchSums::default();
+        self.refine(patch, v, 0, &mut sums, out);
+        self.flush(patch, &sums, out);
+    }
+
+    fn flush(&self, patch: &SurfacePatch, sums: &PatchSums, out: &mut Vec<ContactPoint>) {
+        for &(_, area, moment, nsum) in &sums.sums {
+            if area > 0.0 {
+                let at = moment / area;
+                let (at, n) = if patch.is_flat() {
+                    (at, nsum.normalize_or_zero())
+                } else {
+                    // The centroid of a small curved piece, moved onto the surface (by its sag,
+                    // second order in its size), with the object's normal there.
+                    let q = patch.point(at);
+                    (q, -patch.outward_normal(q))
+                };
+                if n != Vector::ZERO {
+                    out.push(ContactPoint {
+                        position: g2p(self.part_pose.transform_point(at)),
+                        normal: g2v(self.part_pose.transform_vector(n)),
+                        weight: area,
+                    });
+                }
+            }
+        }
+    }
+
+    fn refine(
+        &self,
+        patch: &SurfacePatch,
+        v: [Probe; 3],
+        depth: usize,
+        sums: &mut PatchSums,
+        out: &mut Vec<ContactPoint>,
+    ) {
+        let diam = (v[0].q - v[1].q)
+            .length()
+            .max((v[1].q - v[2].q).length())
+            .max((v[2].q - v[0].q).length());
+        if !patch.is_flat() && depth > 0 && diam <= CURVED_MERGE * self.h && sums.merging.is_none()
+        {
+            let mut own = PatchSums {
+                merging: Some(()),
+                ..PatchSums::default()
+            };
+            self.refine(patch, v, depth, &mut own, out);
+            self.flush(patch, &own, out);
+            return;
+        }
+        let flat = patch.is_flat();
+        if flat
+            && let LinkQuery::Cuboid { axes, origin, half } = &self.query
+            && v.iter().all(|p| !p.hidden)
+            && !(self.object.is_union()
+                && self.object.inside_other_part(
+                    self.part,
+                    self.part_pose
+                        .transform_point((v[0].q + v[1].q + v[2].q) / 3.0),
+                ))
+        {
+            self.cuboid_region(patch, v.map(|p| p.q), axes, *origin, *half, sums);
+            return;
+        }
+        let [a, b, cc] = [v[0].q, v[1].q, v[2].q];
+        let chord_area = 0.5 * (b - a).cross(cc - a).length();
+        // Every link is convex, so the distance to it is a convex function: a flat triangle
+        // whose corners are within the contact distance is within it everywhere.
+        let corners_within = flat && v.iter().all(|p| p.d <= self.d_c);
+        if corners_within
+            && v.iter().all(|p| !p.hidden)
+            && v[0].d > 0.0
+            && v.iter()
+                .all(|p| self.link_smooth(p) && (p.u - v[0].u).length() < SAME_DIRECTION)
+        {
+            // ... and closest to one face of the link everywhere (its region is convex too).
+            self.add(sums, v[0].u, chord_area, (a + b + cc) / 3.0);
+            return;
+        }
+        let c = self.probe(patch, (v[0].pre + v[1].pre + v[2].pre) / 3.0);
+        let reach = v.iter().map(|p| (p.q - c.q).length()).fold(0.0, f64::max) + patch.bulge(diam);
+        let f = |p: &Probe| p.d - self.d_c;
+        if f(&c) > reach {
+            return; // the whole patch is farther than the contact distance
+        }
+        let same_u = c.d > 0.0 && v.iter().all(|p| (p.u - c.u).length() < SAME_DIRECTION);
+        let same_hidden = v.iter().all(|p| p.hidden == c.hidden);
+        let leaf = diam <= self.h || depth >= MAX_DEPTH;
+        if (corners_within || f(&c) < -reach) && same_hidden {
+            // The whole patch is within the contact distance.
+            if c.hidden {
+                return;
+            }
+            // One face of the link closest over the whole triangle (its cell is convex). No
+            // such rule holds for edges and corners: a face's cell can pass between corners
+            // that all see an edge.
+            let uniform = flat && same_u;
+            if uniform || leaf || (!flat && diam <= CURVED_MERGE * self.h) {
+                let at = if flat { (a + b + cc) / 3.0 } else { c.q };
+                self.add(sums, self.normal(patch, &c), chord_area, at);
+                return;
+            }
+        } else if flat && same_u && same_hidden && !c.hidden && self.on_one_plane(&v) {
+            // The link's closest points lie on one of its faces, so the distance is linear over
+            // the triangle: clipping it where the distance is the contact distance is exact.
+            if let Some((area, at)) = clip([a, b, cc], v.map(|p| p.d - self.d_c)) {
+                self.add(sums, self.normal(patch, &c), area, at);
+            }
+            return;
+        } else if leaf {
+            if c.hidden {
+                return;
+            }
+            if let Some((area, at)) = clip([a, b, cc], v.map(|p| p.d - self.d_c)) {
+                self.add(sums, self.normal(patch, &c), area, at);
+            }
+            return;
+        }
+        let mid = |i: usize, j: usize| self.probe(patch, (v[i].pre + v[j].pre) * 0.5);
+        let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
+        for t in [
+            [v[0], m01, m20],
+            [m01, v[1], m12],
+            [m20, m12, v[2]],
+            [m01, m12, m20],
+        ] {
+            self.refine(patch, t, depth + 1, sums, out);
+        }
+    }
+
+    /// The exact region of a box link over a flat triangle (part frame), see `cuboid.rs`.
+    fn cuboid_region(
+        &self,
+        patch: &SurfacePatch,
+        tri: [Vector; 3],
+        axes: &Matrix,
+        origin: Vector,
+        half: Vector,
+        sums: &mut PatchSums,
+    ) {
+        let to_link = axes.transpose();
+        let mut pieces = Vec::new();
+        cuboid::region(
+            tri.map(|q| to_link * (q - origin)),
+            half,
+            self.d_c,
+            &mut pieces,
+        );
+        if pieces.is_empty() {
+            return;
+        }
+        let object_normal = -patch.outward_normal(tri[0]);
+        for piece in pieces {
+            let faces = piece.cell.iter().filter(|s| **s != 0).count();
+            let normal = if faces == 1 {
+                // A face of the link is closest: its normal (see the module doc).
+                let k = piece.cell.iter().position(|s| *s != 0).unwrap_or(0);
+                *axes * (Vector::AXES[k] * f64::from(piece.cell[k]))
+            } else {
+                object_normal
+            };
+            self.add(sums, normal, piece.area, origin + *axes * piece.centroid);
+        }
+    }
+
+    /// Whether the link's closest points of the three probes lie on one plane orthogonal to
+    /// their common direction.
+    fn on_one_plane(&self, v: &[Probe; 3]) -> bool {
+        let y = v.map(|p| p.q - p.u * p.d);
+        let u = v[0].u;
+        let scale = self
+            .d_c
+            .max((y[1] - y[0]).length())
+            .max((y[2] - y[0]).length());
+        (y[1] - y[0]).dot(u).abs() <= 1e-9 * scale && (y[2] - y[0]).dot(u).abs() <= 1e-9 * scale
+    }
+}
+
+/// The part of the triangle `q` where the linear interpolation of `f` is at most 0: area and
+/// centroid (`None` when empty).
+fn clip(q: [Vector; 3], f: [f64; 3]) -> Option<(f64, Vector)> {
+    let mut poly: Vec<Vector> = Vec::with_capacity(4);
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if f[i] <= 0.0 {
+            poly.push(q[i]);
+        }
+        if (f[i] <= 0.0) != (f[j] <= 0.0) {
+            let t = f[i] / (f[i] - f[j]);
+            poly.push(q[i] + (q[j] - q[i]) * t);
+        }
+    }
+    if poly.len() < 3 {
+        return None;
+    }
+    let mut area = 0.0;
+    let mut moment = Vector::ZERO;
+    for k in 1..poly.len() - 1 {
+        let a = 0.5 * (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]).length();
+        area += a;
+        moment += (poly[0] + poly[k] + poly[k + 1]) * (a / 3.0);
+    }
+    (area > 0.0).then(|| (area, moment / area))
+}
+
+/// The contact region of one link at `link_world` (world pose of the link frame): the object's
+/// surface within the contact distance of the link, as weighted points (see the module doc).
+pub(crate) fn link_cloud(
+    object: &Object,
+    geometry: &LinkGeometry,
+    index: usize,
+    link_world: &nalgebra::Isometry3<f64>,
+    settings: &CloudSettings,
+) -> Result<Vec<ContactPoint>> {
+    let pose: Pose = iso2pose(link_world);
+    let Some((shape, shape_pose)) = geometry.shape_at(index, &pose) else {
+        return Err(SimError::InvalidInput(format!("no link {index}")));
+    };
+    let d_c = settings.contact_distance;
+    let mut out = Vec::new();
+    for (part, part_pose, patches) in object.surface_patches() {
+        let link = part_pose.inverse() * shape_pose;
+        let bb = shape.compute_aabb(&link);
+        let (lo, hi) = (bb.mins - Vector::splat(d_c), bb.maxs + Vector::splat(d_c));
+        let builder = RegionBuilder {
+            object,
+            part,
+            part_pose,
+            shape,
+            link,
+            query: LinkQuery::new(shape, &link),
+            d_c,
+            h: settings.resolution,
+        };
+        for patch in patches {
+            let (a, b) = patch.aabb;
+            if a.cmpgt(hi).any() || b.cmplt(lo).any() {
+                continue;
+            }
+            let v = patch.corners.map(|c| builder.probe(patch, c));
+            builder.region(patch, v, &mut out);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use crate::contact::{DEFAULT_RESOLUTION, mean_point};
+    use crate::hand::{LinkShape, LinkSpec};
+    use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+    /// The region of one box link (half extents `half`) at `pose` against `object`; with
+    /// `as_mesh`, the same box given as a convex mesh (parry's general path, not the closed form).
+    fn box_region_of(
+        object: &Object,
+        half: Vector3<f64>,
+        pose: &Isometry3<f64>,
+        resolution: f64,
+        as_mesh: bool,
+    ) -> Vec<ContactPoint> {
+        let shape = if as_mesh {
+            LinkShape::Mesh {
+                mesh: crate::mesh::box_mesh(&half),
+            }
+        } else {
+            LinkShape::Box { half_extents: half }
+        };
+        let links = [LinkSpec {
+            name: "pad".into(),
+            finger: Some(0),
+            shape,
+        }];
+        let settings = CloudSettings {
+            resolution,
+            ..CloudSettings::default()
+        };
+        link_cloud(object, &LinkGeometry::new(&links), 0, pose, &settings).unwrap()
+    }
+
+    fn box_region(
+        object: &Object,
+        half: Vector3<f64>,
+        pose: &Isometry3<f64>,
+        resolution: f64,
+    ) -> Vec<ContactPoint> {
+        box_region_of(object, half, pose, resolution, false)
+    }
+
+    fn total_area(cloud: &[ContactPoint]) -> f64 {
+        cloud.iter().map(|p| p.weight).sum()
+    }
+
+    #[test]
+    fn a_box_pressed_on_a_cube_face_gives_the_offset_rectangle() {
+        // The cuboid's top face is z = 0.12 over [-0.03, 0.03] x [-0.025, 0.025]. A pad of
+        // 10 x 20 mm rests 0.2 mm above it at (0.005, -0.004): the region is the footprint
+        // grown by rho = sqrt(d_c^2 - g^2) with rounded corners, centred under the pad.
+        let cube = Object::by_name("cuboid").unwrap();
+        let (a, b, hz, g, d_c): (f64, f64, f64, f64, f64) = (0.005, 0.01, 0.002, 2e-4, 1e-3);
+        let pose = Isometry3::translation(0.005, -0.004, 0.12 + g + hz);
+        let rho = (d_c * d_c - g * g).sqrt();
+        let area = 4.0 * a * b + 4.0 * (a + b) * rho + std::f64::consts::PI * rho * rho;
+        // A box link in closed form: exact at any resolution. The same box as a convex mesh
+        // (the general path): straight sides exact, rounded corners second order.
+        for as_mesh in [false, true] {
+            let mut errors = Vec::new();
+            for resolution in [DEFAULT_RESOLUTION, DEFAULT_RESOLUTION / 2.0] {
+                let cloud =
+                    box_region_of(&cube, Vector3::new(a, b, hz), &pose, resolution, as_mesh);
+                let m = mean_point(&cloud).unwrap();
+                let rel = (total_area(&cloud) - area).abs() / area;
+                assert!(rel < 1e-4, "area {} vs {area}: {rel:e}", total_area(&cloud));
+                errors.push(rel);
+                assert!(
+                    (m.position - Point3::new(0.005, -0.004, 0.12)).norm() < 1e-8,
+                    "{:?}",
+                    m.position
+                );
+                let worst = cloud
+                    .iter()
+                    .map(|p| (p.normal + Vector3::z()).norm())
+                    .fold(0.0, f64::max);
+                assert!(worst < 1e-12, "mesh {as_mesh}: normal off by {worst:e}");
+            }
+            if as_mesh {
+                assert!(errors[1] < errors[0] / 3.0, "{errors:?}");
+            } else {
+                assert!(errors.iter().all(|e| *e < 1e-13), "{errors:?}");
+            }
+        }
+        // A pad wider than the face covers it all, and the side faces' strips within d_c
+        // below the top edges: every piece is clipped where the distance is linear, so the
+        // area and the centroid are exact to round-off.
+        let pose = Isometry3::translation(0.0, 0.0, 0.12 + g + hz);
+        let cloud = box_region(&cube, Vector3::new(0.04, 0.04, hz), &pose, 1e-3);
+        let (top, strips) = (0.06 * 0.05, 2.0 * (0.06 + 0.05) * (d_c - g));
+        let area = top + strips;
+        assert!((total_area(&cloud) - area).abs() < 1e-12 * area);
+        let z = (top * 0.12 + strips * (0.12 - (d_c - g) / 2.0)) / area;
+        let m = mean_point(&cloud).unwrap();
+        assert!(
+            (m.position - Point3::new(0.0, 0.0, z)).norm() < 1e-14,
+            "{m:?}"
+        );
+        // Object edges against the pad's face: the pad's normal everywhere.
+        assert!(
+            cloud
+                .iter()
+                .all(|p| (p.normal + Vector3::z()).norm() < 1e-12)
+        );
+    }
+
+    #[test]
+    fn an_object_edge_against_a_link_face_takes_the_link_face_normal() {
+        // A pad tilted 30 degrees about y touches the cuboid's top edge x = 0.03, z = 0.12
+        // with the middle of its face, 0.2 mm away. The region: strips along the edge on the
+        // top face (length L1 = (d_c - g) / sin 30) and the side face (L2 = (d_c - g) / cos 30)
+        // and a right triangle with these legs on each end face; all with the pad's normal.
+        let cube = Object::by_name("cuboid").unwrap();
+        let (hz, g, d_c): (f64, f64, f64) = (0.002, 2e-4, 1e-3);
+        let alpha = 30f64.to_radians();
+        let rot = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), alpha);
+        let z_link = rot * Vector3::z();
+        let centre = Vector3::new(0.03, 0.0, 0.12) + z_link * (g + hz);
+        let pose = Isometry3::from_parts(Translation3::from(centre), rot);
+        let cloud = box_region(
+            &cube,
+            Vector3::new(0.01, 0.04, hz),
+            &pose,
+            DEFAULT_RESOLUTION,
+        );
+        let (l1, l2) = ((d_c - g) / alpha.sin(), (d_c - g) / alpha.cos());
+        let area = 0.05 * (l1 + l2) + l1 * l2;
+        assert!(
+            (total_area(&cloud) - area).abs() < 1e-12 * area,
+            "{} vs {area}",
+            total_area(&cloud)
+        );
+        for p in &cloud {
+            assert!((p.normal + z_link).norm() < 1e-12, "{p:?}");
+        }
+        // The same edge against the pad's own edge (the pad moved so that its edge is
+        // closest): the region beyond the pad's edge takes the object's face normals.
+        let pose = Isometry3::from_parts(
+            Translation3::from(centre + rot * Vector3::x() * 0.0099),
+            rot,
+        );
+        let cloud = box_region(
+            &cube,
+            Vector3::new(0.01, 0.04, hz),
+            &pose,
+            DEFAULT_RESOLUTION,
+        );
+        assert!(
+            cloud
+                .iter()
+                .any(|p| (p.normal + Vector3::z()).norm() < 1e-12
+                    || (p.normal + Vector3::x()).norm() < 1e-12)
+        );
+    }
+
+    #[test]
+    fn the_closed_form_box_region_matches_a_fine_subdivision_of_the_same_box_as_a_mesh() {
+        // Random pads near the cuboid's top corner (face, edge and corner cells, tilted both
+        // ways): the closed form and the general path (the box as a convex mesh, subdivided
+        // to 25 micrometres) agree on the area, the centroid and the mean normal.
+        use rand::{RngExt, SeedableRng};
+        let cube = Object::by_name("cuboid").unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let half = Vector3::new(0.004, 0.006, 0.002);
+        let mut compared = 0;
+        for _ in 0..24 {
+            let axis = Vector3::new(rng.random::<f64>(), rng.random(), rng.random()) * 2.0
+                - Vector3::repeat(1.0);
+            let rot = UnitQuaternion::from_scaled_axis(axis * 0.6);
+            let corner = Vector3::new(0.03, 0.025, 0.12);
+            let offset = Vector3::new(rng.random::<f64>(), rng.random(), 0.0) * 0.008
+                - Vector3::new(0.004, 0.004, 0.0);
+            // Lift the pad until its lowest point is 0 to 0.8 mm above the top face.
+            let mut pose = Isometry3::from_parts(Translation3::from(corner + offset), rot);
+            let lowest = crate::mesh::box_mesh(&half)
+                .vertices
+                .iter()
+                .map(|v| (pose * v).z)
+                .fold(f64::INFINITY, f64::min);
+            pose.translation.vector.z += 0.12 - lowest + rng.random::<f64>() * 8e-4;
+            let exact = box_region_of(&cube, half, &pose, DEFAULT_RESOLUTION, false);
+            let fine = box_region_of(&cube, half, &pose, 2.5e-5, true);
+            let (ae, af) = (total_area(&exact), total_area(&fine));
+            if ae == 0.0 && af == 0.0 {
+                continue;
+            }
+            compared += 1;
+            assert!((ae - af).abs() <= 1e-3 * ae, "area {ae:e} vs {af:e}");
+            let (me, mf) = (mean_point(&exact).unwrap(), mean_point(&fine).unwrap());
+            assert!(
+                (me.position - mf.position).norm() < 2e-6,
+                "{me:?} vs {mf:?}"
+            );
+            assert!((me.normal - mf.normal).norm() < 2e-3, "{me:?} vs {mf:?}");
+        }
+        assert!(compared >= 12, "only {compared} pads touched the cube");
+    }
+}
