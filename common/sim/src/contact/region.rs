@@ -17,8 +17,8 @@
 //!   resolution. How much halving it moves BW on the 67 x 33 grids of the seven objects is in
 //!   docs/benchmarks.md.
 //!
-//! The distance to a box or a ball is computed in closed form, to a convex mesh link and any
-//! other shape by parry's point projection.
+//! The distance to a box, cylinder or ball link is computed in closed form, to a convex mesh
+//! link and any other shape by parry's point projection (see `LinkQuery`).
 //!
 //! Each kept piece is a point with a weight, its area; on a flat triangle the pieces with the
 //! same normal are merged into one point (the area-weighted centroid, the summed area), so the
@@ -81,6 +81,9 @@ struct Probe {
 struct PatchSums {
     /// Normal of the first piece, area, area-weighted position, area-weighted normal.
     sums: Vec<(Vector, f64, Vector, Vector)>,
+    /// Index in `sums` of each normal, rounded to [`SAME_DIRECTION`] (a curved link's pieces
+    /// each have their own normal: a linear search made a palm against the mug quadratic).
+    by_normal: std::collections::HashMap<[i64; 3], usize>,
     /// Set inside a curved patch's merged piece.
     merging: Option<()>,
 }
@@ -103,11 +106,13 @@ struct RegionBuilder<'a> {
     h: f64,
 }
 
-/// How the distance to a link is computed. A box or a ball (every link of the built-in hands) in
-/// closed form: the distance, the direction and whether the closest link point lies on a face
-/// come from the point's coordinates in the link frame. Any other shape through parry's point
-/// projection and a ray cast to its surface. The closed forms made the scored mug trial about
-/// N times faster (docs/benchmarks.md): the region's probes are the trial's main cost.
+/// How the distance to a link is computed. A box, a cylinder or a ball (every link of the
+/// built-in hands) in closed form: the distance, the direction and whether the closest link
+/// point lies on a face come from the point's coordinates in the link frame. A convex mesh and
+/// any other shape through parry's point projection. Two measured reasons: the closed forms cut
+/// the region's probes (most of a trial's time) several times over, and parry's ray cast on a
+/// support-map shape (cylinder, convex mesh) returns the ray's own direction as the normal at an
+/// edge, so it cannot tell a face from an edge (the tests compare both).
 enum LinkQuery {
     /// A box: the link frame's rotation (columns: its axes in the part frame), its origin and
     /// the half extents.
@@ -118,6 +123,14 @@ enum LinkQuery {
     },
     /// A ball.
     Ball { centre: Vector, radius: f64 },
+    /// A cylinder along the link frame's `y` (parry's convention): its axes, origin, radius
+    /// and half height.
+    Cylinder {
+        axes: Matrix,
+        origin: Vector,
+        radius: f64,
+        half_height: f64,
+    },
     /// A convex polyhedron (a mesh link): distances by parry; the link is smooth where the
     /// direction to the point is one of its face normals (here in the part frame). Parry's ray
     /// cast returns a normal equal to the ray's direction at an edge or a vertex, so it cannot
@@ -139,6 +152,13 @@ impl LinkQuery {
             LinkQuery::Ball {
                 centre: link.translation,
                 radius: b.radius,
+            }
+        } else if let Some(c) = shape.as_cylinder() {
+            LinkQuery::Cylinder {
+                axes: Matrix::from_quat(link.rotation),
+                origin: link.translation,
+                radius: c.radius,
+                half_height: c.half_height,
             }
         } else if let Some(c) = shape.as_convex_polyhedron() {
             LinkQuery::Polyhedron {
@@ -178,6 +198,30 @@ impl RegionBuilder<'_> {
                     let largest = excess.max_element();
                     p.smooth = d2 - largest * largest
                         < (SMOOTH_TOLERANCE * p.d) * (SMOOTH_TOLERANCE * p.d);
+                }
+            }
+            LinkQuery::Cylinder {
+                axes,
+                origin,
+                radius,
+                half_height,
+            } => {
+                let local = axes.transpose() * (q - *origin);
+                let rho = local.x.hypot(local.z);
+                let side = (rho - radius).max(0.0);
+                let cap = (local.y.abs() - half_height).max(0.0);
+                let d2 = side * side + cap * cap;
+                if d2 > 0.0 {
+                    p.d = d2.sqrt();
+                    let radial = if rho > 0.0 {
+                        Vector::new(local.x / rho, 0.0, local.z / rho)
+                    } else {
+                        Vector::ZERO
+                    };
+                    let dir = radial * side + Vector::Y * (cap * local.y.signum());
+                    p.u = *axes * (dir / p.d);
+                    let smaller = side.min(cap);
+                    p.smooth = smaller < SMOOTH_TOLERANCE * p.d;
                 }
             }
             LinkQuery::Ball { centre, radius } => {
@@ -242,17 +286,15 @@ impl RegionBuilder<'_> {
 
     fn add(&self, sums: &mut PatchSums, n: Vector, area: f64, at: Vector) {
         if area > 0.0 {
-            let k = match sums
-                .sums
-                .iter()
-                .position(|s| sums.merging.is_some() || (s.0 - n).length() <= SAME_DIRECTION)
-            {
-                Some(k) => k,
-                None => {
-                    sums.sums.push((n, 0.0, Vector::ZERO, Vector::ZERO));
-                    sums.sums.len() - 1
-                }
+            let key = if sums.merging.is_some() {
+                [0; 3]
+            } else {
+                (n / SAME_DIRECTION).round().as_i64vec3().to_array()
             };
+            let k = *sums.by_normal.entry(key).or_insert_with(|| {
+                sums.sums.push((n, 0.0, Vector::ZERO, Vector::ZERO));
+                sums.sums.len() - 1
+            });
             let s = &mut sums.sums[k];
             s.1 += area;
             s.2 += at * area;
@@ -709,5 +751,67 @@ mod tests {
             assert!((me.normal - mf.normal).norm() < 2e-3, "{me:?} vs {mf:?}");
         }
         assert!(compared >= 12, "only {compared} pads touched the cube");
+    }
+
+    #[test]
+    fn closed_form_distances_to_boxes_balls_and_cylinders_match_parry() {
+        use parry3d_f64::shape::{Ball, Cuboid, Cylinder, Shape};
+        use rand::{RngExt, SeedableRng};
+        let object = Object::by_name("cuboid").unwrap();
+        let (part, part_pose, patches) = object.surface_patches().next().unwrap();
+        let patch = &patches[0];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let shapes: [Box<dyn Shape>; 3] = [
+            Box::new(Cuboid::new(Vector::new(0.004, 0.01, 0.002))),
+            Box::new(Ball::new(0.006)),
+            Box::new(Cylinder::new(0.003, 0.02)),
+        ];
+        for shape in &shapes {
+            let link = Pose::from_parts(
+                Vector::new(0.01, -0.02, 0.03),
+                parry3d_f64::math::Rotation::from_scaled_axis(Vector::new(0.3, -1.1, 0.7)),
+            );
+            let builder = |query| RegionBuilder {
+                object: &object,
+                part,
+                part_pose,
+                shape: shape.as_ref(),
+                link,
+                query,
+                d_c: 1e-3,
+                h: DEFAULT_RESOLUTION,
+            };
+            let closed = builder(LinkQuery::new(shape.as_ref(), &link));
+            assert!(!matches!(closed.query, LinkQuery::General));
+            let parry = builder(LinkQuery::General);
+            let (mut near, mut smooth) = (0, 0);
+            for _ in 0..4000 {
+                let offset = Vector::new(rng.random(), rng.random(), rng.random()) * 0.05
+                    - Vector::splat(0.025);
+                let q = link.translation + offset;
+                let (a, b) = (closed.probe(patch, q), parry.probe(patch, q));
+                assert!((a.d - b.d).abs() < 1e-9, "{} vs {} at {q:?}", a.d, b.d);
+                if a.d > 1e-6 {
+                    assert!((a.u - b.u).length() < 1e-6, "{:?} vs {:?}", a.u, b.u);
+                }
+                if a.d > 1e-6 && a.d <= 1e-3 {
+                    near += 1;
+                    smooth += usize::from(a.smooth);
+                    // Parry's ray cast on a cylinder (a support map) returns the ray's own
+                    // direction at the rim: there the closest point tells.
+                    let expected = match shape.as_cylinder() {
+                        Some(c) => {
+                            let y = link.inverse_transform_point(q - a.u * a.d);
+                            let on_rim = (y.x.hypot(y.z) - c.radius).abs() < 1e-9
+                                && (y.y.abs() - c.half_height).abs() < 1e-9;
+                            !on_rim
+                        }
+                        None => b.smooth,
+                    };
+                    assert_eq!(a.smooth, expected, "{:?} at {q:?}", shape.shape_type());
+                }
+            }
+            assert!(near > 20 && smooth > 0, "{near} near, {smooth} smooth");
+        }
     }
 }
