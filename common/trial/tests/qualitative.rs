@@ -9,11 +9,11 @@
 //! its bounding radius).
 //!
 //! The Barrett hand is the corrected BH8 (distal links bent 50 degrees at rest, as in
-//! OpenRAVE's model); with it the width of the informative BW range (claim 1) holds. Two parts
-//! are not reproduced; their tests assert them as stated and are `#[ignore]`d with the reason
-//! (run them with `cargo test -p graspopt-trial --test qualitative -- --ignored`): BW's
-//! continuity at the force-closure boundary of the sphere's approach scan (claim 2) and the
-//! world-frame argmax (claim 3). The tests next to them assert the parts that hold.
+//! OpenRAVE's model); with it and the exact contact regions the width of the informative BW
+//! range (claim 1) and BW's continuity at the sphere's force-closure boundaries (claim 2) hold.
+//! One part is not reproduced; its test asserts it as stated and is `#[ignore]`d with the
+//! reason (run it with `cargo test -p graspopt-trial --test qualitative -- --ignored`): the
+//! world-frame argmax (claim 3). The tests next to it assert the parts that hold.
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -319,28 +319,15 @@ fn sphere_approach_bw_is_informative_over_twice_the_force_closure_range() {
 /// of it must be within 1% of the scan's BW span of zero (no jump at the boundary).
 ///
 /// Not asserted on the other scans: the cuboid's and the star's edges make BW jump (thesis
-/// 4.2), and on the sphere's vertical scan BW jumps from -0.0064 to +0.0011 at the boundary
-/// (1.8% of that scan's span): there one more sample of F3's raw contact cloud comes within
-/// the 1 mm contact distance (9 to 10 points), which moves the finger's mean contact by
-/// 0.6 mm and its normal by 1.7 degrees, and the surface patch built on them with it
-/// (cloud points count fully within the contact distance and not at all beyond).
+/// 4.2).
 ///
-/// The continuity check is `#[ignore]`d since the distal links are bent (corrected BH8): on
-/// the sphere's approach scan BW jumps from -0.066 to +0.033 at the boundary near +0.0045 m
-/// with the same links touching on both sides. There F1's and F2's distal links rest at their
-/// 90-degree limit 0.97 mm from the sphere, just inside the 1 mm contact distance: across the
-/// boundary two of their cloud samples leave it (13 to 11 points), which moves each finger's
-/// mean contact by 5 mm. The same cut-off as on the vertical scan; exact contact regions
-/// (issue 16) are meant to remove it.
+/// History: with contact clouds sampled on a 2.5 mm grid of the links, BW jumped at the
+/// sphere's boundaries (-0.0064 to +0.0011 on the vertical scan, -0.066 to +0.033 on the
+/// approach scan with the bent distal links), each time where a cloud sample crossed the 1 mm
+/// contact distance and moved a finger's mean contact by up to 5 mm. The exact contact
+/// regions (issue 16) made both continuous.
 #[test]
-fn bw_changes_sign_where_force_closure_switches() {
-    sign_and_continuity(false);
-}
-
-/// Claim 2's continuity on the sphere's approach scan (see the test above).
-#[test]
-#[ignore = "not reproduced: BW jumps at a force-closure boundary where a link's contact cloud crosses the 1 mm contact distance (see the doc comment of bw_changes_sign_where_force_closure_switches)"]
-fn bw_is_continuous_where_force_closure_switches_on_the_sphere_approach() {
+fn bw_changes_sign_and_stays_continuous_where_force_closure_switches() {
     sign_and_continuity(true);
 }
 
@@ -353,7 +340,12 @@ fn sign_and_continuity(check_continuity: bool) {
             APPROACH_STEP,
             check_continuity,
         ),
-        ("sphere", ParamKind::Vertical, VERTICAL_STEP, false),
+        (
+            "sphere",
+            ParamKind::Vertical,
+            VERTICAL_STEP,
+            check_continuity,
+        ),
         ("rotated_cuboid", ParamKind::Approach, APPROACH_STEP, false),
         ("star_prism", ParamKind::Approach, APPROACH_STEP, false),
     ];
