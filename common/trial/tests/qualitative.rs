@@ -460,14 +460,15 @@ fn argmax_of_the_2d_sphere_scan_is_the_same_in_the_object_and_hand_frames() {
 /// Claim 3 for the world frame (figure 4.8, left): the set of maximal cells of the 2D scan
 /// is the same in the world and object frames. Set-up as above.
 ///
-/// Not reproduced: with the corrected BH8 the world frame moves the maximum two cells down
-/// (object frame: BW 0.2990 at approach 0.02, vertical 0; world frame: 0.2475 at approach
-/// 0.02, vertical -12.9 mm). With straight distal links it moved one cell (0.2991 at vertical
-/// 0 against 0.2460 at -6.4 mm), which was measured to come from a flat ridge of best grasps
-/// (palm pressing, fingers closed) along the vertical axis, symmetric about the sphere's
-/// centre, tilted by the torques about the world origin (the sphere's footprint, 35 mm below
-/// its centre). The thesis's invariance is empirical and holds here only up to the width of
-/// a flat maximum.
+/// Not reproduced: the world frame moves the maximum two cells down (object frame: BW 0.2996
+/// at approach 0.02, vertical 0; world frame: 0.2491 at approach 0.02, vertical -12.9 mm). On
+/// the seven objects (`cargo run --release -p graspopt-trial --example frames`, table in
+/// docs/benchmarks.md) the world frame moves the 2D argmax by 0 to 7 cells, the palm frame by
+/// 0 or 1 on six objects (8 on the mug). The best grasps form a flat ridge along the vertical
+/// axis (palm pressing, fingers closed); moving the torque reference shears the wrench space,
+/// the largest inscribed ball is not invariant under a shear, and the ridge's top moves along
+/// it. The thesis's invariance is empirical and holds here only up to the width of a flat
+/// maximum.
 #[test]
 #[ignore = "not reproduced: the world frame moves the argmax two cells (12.9 mm) down the ridge of best grasps (see the doc comment)"]
 fn argmax_of_the_2d_sphere_scan_is_the_same_in_the_world_and_object_frames() {
