@@ -11,7 +11,6 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 mod commands;
 mod export;
 mod out;
-mod render;
 
 #[derive(Parser, Debug)]
 #[command(

@@ -14,6 +14,5 @@ pub mod router;
 pub mod run;
 pub mod scan;
 pub mod setup;
-pub mod svg;
 pub mod topic;
 pub mod trial;

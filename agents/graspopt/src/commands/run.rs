@@ -18,8 +18,8 @@ use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 
 use super::setup::{Contacts, Frame, SimArgs, param_kind};
-use super::svg;
 use crate::out::outln;
+use graspopt_pictures::chart;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
@@ -520,7 +520,7 @@ fn write_pictures(e: &Embedded, object: &str, trials: &[graspopt_journal::TrialR
     // A trial that touched nothing scores below every grasp: `None` on the pictures.
     let hit = |t: &graspopt_journal::TrialRow| t.score.filter(|_| t.contacts > 0);
     let scores: Vec<Option<f64>> = done.iter().map(|t| hit(t)).collect();
-    let plot = svg::progress_plot(&format!("{object}: score by trial, best so far"), &scores);
+    let plot = chart::progress_plot(&format!("{object}: score by trial, best so far"), &scores);
     std::fs::write(e.out.join("best.svg"), plot)?;
 
     let names: Vec<String> = e
@@ -540,7 +540,7 @@ fn write_pictures(e: &Embedded, object: &str, trials: &[graspopt_journal::TrialR
     };
     let points: Vec<(Vec<f64>, Option<f64>)> =
         done.iter().map(|t| (t.params.clone(), hit(t))).collect();
-    let map = svg::trials_map(
+    let map = chart::trials_map(
         &format!(
             "{object}: {} trials on the parameter space{shown}",
             done.len()

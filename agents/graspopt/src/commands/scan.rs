@@ -14,8 +14,8 @@ use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid, worker_count};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::setup::{SimArgs, param_kind};
-use super::svg;
 use crate::out::outln;
+use graspopt_pictures::chart;
 
 /// The most points a grid (`--steps` multiplied over the axes) may hold.
 pub const MAX_GRID_POINTS: usize = 10_000_000;
@@ -146,7 +146,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
     );
     let mut extra = Vec::new();
     let chart = match axes.len() {
-        1 => Some(svg::line_plot(
+        1 => Some(chart::line_plot(
             &title,
             &format!("{} offset (m)", names[0]),
             &args.sim.metric,
@@ -162,9 +162,10 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
                 })
                 .collect();
             let png_path = args.out.join(format!("{stem}.png"));
-            crate::render::heatmap_figure(&z, 8, &title, svg::MISSING_LABEL).save_png(&png_path)?;
+            graspopt_pictures::preview::heatmap_figure(&z, 8, &title, chart::MISSING_LABEL)
+                .save_png(&png_path)?;
             extra.push(png_path.display().to_string());
-            Some(svg::heatmap(
+            Some(chart::heatmap(
                 &title,
                 &format!("{} offset (m)", names[0]),
                 &format!("{} offset (m)", names[1]),

@@ -11,8 +11,9 @@ use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use serde::Serialize;
 
 use super::setup::{SimArgs, param_kind};
+use crate::export;
 use crate::out::outln;
-use crate::{export, render};
+use graspopt_pictures::preview;
 
 /// Size of `--preview` pictures (two views side by side).
 pub const PREVIEW_WIDTH: u32 = 1200;
@@ -281,8 +282,8 @@ pub fn score_words(s: &graspopt_trial::TrialScore) -> String {
 }
 
 /// The `--preview` picture of the evaluated trial `e` under `title`: the object (blue) and
-/// the hand's links (orange), two views (see [`render::preview`]).
-pub fn preview_image(ev: &Evaluator, e: &Evaluation, title: &str) -> Result<render::Image> {
+/// the hand's links (orange), two views (see [`preview::render`]).
+pub fn preview_image(ev: &Evaluator, e: &Evaluation, title: &str) -> Result<preview::Image> {
     let meshes = graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
     let contacts = e.outcome.contacts(ev.score.contacts, true);
     let posts = knuckles(ev.hand.as_ref(), &e.outcome.grasp);
@@ -300,7 +301,7 @@ pub fn preview_image(ev: &Evaluator, e: &Evaluation, title: &str) -> Result<rend
         .collect();
     // The posts in the palm's colour.
     coloured.extend(posts.iter().map(|m| (m, LINK_COLOURS[1])));
-    Ok(render::preview(
+    Ok(preview::render(
         &coloured,
         &contacts,
         (PREVIEW_WIDTH, PREVIEW_HEIGHT),

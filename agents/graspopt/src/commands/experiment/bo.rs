@@ -26,8 +26,8 @@ use graspopt_trial::Evaluator;
 
 use super::{argmax, evaluator, scan, touched_grid, write};
 use crate::commands::setup::Contacts;
-use crate::commands::svg;
 use crate::out::outln;
+use graspopt_pictures::chart;
 
 /// Thesis Table 4.1 (total, 5%, 10%, 20%), its rows read as shifted by one line (the text's
 /// table starts with an unnamed row and ends with an empty one).
@@ -354,7 +354,7 @@ fn one_d(dir: &Path, args: &BoArgs, engine: Engine, report: &mut String) -> Resu
             files.push(write(
                 dir,
                 &format!("fig{fig}-{object}-after-{:02}.svg", snap.trials),
-                &svg::model_plot(&svg::ModelPlot {
+                &chart::model_plot(&chart::ModelPlot {
                     title: &title,
                     xlabel: "approach offset (m)",
                     xs: &snap.grid,
@@ -471,7 +471,7 @@ fn comparison_files(
     files.push(write(
         dir,
         &format!("{stem}.svg"),
-        &svg::bands_plot(
+        &chart::bands_plot(
             title,
             "trial",
             "best score so far (mean, 1 sd band)",
@@ -606,7 +606,7 @@ fn two_d(dir: &Path, args: &BoArgs, plan: &Plan, report: &mut String) -> Result<
         let map = write(
             dir,
             &format!("fig4.18-4.24-{object}-samples.svg"),
-            &svg::samples_map(
+            &chart::samples_map(
                 &format!(
                     "BO samples on the {name} (seed {}, {shown} trials)",
                     first.seed

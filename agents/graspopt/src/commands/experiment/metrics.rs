@@ -19,8 +19,8 @@ use graspopt_trial::scan::ScanPoint;
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
 
 use super::{argmax, evaluator, scan, touched_grid, write};
-use crate::commands::svg;
 use crate::out::outln;
+use graspopt_pictures::chart;
 
 #[derive(Args, Debug)]
 pub struct MetricsArgs {
@@ -92,7 +92,7 @@ fn approach_plot<'a>(
         .iter()
         .map(|(name, _, points)| (*name, points.iter().map(|p| p.score.score).collect()))
         .collect();
-    let plot = svg::lines_plot(title, "approach offset (m)", "bw", &xs, &series);
+    let plot = chart::lines_plot(title, "approach offset (m)", "bw", &xs, &series);
     Ok((scans, write(dir, file, &plot)?))
 }
 
@@ -139,7 +139,7 @@ pub(super) fn metrics(args: &MetricsArgs) -> Result<()> {
             files.push(write(
                 dir,
                 &format!("fig{fig}-{object}-{name}.svg"),
-                &svg::line_plot(&title, "approach offset (m)", name, xs, ys),
+                &chart::line_plot(&title, "approach offset (m)", name, xs, ys),
             )?);
         }
         let fc_range = span(xs, &points, |p| {
@@ -316,7 +316,7 @@ fn map_row(
     let file = write(
         dir,
         &format!("{stem}.svg"),
-        &svg::heatmap(
+        &chart::heatmap(
             title,
             "approach offset (m)",
             "vertical offset (m)",
@@ -325,7 +325,7 @@ fn map_row(
             &z,
         ),
     )?;
-    crate::render::heatmap_figure(&z, 8, title, svg::MISSING_LABEL)
+    graspopt_pictures::preview::heatmap_figure(&z, 8, title, chart::MISSING_LABEL)
         .save_png(&dir.join(format!("{stem}.png")))?;
     let best = argmax(&points);
     let closed = points

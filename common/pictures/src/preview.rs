@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use graspopt_sim::{ContactPoint, TriangleMesh};
 use nalgebra::{Point3, Vector3};
 
-use crate::commands::svg::colour;
+use crate::chart::colour;
 
 /// Background of scene pictures.
 pub const BACKGROUND: [u8; 3] = [255, 255, 255];
@@ -323,7 +323,7 @@ pub const VIEW_LABELS: [&str; 2] = ["along the approach axis", "from the side"];
 
 /// A grasp picture (`width` x `height`): `title` at the top, the two views of
 /// [`render_grasp`] below it, each labelled (see [`VIEW_LABELS`]).
-pub fn preview(
+pub fn render(
     meshes: &[(&TriangleMesh, [u8; 3])],
     contacts: &[ContactPoint],
     (width, height): (u32, u32),
