@@ -9,7 +9,6 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
-mod export;
 mod out;
 
 #[derive(Parser, Debug)]

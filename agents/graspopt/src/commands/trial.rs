@@ -11,9 +11,9 @@ use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use serde::Serialize;
 
 use super::setup::{SimArgs, param_kind};
-use crate::export;
 use crate::out::outln;
 use graspopt_pictures::preview;
+use graspopt_scene as scene;
 
 /// Size of `--preview` pictures (two views side by side).
 pub const PREVIEW_WIDTH: u32 = 1200;
@@ -379,13 +379,13 @@ fn write_pictures(
         let (lo, hi) = ev.object.aabb();
         let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
         if has_extension(path, "gltf") {
-            export::write_gltf(path, &meshes, &contacts, normal_length)?;
+            scene::write_gltf(path, &meshes, &contacts, normal_length)?;
             written.push(path.clone());
         } else {
             // `.obj`, checked by `check_outputs`.
-            export::write_obj(path, &meshes, &contacts, normal_length)?;
+            scene::write_obj(path, &meshes, &contacts, normal_length)?;
             written.push(path.clone());
-            written.push(export::mtl_path(path));
+            written.push(scene::mtl_path(path));
         }
     }
     if let Some(path) = &args.preview {

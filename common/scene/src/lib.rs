@@ -1,4 +1,4 @@
-//! Scene export for 3D viewers: a grasp's object, hand links, contact points and contact
+//! A grasp scene for 3D viewers: a grasp's object, hand links, contact points and contact
 //! normals as a Wavefront OBJ (with an MTL of one colour per group) or a glTF 2.0 JSON file
 //! with its buffer embedded (base64).
 
