@@ -2,6 +2,7 @@
 //! Settings come from `--config FILE` (TOML, the agent's settings struct) and flags override
 //! them.
 
+use graspopt_runner::signal::shutdown_signal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -185,23 +186,6 @@ fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Op
         }
     }
     None
-}
-
-/// Resolves on Ctrl-C or SIGTERM.
-pub async fn shutdown_signal() {
-    let term = async {
-        #[cfg(unix)]
-        if let Ok(mut s) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-        {
-            s.recv().await;
-            return;
-        }
-        std::future::pending::<()>().await
-    };
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {},
-        _ = term => {},
-    }
 }
 
 async fn until_signal<F: std::future::Future<Output = Result<()>>>(agent: F) -> Result<()> {

@@ -17,9 +17,10 @@ use graspopt_bus::{Bus, BusArgs, CloudPath, CloudReceiver, CloudSender, free_loo
 use graspopt_protocol::{CloudPoint, ContactClouds, FingerCloud, Pose, RunId, RunStatus};
 use tokio::sync::watch;
 
-use super::run::{Embedded, Method, RunArgs, placeholder, run_embedded};
+use super::run::{Method, RunArgs};
 use super::setup::SimArgs;
 use crate::out::outln;
+use graspopt_runner::{Embedded, placeholder, run_embedded};
 
 /// The most hand workers of one throughput run.
 pub const MAX_WORKERS: usize = 256;
@@ -178,7 +179,7 @@ fn embedded(tag: &str, workers: usize, trials: u64, cost: u64, method: Method) -
         quiet: true,
         bus: BusArgs::default(),
     };
-    Embedded::from_args(&args)
+    super::run::embedded(&args)
 }
 
 /// Runs an embedded run and returns the instants at which each trial completed.

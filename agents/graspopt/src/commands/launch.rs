@@ -385,7 +385,7 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     let runtime = tokio::runtime::Runtime::new()?;
     let outcome = runtime.block_on(async {
         let mut poll = tokio::time::interval(Duration::from_millis(100));
-        let signal = super::agent::shutdown_signal();
+        let signal = graspopt_runner::signal::shutdown_signal();
         tokio::pin!(signal);
         loop {
             tokio::select! {

@@ -427,7 +427,7 @@ async fn dashboard(bus: &Bus, only: Option<&RunId>) -> Result<()> {
     let mut alive_runs: Vec<String> = Vec::new();
     let mut redraw = tokio::time::interval(Duration::from_millis(250));
     let mut ask = tokio::time::interval(Duration::from_secs(2));
-    let signal = super::agent::shutdown_signal();
+    let signal = graspopt_runner::signal::shutdown_signal();
     tokio::pin!(signal);
     let result = loop {
         tokio::select! {

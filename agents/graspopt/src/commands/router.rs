@@ -58,7 +58,7 @@ pub fn run(args: &RouterArgs) -> Result<ExitCode> {
         } else {
             eprintln!("graspopt router listening on {}", bus.listen.join(", "));
         }
-        super::agent::shutdown_signal().await;
+        graspopt_runner::signal::shutdown_signal().await;
         session.close().await?;
         Ok::<(), anyhow::Error>(())
     })?;

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use graspopt_bus::{Bus, BusArgs, free_loopback_port};
+use graspopt_bus::{BusArgs, free_loopback_port};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId, RunPhase, RunStatus};
 use graspopt_sim::ParamKind;
@@ -20,6 +20,7 @@ use tokio::sync::watch;
 use super::setup::{Contacts, Frame, SimArgs, param_kind};
 use crate::out::outln;
 use graspopt_pictures::chart;
+use graspopt_runner::{Embedded, placeholder, run_embedded};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
@@ -94,22 +95,6 @@ pub struct RunArgs {
     pub quiet: bool,
     #[command(flatten)]
     pub bus: BusArgs,
-}
-
-/// Everything one embedded run needs, resolved from flags.
-pub struct Embedded {
-    pub run: RunId,
-    pub spec: RunSpec,
-    pub workers: usize,
-    pub out: PathBuf,
-    pub resume: bool,
-    pub perception: graspopt_perception::PerceptionConfig,
-    pub metric: graspopt_metric::MetricConfig,
-    pub hand: graspopt_hand::HandConfig,
-    pub coordinator: CoordinatorConfig,
-    pub bus: BusArgs,
-    /// The trials as simulated here (for the pictures of the results).
-    pub evaluator: graspopt_trial::Evaluator,
 }
 
 /// The settings of an embedded run beyond its spec (the object's mesh, the scoring,
@@ -330,170 +315,108 @@ fn check_folder_is_free(out: &Path, run: &RunId) -> Result<()> {
     Ok(())
 }
 
-impl Embedded {
-    /// The run the flags describe, nothing taken as given explicitly (see
-    /// [`Embedded::from_args_with`]).
-    pub fn from_args(args: &RunArgs) -> Result<Embedded> {
-        Embedded::from_args_with(args, &|_| false)
-    }
-
-    /// The run the flags describe. With `--resume`, the run's recorded settings replace the
-    /// flags' defaults; `explicit(name)` says whether `--name` was given on the command line.
-    pub fn from_args_with(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<Embedded> {
-        let mut run = RunId::new(&args.run)?;
-        let out = args
-            .out
-            .clone()
-            .unwrap_or_else(|| Path::new("results").join(run.as_str()));
-        // `--resume --out DIR` continues the run of DIR's journal: its id need not be given.
-        if args.resume
-            && !explicit("run")
-            && let Some(only) = graspopt_coordinator::sole_run(&out.join("journal.sqlite"))?
-        {
-            run = only;
-        }
-        let resumed;
-        let args = if args.resume {
-            let named = RunArgs {
-                run: run.as_str().to_string(),
-                ..args.clone()
-            };
-            resumed = resumed_args(&named, &out, explicit)?;
-            &resumed
-        } else {
-            check_folder_is_free(&out, &run)?;
-            args
-        };
-        anyhow::ensure!(args.workers >= 1, "--workers must be at least 1");
-        anyhow::ensure!(args.trials >= 1, "--trials must be at least 1");
-        let kinds = args
-            .params
-            .iter()
-            .map(|p| param_kind(p))
-            .collect::<Result<Vec<_>>>()?;
-        let evaluator = args.sim.evaluator(&kinds)?;
-        let object_name = evaluator.object.name().to_string();
-        let mut bus = args.bus.clone();
-        if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
-            bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
-            bus.no_multicast_scouting = true;
-        }
-        if bus.shm_prefix.is_none() {
-            bus.shm_prefix = Some(graspopt_shm::run_prefix(&format!(
-                "{}_{}",
-                run.as_str(),
-                std::process::id()
-            )));
-        }
-        let perception = graspopt_perception::PerceptionConfig {
-            object: object_name.clone(),
-            mesh: args.sim.mesh.clone(),
-            mesh_scale: args.sim.mesh_scale,
-            position_noise: args.position_noise,
-            rotation_noise: args.rotation_noise,
-            seed: args.seed,
-            period_ms: 500,
-            ..Default::default()
-        };
-        // Checked before anything is written, so a refused run leaves no trace.
-        perception
-            .validate()
-            .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
-        Ok(Embedded {
-            spec: RunSpec {
-                object: object_name.clone(),
-                hand: args.sim.hand.clone(),
-                params: kinds,
-                bounds: None,
-                trials: args.trials,
-                seed: args.seed,
-                method: args.method.planner(),
-                initial: args.initial,
-                settings: Some(serde_json::to_value(EmbeddedSettings::of(args))?),
-            },
-            workers: args.workers,
-            resume: args.resume,
-            perception,
-            metric: graspopt_metric::MetricConfig {
-                score: evaluator.score,
-                contacts: evaluator.contacts,
-                ..Default::default()
-            },
-            hand: graspopt_hand::HandConfig {
-                hand: args.sim.hand.clone(),
-                trial_cost_ms: args.trial_cost_ms,
-                ..Default::default()
-            },
-            coordinator: CoordinatorConfig {
-                journal: out.join("journal.sqlite"),
-                lease_ms: args.lease_ms,
-                ..Default::default()
-            },
-            out,
-            run,
-            bus,
-            evaluator,
-        })
-    }
+/// The run the flags describe, nothing taken as given explicitly (see [`embedded_with`]).
+pub fn embedded(args: &RunArgs) -> Result<Embedded> {
+    embedded_with(args, &|_| false)
 }
 
-/// Runs every agent in this process until the coordinator finishes (or Ctrl-C stops it:
-/// the status returned is then not [`RunPhase::Finished`]).
-pub async fn run_embedded(
-    e: &Embedded,
-    progress: Option<watch::Sender<RunStatus>>,
-) -> Result<RunStatus> {
-    std::fs::create_dir_all(&e.out)
-        .with_context(|| format!("cannot create the results folder {}", e.out.display()))?;
-    let bus = Bus::open(&e.bus).await?;
-    let mut tasks = tokio::task::JoinSet::new();
+/// The run the flags describe. With `--resume`, the run's recorded settings replace the
+/// flags' defaults; `explicit(name)` says whether `--name` was given on the command line.
+pub fn embedded_with(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<Embedded> {
+    let mut run = RunId::new(&args.run)?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("results").join(run.as_str()));
+    // `--resume --out DIR` continues the run of DIR's journal: its id need not be given.
+    if args.resume
+        && !explicit("run")
+        && let Some(only) = graspopt_coordinator::sole_run(&out.join("journal.sqlite"))?
     {
-        let (b, r, c) = (bus.clone(), e.run.clone(), e.perception.clone());
-        tasks.spawn(async move { graspopt_perception::run(&b, &r, &c).await });
+        run = only;
     }
-    {
-        let (b, r) = (bus.clone(), e.run.clone());
-        tasks.spawn(async move {
-            graspopt_planner::run(&b, &r, &graspopt_planner::PlannerConfig::default()).await
-        });
-    }
-    {
-        let (b, r, c) = (bus.clone(), e.run.clone(), e.metric.clone());
-        tasks.spawn(async move { graspopt_metric::run(&b, &r, &c).await });
-    }
-    for i in 1..=e.workers {
-        let (b, r) = (bus.clone(), e.run.clone());
-        let c = graspopt_hand::HandConfig {
-            id: format!("hand-{i}"),
-            ..e.hand.clone()
+    let resumed;
+    let args = if args.resume {
+        let named = RunArgs {
+            run: run.as_str().to_string(),
+            ..args.clone()
         };
-        tasks.spawn(async move { graspopt_hand::run(&b, &r, &c).await });
-    }
-    // Ctrl-C (or SIGTERM) stops the run cleanly: the journal records it as stopped.
-    let coordinator = graspopt_coordinator::run_until(
-        &bus,
-        &e.run,
-        &e.spec,
-        &e.coordinator,
-        e.resume,
-        progress,
-        super::agent::shutdown_signal(),
-    );
-    let status = tokio::select! {
-        s = coordinator => s,
-        Some(agent) = tasks.join_next() => {
-            // An agent stopped before the run finished: that is an error.
-            match agent {
-                Ok(Ok(())) => Err(anyhow::anyhow!("an agent stopped before the run finished")),
-                Ok(Err(err)) => Err(err),
-                Err(join) => Err(anyhow::anyhow!("an agent panicked: {join}")),
-            }
-        }
+        resumed = resumed_args(&named, &out, explicit)?;
+        &resumed
+    } else {
+        check_folder_is_free(&out, &run)?;
+        args
     };
-    tasks.abort_all();
-    while tasks.join_next().await.is_some() {}
-    let _ = bus.close().await;
-    status
+    anyhow::ensure!(args.workers >= 1, "--workers must be at least 1");
+    anyhow::ensure!(args.trials >= 1, "--trials must be at least 1");
+    let kinds = args
+        .params
+        .iter()
+        .map(|p| param_kind(p))
+        .collect::<Result<Vec<_>>>()?;
+    let evaluator = args.sim.evaluator(&kinds)?;
+    let object_name = evaluator.object.name().to_string();
+    let mut bus = args.bus.clone();
+    if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
+        bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
+        bus.no_multicast_scouting = true;
+    }
+    if bus.shm_prefix.is_none() {
+        bus.shm_prefix = Some(graspopt_shm::run_prefix(&format!(
+            "{}_{}",
+            run.as_str(),
+            std::process::id()
+        )));
+    }
+    let perception = graspopt_perception::PerceptionConfig {
+        object: object_name.clone(),
+        mesh: args.sim.mesh.clone(),
+        mesh_scale: args.sim.mesh_scale,
+        position_noise: args.position_noise,
+        rotation_noise: args.rotation_noise,
+        seed: args.seed,
+        period_ms: 500,
+        ..Default::default()
+    };
+    // Checked before anything is written, so a refused run leaves no trace.
+    perception
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
+    Ok(Embedded {
+        spec: RunSpec {
+            object: object_name.clone(),
+            hand: args.sim.hand.clone(),
+            params: kinds,
+            bounds: None,
+            trials: args.trials,
+            seed: args.seed,
+            method: args.method.planner(),
+            initial: args.initial,
+            settings: Some(serde_json::to_value(EmbeddedSettings::of(args))?),
+        },
+        workers: args.workers,
+        resume: args.resume,
+        perception,
+        metric: graspopt_metric::MetricConfig {
+            score: evaluator.score,
+            contacts: evaluator.contacts,
+            ..Default::default()
+        },
+        hand: graspopt_hand::HandConfig {
+            hand: args.sim.hand.clone(),
+            trial_cost_ms: args.trial_cost_ms,
+            ..Default::default()
+        },
+        coordinator: CoordinatorConfig {
+            journal: out.join("journal.sqlite"),
+            lease_ms: args.lease_ms,
+            ..Default::default()
+        },
+        out,
+        run,
+        bus,
+        evaluator,
+    })
 }
 
 /// Writes `trials.csv`, `trials.json` and the pictures ([`write_pictures`]) from the journal.
@@ -579,7 +502,7 @@ fn write_pictures(e: &Embedded, object: &str, trials: &[graspopt_journal::TrialR
 
 /// `graspopt run`; `explicit(name)` says whether `--name` was given on the command line.
 pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> {
-    let e = Embedded::from_args_with(args, explicit)?;
+    let e = embedded_with(args, explicit)?;
     let runtime = tokio::runtime::Runtime::new()?;
     let (status_tx, mut status_rx) = watch::channel(placeholder(&e));
     let bar = if args.quiet {
@@ -667,24 +590,4 @@ pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
         .map(|(n, v)| format!("{n}={v:.5}"))
         .collect();
     parts.join(sep)
-}
-
-/// The status before the coordinator's first one.
-pub fn placeholder(e: &Embedded) -> RunStatus {
-    RunStatus {
-        run_id: e.run.clone(),
-        phase: graspopt_protocol::RunPhase::Waiting,
-        object: e.spec.object.clone(),
-        param_names: graspopt_coordinator::param_names(&e.spec),
-        budget: e.spec.trials,
-        completed: 0,
-        running: 0,
-        failed: 0,
-        best: None,
-        best_history: Vec::new(),
-        workers: Vec::new(),
-        errors: Default::default(),
-        stamp_ms: 0,
-        waiting: Vec::new(),
-    }
 }

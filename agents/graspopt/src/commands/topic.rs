@@ -465,7 +465,7 @@ async fn echo(bus: &Bus, watch: &Watch, format: Format, count: Option<u64>) -> R
     let mut seen = 0u64;
     let stop = until(end);
     tokio::pin!(stop);
-    let signal = super::agent::shutdown_signal();
+    let signal = graspopt_runner::signal::shutdown_signal();
     tokio::pin!(signal);
     while count.is_none_or(|c| seen < c) {
         let sample = tokio::select! {
@@ -534,7 +534,7 @@ async fn rate(bus: &Bus, watch: &Watch, window: usize, bandwidth: bool) -> Resul
     report.tick().await;
     let stop = until(end);
     tokio::pin!(stop);
-    let signal = super::agent::shutdown_signal();
+    let signal = graspopt_runner::signal::shutdown_signal();
     tokio::pin!(signal);
     let line = |w: &Window| -> String {
         match w.stats(start.elapsed().as_secs_f64()) {

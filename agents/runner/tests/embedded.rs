@@ -1,0 +1,81 @@
+//! An embedded run, in-process: every agent on one loopback bus, no binary spawned.
+
+use graspopt_bus::{BusArgs, free_loopback_port};
+use graspopt_coordinator::{CoordinatorConfig, RunSpec};
+use graspopt_protocol::{PlannerMethod, RunId, RunPhase};
+use graspopt_runner::{Embedded, run_embedded};
+use graspopt_sim::hand::hand_by_name;
+use graspopt_sim::{Object, ParamKind, TrialSpace};
+use graspopt_trial::Evaluator;
+
+fn mug_run(out: &std::path::Path, trials: u64) -> Embedded {
+    let object = Object::by_name("mug").unwrap();
+    let space = TrialSpace::approach_vertical_2d(&object);
+    let evaluator = Evaluator::new(object, hand_by_name("barrett").unwrap(), space);
+    let run = RunId::new("inproc").unwrap();
+    let bus = BusArgs {
+        listen: vec![format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap())],
+        no_multicast_scouting: true,
+        shm_prefix: Some(graspopt_shm::run_prefix(&format!(
+            "inproc_{}",
+            std::process::id()
+        ))),
+        ..BusArgs::default()
+    };
+    Embedded {
+        spec: RunSpec {
+            object: "mug".into(),
+            hand: "barrett".into(),
+            params: vec![ParamKind::Approach, ParamKind::Vertical],
+            bounds: None,
+            trials,
+            seed: 7,
+            method: PlannerMethod::Random,
+            initial: None,
+            settings: None,
+        },
+        workers: 2,
+        resume: false,
+        perception: graspopt_perception::PerceptionConfig {
+            object: "mug".into(),
+            period_ms: 200,
+            ..Default::default()
+        },
+        metric: graspopt_metric::MetricConfig {
+            score: evaluator.score,
+            contacts: evaluator.contacts,
+            ..Default::default()
+        },
+        hand: graspopt_hand::HandConfig {
+            hand: "barrett".into(),
+            ..Default::default()
+        },
+        coordinator: CoordinatorConfig {
+            journal: out.join("journal.sqlite"),
+            ..Default::default()
+        },
+        out: out.to_path_buf(),
+        run,
+        bus,
+        evaluator,
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_embedded_run_records_every_trial_in_its_journal() {
+    let dir = tempfile::tempdir().unwrap();
+    let e = mug_run(dir.path(), 6);
+    let status = run_embedded(&e, None).await.unwrap();
+    assert_eq!(status.phase, RunPhase::Finished, "{status:?}");
+    assert_eq!((status.completed, status.failed), (6, 0));
+    let journal = graspopt_journal::Journal::open(&e.coordinator.journal).unwrap();
+    let trials = journal.export("inproc").unwrap().trials;
+    assert_eq!(trials.len(), 6);
+    // Every trial was scored, and the status's best is the journal's best.
+    let best = trials
+        .iter()
+        .filter_map(|t| t.score)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(trials.iter().filter(|t| t.score.is_some()).count(), 6);
+    assert_eq!(status.best.map(|b| b.score), Some(best));
+}
