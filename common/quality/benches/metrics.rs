@@ -8,10 +8,10 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use graspopt_quality::metrics::{MetricsOptions, evaluate};
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel};
+use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel};
 use nalgebra::Vector3;
 
-const SOFT: ContactModel = ContactModel::SoftFinger {
+const SOFT: FrictionModel = FrictionModel::SoftFinger {
     mu: 0.5,
     edges: 8,
     gamma: 0.05,

@@ -111,14 +111,15 @@ fn check_range(
     }
 }
 
-/// A contact model (thesis section 2.2). The friction cone is sampled on its boundary
+/// A friction model: what one contact transmits (thesis section 2.2: frictionless, point
+/// contact with friction, soft finger; the thesis calls these contact models). The friction cone is sampled on its boundary
 /// with `edges` generators `f_j = n + mu (cos th_j t1 + sin th_j t2)`, `th_j = 2 pi j / edges`.
 ///
 /// Parameter ranges (see [`crate::limits`]): `0 <= mu <= 1e6` ([`MAX_MU`]),
 /// `3 <= edges <= 4096` ([`MAX_EDGES`]), `0 <= gamma <= 1e12` ([`MAX_COORDINATE`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "snake_case")]
-pub enum ContactModel {
+pub enum FrictionModel {
     /// Frictionless point contact: one wrench `(n, r x n / rho)`.
     Frictionless,
     /// Point contact with Coulomb friction `mu`: `edges` wrenches `(f_j, r x f_j / rho)`.
@@ -128,14 +129,14 @@ pub enum ContactModel {
     SoftFinger { mu: f64, edges: usize, gamma: f64 },
 }
 
-impl ContactModel {
+impl FrictionModel {
     /// The number of wrenches one contact produces (saturating: an unvalidated edge
     /// count cannot overflow it).
     pub fn wrenches_per_contact(&self) -> usize {
         match *self {
-            ContactModel::Frictionless => 1,
-            ContactModel::PointFriction { edges, .. } => edges,
-            ContactModel::SoftFinger { edges, .. } => edges.saturating_mul(2),
+            FrictionModel::Frictionless => 1,
+            FrictionModel::PointFriction { edges, .. } => edges,
+            FrictionModel::SoftFinger { edges, .. } => edges.saturating_mul(2),
         }
     }
 
@@ -165,12 +166,12 @@ impl ContactModel {
             }
         };
         match *self {
-            ContactModel::Frictionless => Ok(()),
-            ContactModel::PointFriction { mu, edges } => {
+            FrictionModel::Frictionless => Ok(()),
+            FrictionModel::PointFriction { mu, edges } => {
                 check_mu(mu)?;
                 check_edges(edges)
             }
-            ContactModel::SoftFinger { mu, edges, gamma } => {
+            FrictionModel::SoftFinger { mu, edges, gamma } => {
                 check_mu(mu)?;
                 check_edges(edges)?;
                 if (0.0..=MAX_COORDINATE).contains(&gamma) {
@@ -191,14 +192,14 @@ impl ContactModel {
 /// point about which torques are taken, and the torque scale `rho > 0`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GraspModel {
-    pub contact: ContactModel,
+    pub contact: FrictionModel,
     pub reference_point: Vector3<f64>,
     pub torque_scale: f64,
 }
 
 impl GraspModel {
     /// A model with the reference point at the origin and `rho = 1`.
-    pub fn new(contact: ContactModel) -> Self {
+    pub fn new(contact: FrictionModel) -> Self {
         Self {
             contact,
             reference_point: Vector3::zeros(),
@@ -255,11 +256,11 @@ impl GraspModel {
             })
         };
         match self.contact {
-            ContactModel::Frictionless => out.push(wrench(&n, &(r.cross(&n) * inv_rho))),
-            ContactModel::PointFriction { mu, edges } => {
+            FrictionModel::Frictionless => out.push(wrench(&n, &(r.cross(&n) * inv_rho))),
+            FrictionModel::PointFriction { mu, edges } => {
                 out.extend(cone(mu, edges).map(|f| wrench(&f, &(r.cross(&f) * inv_rho))));
             }
-            ContactModel::SoftFinger { mu, edges, gamma } => {
+            FrictionModel::SoftFinger { mu, edges, gamma } => {
                 for f in cone(mu, edges) {
                     let t = r.cross(&f);
                     out.push(wrench(&f, &((t + n * gamma) * inv_rho)));
@@ -291,7 +292,7 @@ mod tests {
 
     #[test]
     fn soft_finger_wrenches_have_unit_normal_force_and_torsion() {
-        let model = GraspModel::new(ContactModel::SoftFinger {
+        let model = GraspModel::new(FrictionModel::SoftFinger {
             mu: 0.5,
             edges: 8,
             gamma: 0.2,
@@ -312,9 +313,9 @@ mod tests {
     #[test]
     fn invalid_parameters_are_named() {
         let bad = [
-            ContactModel::PointFriction { mu: -0.1, edges: 8 },
-            ContactModel::PointFriction { mu: 0.5, edges: 2 },
-            ContactModel::SoftFinger {
+            FrictionModel::PointFriction { mu: -0.1, edges: 8 },
+            FrictionModel::PointFriction { mu: 0.5, edges: 2 },
+            FrictionModel::SoftFinger {
                 mu: 0.5,
                 edges: 8,
                 gamma: f64::NAN,
@@ -328,7 +329,7 @@ mod tests {
             })
             .collect();
         assert_eq!(names, ["mu", "edges", "gamma"]);
-        let rho = GraspModel::new(ContactModel::Frictionless).with_torque_scale(0.0);
+        let rho = GraspModel::new(FrictionModel::Frictionless).with_torque_scale(0.0);
         assert!(matches!(
             rho.validate(),
             Err(QualityError::Parameter {

@@ -125,12 +125,12 @@ fn first_out_of_range(wrenches: &[Wrench]) -> Option<(usize, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::ContactModel;
+    use crate::contact::FrictionModel;
     use nalgebra::Vector3;
 
     #[test]
     fn one_frictionless_contact_gives_its_normal_and_moment() {
-        let model = GraspModel::new(ContactModel::Frictionless);
+        let model = GraspModel::new(FrictionModel::Frictionless);
         let c = Contact::new(Vector3::new(0.0, 1.0, 0.0), Vector3::x());
         let g = GraspMap::from_contacts(&[c], &model).unwrap();
         assert_eq!(g.wrenches().len(), 1);
@@ -141,7 +141,7 @@ mod tests {
 
     #[test]
     fn errors_name_the_bad_contact() {
-        let model = GraspModel::new(ContactModel::Frictionless);
+        let model = GraspModel::new(FrictionModel::Frictionless);
         let good = Contact::new(Vector3::zeros(), Vector3::z());
         let bad = Contact::new(Vector3::zeros(), Vector3::zeros());
         assert_eq!(

@@ -28,7 +28,7 @@ pub mod metrics;
 pub mod wrench;
 
 pub use cloud::{MeanContact, mean_contact};
-pub use contact::{Contact, ContactModel, GraspModel};
+pub use contact::{Contact, FrictionModel, GraspModel};
 pub use error::QualityError;
 pub use grasp_map::GraspMap;
 pub use metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};

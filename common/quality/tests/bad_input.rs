@@ -4,7 +4,7 @@ use graspopt_quality::limits::{MAX_COORDINATE, MAX_EDGES, MAX_MU, MAX_WRENCHES};
 use graspopt_quality::metrics::{
     DistanceSolver, MetricsOptions, distance_to_hull, evaluate_contacts, evaluate_wrenches,
 };
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, QualityError, Wrench};
+use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, QualityError, Wrench};
 use nalgebra::Vector3;
 
 mod support;
@@ -14,7 +14,7 @@ fn sphere_grasp() -> Vec<Contact> {
 }
 
 fn model() -> GraspModel {
-    GraspModel::new(ContactModel::PointFriction { mu: 0.5, edges: 8 })
+    GraspModel::new(FrictionModel::PointFriction { mu: 0.5, edges: 8 })
 }
 
 fn eval(contacts: &[Contact], model: &GraspModel) -> Result<f64, QualityError> {
@@ -82,15 +82,15 @@ fn bad_normals_are_named() {
 fn bad_parameters_are_named() {
     let cases = [
         (
-            GraspModel::new(ContactModel::PointFriction { mu: -0.1, edges: 8 }),
+            GraspModel::new(FrictionModel::PointFriction { mu: -0.1, edges: 8 }),
             "mu",
         ),
         (
-            GraspModel::new(ContactModel::PointFriction { mu: 0.5, edges: 2 }),
+            GraspModel::new(FrictionModel::PointFriction { mu: 0.5, edges: 2 }),
             "edges",
         ),
         (
-            GraspModel::new(ContactModel::SoftFinger {
+            GraspModel::new(FrictionModel::SoftFinger {
                 mu: 0.5,
                 edges: 8,
                 gamma: -1.0,
@@ -138,7 +138,7 @@ fn duplicated_points_give_the_same_result() {
     assert_eq!(m.rank, 2);
     assert!(!m.force_closure && m.bw < 0.0);
     // Zero friction: every cone edge is the normal; still defined.
-    let frictionless_cone = GraspModel::new(ContactModel::PointFriction { mu: 0.0, edges: 8 });
+    let frictionless_cone = GraspModel::new(FrictionModel::PointFriction { mu: 0.0, edges: 8 });
     let m = evaluate_contacts(&g, &frictionless_cone, &MetricsOptions::default()).unwrap();
     assert!(!m.force_closure && m.rank < 6);
 }
@@ -148,8 +148,8 @@ fn edge_counts_are_bounded_before_anything_is_allocated() {
     // 3 contacts x 2^40 edges: the old code asked for 158 TB and aborted.
     for edges in [1usize << 40, MAX_EDGES + 1, usize::MAX] {
         for contact in [
-            ContactModel::PointFriction { mu: 0.5, edges },
-            ContactModel::SoftFinger {
+            FrictionModel::PointFriction { mu: 0.5, edges },
+            FrictionModel::SoftFinger {
                 mu: 0.5,
                 edges,
                 gamma: 0.1,
@@ -167,7 +167,7 @@ fn edge_counts_are_bounded_before_anything_is_allocated() {
     }
     assert_eq!(MAX_EDGES, 4096);
     // The limit itself is accepted: one contact on the unit sphere is at distance 1.
-    let fine = GraspModel::new(ContactModel::PointFriction {
+    let fine = GraspModel::new(FrictionModel::PointFriction {
         mu: 0.5,
         edges: MAX_EDGES,
     });
@@ -181,7 +181,7 @@ fn edge_counts_are_bounded_before_anything_is_allocated() {
 #[test]
 fn wrench_counts_are_bounded() {
     // 250 contacts x 2 x 4096 soft-finger wrenches = 2,048,000 > 2,000,000.
-    let model = GraspModel::new(ContactModel::SoftFinger {
+    let model = GraspModel::new(FrictionModel::SoftFinger {
         mu: 0.5,
         edges: MAX_EDGES,
         gamma: 0.1,
@@ -217,7 +217,7 @@ fn wrench_counts_are_bounded() {
 #[test]
 fn huge_magnitudes_are_named_errors_not_null_metrics() {
     // mu = 1e308 used to give NaN distance and bw (printed as null) with min-norm.
-    let huge_mu = GraspModel::new(ContactModel::PointFriction {
+    let huge_mu = GraspModel::new(FrictionModel::PointFriction {
         mu: 1e308,
         edges: 8,
     });
@@ -237,7 +237,7 @@ fn huge_magnitudes_are_named_errors_not_null_metrics() {
         );
     }
     let soft = |gamma| {
-        GraspModel::new(ContactModel::SoftFinger {
+        GraspModel::new(FrictionModel::SoftFinger {
             mu: 0.5,
             edges: 8,
             gamma,
@@ -248,7 +248,7 @@ fn huge_magnitudes_are_named_errors_not_null_metrics() {
         other => panic!("{other:?}"),
     };
     assert_eq!(named(&soft(1e300)), "gamma");
-    let over_mu = GraspModel::new(ContactModel::PointFriction {
+    let over_mu = GraspModel::new(FrictionModel::PointFriction {
         mu: MAX_MU * 2.0,
         edges: 8,
     });
@@ -356,7 +356,7 @@ fn bw_is_a_positive_zero_on_the_boundary() {
         Contact::new(Vector3::x(), -Vector3::x()),
         Contact::new(-Vector3::x(), Vector3::x()),
     ];
-    let m = GraspModel::new(ContactModel::Frictionless);
+    let m = GraspModel::new(FrictionModel::Frictionless);
     for solver in [DistanceSolver::MinNorm, DistanceSolver::Clarabel] {
         let options = MetricsOptions {
             volume: true,
@@ -375,7 +375,7 @@ fn hulls_too_large_for_memory_are_refused() {
     // 3 contacts x 256 cone edges: the full hull (volume) needs more than 5 million
     // facets; the old code built it in 2 GB (at 1,024 edges it used 24 GB and was
     // killed). The inscribed radius alone (expanding polytope) stays cheap.
-    let dense = GraspModel::new(ContactModel::PointFriction {
+    let dense = GraspModel::new(FrictionModel::PointFriction {
         mu: 0.5,
         edges: 256,
     });

@@ -1,13 +1,13 @@
 //! The known values of `docs/metric-conventions.md`.
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts, evaluate_wrenches};
-use graspopt_quality::{Contact, ContactModel, GraspModel, Wrench};
+use graspopt_quality::{Contact, FrictionModel, GraspModel, Wrench};
 mod support;
 
 use support::equator;
 
 fn friction(mu: f64) -> GraspModel {
-    GraspModel::new(ContactModel::PointFriction { mu, edges: 8 })
+    GraspModel::new(FrictionModel::PointFriction { mu, edges: 8 })
 }
 
 fn metrics(contacts: &[Contact], model: GraspModel) -> Metrics {
@@ -42,7 +42,7 @@ fn two_antipodal_contacts() {
     assert_eq!(m.epsilon, 0.0);
     assert_eq!(m.volume, Some(0.0));
     assert!(m.bw.abs() < 1e-12 && m.bw <= 0.0);
-    let soft = GraspModel::new(ContactModel::SoftFinger {
+    let soft = GraspModel::new(FrictionModel::SoftFinger {
         mu: 0.5,
         edges: 8,
         gamma: 0.2,

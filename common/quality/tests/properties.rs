@@ -2,7 +2,7 @@
 //! continuity across the force-closure boundary.
 
 use graspopt_quality::metrics::{MetricsOptions, evaluate_contacts, evaluate_wrenches};
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, Wrench};
+use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, Wrench};
 use nalgebra::{Rotation3, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,7 +32,7 @@ fn box_grasp() -> Vec<Contact> {
 fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
     let contacts = box_grasp();
     let c = Vector3::new(0.1, -0.2, 0.05);
-    let model = GraspModel::new(ContactModel::Frictionless)
+    let model = GraspModel::new(FrictionModel::Frictionless)
         .with_reference_point(c)
         .with_torque_scale(1.3);
     let base = evaluate_contacts(&contacts, &model, &MetricsOptions::default()).unwrap();
@@ -59,7 +59,7 @@ fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
         assert!((v - v0).abs() < 1e-9 * v0, "{v} vs {v0}");
     }
     // Soft-finger wrench sets rotated in wrench space (R acting on force and torque).
-    let soft = GraspModel::new(ContactModel::SoftFinger {
+    let soft = GraspModel::new(FrictionModel::SoftFinger {
         mu: 0.4,
         edges: 6,
         gamma: 0.1,
@@ -84,7 +84,7 @@ fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
 #[test]
 fn bw_sign_agrees_with_force_closure() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let model = GraspModel::new(ContactModel::SoftFinger {
+    let model = GraspModel::new(FrictionModel::SoftFinger {
         mu: 0.5,
         edges: 6,
         gamma: 0.05,
@@ -120,7 +120,7 @@ fn bw_sign_agrees_with_force_closure() {
 /// equator grasp slides towards the second, and force closure is lost on the way.
 #[test]
 fn bw_is_continuous_across_the_force_closure_boundary() {
-    let model = GraspModel::new(ContactModel::PointFriction { mu: 0.3, edges: 8 });
+    let model = GraspModel::new(FrictionModel::PointFriction { mu: 0.3, edges: 8 });
     let at = |deg: f64| {
         let (s, c) = deg.to_radians().sin_cos();
         let p = Vector3::new(c, s, 0.0);

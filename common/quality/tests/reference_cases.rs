@@ -5,7 +5,7 @@
 
 use graspopt_quality::hull::{epa, quickhull};
 use graspopt_quality::metrics::{DistanceSolver, MetricsOptions, distance_to_hull, evaluate};
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, Wrench};
+use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, Wrench};
 use nalgebra::Vector3;
 use serde_json::Value;
 
@@ -33,9 +33,9 @@ fn model(params: &Value) -> GraspModel {
     let edges = params["edges"].as_u64().unwrap() as usize;
     let gamma = params["gamma"].as_f64().unwrap();
     let contact = match params["model"].as_str().unwrap() {
-        "frictionless" => ContactModel::Frictionless,
-        "point_friction" => ContactModel::PointFriction { mu, edges },
-        "soft_finger" => ContactModel::SoftFinger { mu, edges, gamma },
+        "frictionless" => FrictionModel::Frictionless,
+        "point_friction" => FrictionModel::PointFriction { mu, edges },
+        "soft_finger" => FrictionModel::SoftFinger { mu, edges, gamma },
         other => panic!("unknown model {other}"),
     };
     GraspModel::new(contact)

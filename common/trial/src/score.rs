@@ -13,7 +13,7 @@
 //! it. For epsilon and volume, which are 0 without force closure, it scores 0.
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts};
-use graspopt_quality::{Contact, ContactModel as QualityModel, GraspModel};
+use graspopt_quality::{Contact, FrictionModel, GraspModel};
 use graspopt_sim::{ContactModel, Object, TrialOutcome};
 use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
@@ -68,7 +68,7 @@ pub struct ScoreSettings {
     /// Which of the simulator's contact models supplies the contacts.
     pub contacts: ContactModel,
     /// The contact model of each contact point (soft finger by default, as in the thesis).
-    pub model: QualityModel,
+    pub model: FrictionModel,
     pub frame: ReferenceFrame,
     /// Torque scale in metres; `None`: the object's bounding radius.
     pub torque_scale: Option<f64>,
@@ -81,7 +81,7 @@ impl Default for ScoreSettings {
     fn default() -> Self {
         Self {
             contacts: ContactModel::Surface,
-            model: QualityModel::SoftFinger {
+            model: FrictionModel::SoftFinger {
                 mu: 0.5,
                 edges: 8,
                 gamma: 0.005,
@@ -207,9 +207,9 @@ pub fn wrench_norm_bound(object: &Object, model: &GraspModel) -> f64 {
     let reach = (centre.coords - model.reference_point).norm() + radius;
     let rho = model.torque_scale;
     let (mu, gamma) = match model.contact {
-        QualityModel::Frictionless => (0.0, 0.0),
-        QualityModel::PointFriction { mu, .. } => (mu, 0.0),
-        QualityModel::SoftFinger { mu, gamma, .. } => (mu, gamma),
+        FrictionModel::Frictionless => (0.0, 0.0),
+        FrictionModel::PointFriction { mu, .. } => (mu, 0.0),
+        FrictionModel::SoftFinger { mu, gamma, .. } => (mu, gamma),
     };
     let force = (1.0 + mu * mu).sqrt();
     force * (1.0 + (reach / rho).powi(2)).sqrt() + gamma / rho

@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use graspopt_quality::metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
-use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, QualityError, Wrench};
+use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, QualityError, Wrench};
 use nalgebra::Vector3;
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -318,12 +318,12 @@ fn parse_params(params: &Value) -> Result<GraspModel> {
         usize::try_from(n).context("params.edges: too large")
     };
     let contact = match model {
-        "frictionless" => ContactModel::Frictionless,
-        "point_friction" => ContactModel::PointFriction {
+        "frictionless" => FrictionModel::Frictionless,
+        "point_friction" => FrictionModel::PointFriction {
             mu: number("mu")?,
             edges: edges()?,
         },
-        "soft_finger" => ContactModel::SoftFinger {
+        "soft_finger" => FrictionModel::SoftFinger {
             mu: number("mu")?,
             edges: edges()?,
             gamma: number("gamma")?,
