@@ -14,8 +14,9 @@ use anyhow::Context;
 use graspopt_bus::{Bus, now_ms};
 use graspopt_protocol::{AgentKind, Encoding, ObjectEstimate, RunId};
 use graspopt_sim::Object;
+use graspopt_sim::noise::gaussian;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -78,12 +79,6 @@ pub fn scene_object(config: &PerceptionConfig) -> anyhow::Result<Object> {
             .with_context(|| format!("perception: cannot load mesh {}", path.display())),
         None => Object::by_name(&config.object).context("perception"),
     }
-}
-
-fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// The noisy pose estimate of `truth`: the same for the same seed.

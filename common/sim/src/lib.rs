@@ -35,6 +35,7 @@ mod convert;
 pub mod error;
 pub mod hand;
 pub mod mesh;
+pub mod noise;
 pub mod object;
 pub mod pose;
 pub mod scene;

@@ -20,11 +20,12 @@
 //! Raw clouds (contact regions) are computed in `region.rs` (and `cuboid.rs` for box links).
 
 use nalgebra::{Point3, Vector3};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::convert::{g2p, g2v, p2g, v2g};
 use crate::error::{Result, SimError, ensure_finite};
+use crate::noise::gaussian;
 use crate::object::Object;
 
 /// Default radius `r` of the circular patch and of the surface model (metres).
@@ -336,13 +337,6 @@ pub fn model_contacts(
         ContactModel::CircularPatch => circular_patch(cloud, settings),
         ContactModel::Surface => surface_model(cloud, object, settings),
     }
-}
-
-/// One standard normal sample (Box-Muller).
-fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>(); // (0, 1]
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// Adds Gaussian noise to positions and normals (normals stay unit). `stream` separates the
