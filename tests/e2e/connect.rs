@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use graspopt_e2e::{Proc, free_port, graspopt_bin, log, tempdir, wait_for_port, wait_until};
+use crate::support::{Proc, free_port, graspopt_bin, log, tempdir, wait_for_port, wait_until};
 
 /// Starts `graspopt args...` as a user would: no `RUST_LOG`, stderr to `<logs>/<name>.log`.
 fn start_plain(name: &str, args: &[&str], logs: &Path) -> Proc {

@@ -2,8 +2,7 @@
 //! the trials on the parameter space (`trials.svg`) and the scores (`best.svg`), where trials
 //! that touched nothing are grey and never set a scale.
 
-mod support;
-use support::{decode_png, graspopt, tempdir};
+use crate::support::{decode_png, graspopt, tempdir};
 
 /// The grey of grasps that touched nothing.
 const GREY: &str = "rgb(128,128,128)";

@@ -6,8 +6,7 @@ use graspopt_sim::scene::scene_meshes;
 use graspopt_sim::{ContactModel, Object, TrialOutcome};
 use serde_json::Value;
 
-mod support;
-use support::{graspopt, tempdir};
+use crate::support::{graspopt, tempdir};
 
 /// Runs a sphere trial with JSON output and `extra` flags; returns the outcome.
 fn sphere_trial(extra: &[&str]) -> TrialOutcome {

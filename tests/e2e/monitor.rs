@@ -6,7 +6,7 @@ use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use graspopt_e2e::{free_port, graspopt, graspopt_bin, long_run, tempdir};
+use crate::support::{free_port, graspopt, graspopt_bin, long_run, tempdir};
 use graspopt_journal::Journal;
 
 const ROWS: u16 = 32;

@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use graspopt_e2e::{free_port, graspopt, long_run, tempdir};
+use crate::support::{free_port, graspopt, long_run, tempdir};
 use graspopt_journal::Journal;
 
 fn topic(endpoint: &str, args: &[&str]) -> String {

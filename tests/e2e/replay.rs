@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use graspopt_e2e::{Cluster, Proc, check_journal, graspopt};
+use crate::support::{Cluster, Proc, check_journal, graspopt, repo_root};
 
 const TRIALS: usize = 10;
 
@@ -117,7 +117,7 @@ fn replay_hand_answers_trials_from_a_recording() {
 fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
     let python = std::env::var("GRASPOPT_PYTHON")
         .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/python/hand_agent.py");
+    let script = repo_root().join("examples/python/hand_agent.py");
     let log = std::fs::File::create(c.dir.join(format!("{name}.log"))).unwrap();
     let child = std::process::Command::new(python)
         .arg(&script)
@@ -141,7 +141,7 @@ fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
 }
 
 /// Needs Python with eclipse-zenoh: `.ci/run` makes a venv and runs this with
-/// `GRASPOPT_PYTHON` set (`cargo test --workspace --test replay -- --ignored`).
+/// `GRASPOPT_PYTHON` set (`cargo test -p graspopt --test e2e -- --ignored replay::`).
 #[test]
 #[ignore = "needs Python with eclipse-zenoh (GRASPOPT_PYTHON); .ci/run runs it"]
 fn python_hand_agent_is_the_only_worker_of_an_optimization() {

@@ -4,15 +4,16 @@
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use graspopt_e2e::{
-    check_journal, completed_now, free_port, graspopt_bin, journal_best, tempdir, wait_until,
+use crate::support::{
+    check_journal, completed_now, free_port, graspopt_bin, journal_best, repo_root, tempdir,
+    wait_until,
 };
 use graspopt_journal::{Journal, RunStatus, TrialState};
 
 #[test]
 fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
     let dir = tempdir("launch");
-    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../deploy/local.toml");
+    let file = repo_root().join("deploy/local.toml");
     let port = free_port();
     let out = Command::new(graspopt_bin())
         .current_dir(&dir)

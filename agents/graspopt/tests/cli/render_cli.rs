@@ -1,7 +1,6 @@
 //! `graspopt trial --preview FILE.png`: a two-view picture of the grasp.
 
-mod support;
-use support::{decode_png as decode, graspopt, tempdir};
+use crate::support::{decode_png as decode, graspopt, tempdir};
 
 /// The contact dots' colour (`render::CONTACT_COLOUR`).
 const DOT: [u8; 3] = [230, 20, 20];

@@ -1,7 +1,6 @@
-//! End-to-end tests live in `tests/tests/`; this library holds what they share: finding the
-//! `graspopt` binary, scratch folders, free loopback ports, child processes that are killed
-//! when the test ends (pass or fail), a router with agents around it, and checks of a
-//! finished run's journal.
+//! What the end-to-end tests share: the `graspopt` binary of this build, scratch folders,
+//! free loopback ports, child processes that are killed when the test ends (pass or fail), a
+//! router with agents around it, and checks of a finished run's journal.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
@@ -10,28 +9,18 @@ use std::time::{Duration, Instant};
 
 /// The repository's root folder.
 pub fn repo_root() -> PathBuf {
+    // These tests belong to the package in agents/graspopt.
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
-        .expect("tests/ is inside the repository")
+        .and_then(Path::parent)
+        .expect("agents/graspopt is two levels inside the repository")
         .to_path_buf()
 }
 
-/// The `graspopt` binary of this build (`cargo test --workspace` builds it before any test
-/// runs; `cargo build -p graspopt` does too).
+/// The `graspopt` binary of this very build: cargo builds it before it builds the tests of
+/// its package, so a test never runs a stale binary.
 pub fn graspopt_bin() -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable path");
-    // target/<profile>/deps/<test> -> target/<profile>/graspopt
-    let dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target directory");
-    let bin = dir.join(format!("graspopt{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        bin.exists(),
-        "{} not found: build it first (cargo build -p graspopt; cargo test --workspace does)",
-        bin.display()
-    );
-    bin
+    PathBuf::from(env!("CARGO_BIN_EXE_graspopt"))
 }
 
 /// Runs `graspopt` to completion.

@@ -2,9 +2,8 @@
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts, evaluate_wrenches};
 use graspopt_quality::{Contact, ContactModel, GraspModel, Wrench};
-mod support;
 
-use support::equator;
+use crate::support::equator;
 
 fn friction(mu: f64) -> GraspModel {
     GraspModel::new(ContactModel::PointFriction { mu, edges: 8 })

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use graspopt_e2e::{
+use crate::support::{
     Cluster, check_journal, cloud_transport, col, graspopt, journal_best, read_csv, tempdir,
 };
 

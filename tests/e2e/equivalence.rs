@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use graspopt_e2e::{Cluster, check_journal, cloud_transport, graspopt, tempdir};
+use crate::support::{Cluster, check_journal, cloud_transport, graspopt, tempdir};
 use graspopt_journal::TrialRow;
 
 const TRIALS: usize = 8;

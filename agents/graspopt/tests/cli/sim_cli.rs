@@ -2,8 +2,7 @@
 
 use serde_json::Value;
 
-mod support;
-use support::{decode_png, graspopt, tempdir};
+use crate::support::{decode_png, graspopt, tempdir};
 
 #[test]
 fn trial_prints_contacts_and_metrics() {

@@ -5,8 +5,7 @@ use std::process::Output;
 
 use serde_json::Value;
 
-mod support;
-use support::{graspopt, tempdir};
+use crate::support::{graspopt, tempdir};
 
 fn reference_file() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/metric-cases.json")

@@ -7,7 +7,7 @@ use graspopt_quality::metrics::{
 use graspopt_quality::{Contact, ContactModel, GraspMap, GraspModel, QualityError, Wrench};
 use nalgebra::Vector3;
 
-mod support;
+use crate::support;
 
 fn sphere_grasp() -> Vec<Contact> {
     support::equator(&[0.0, 120.0, 240.0])

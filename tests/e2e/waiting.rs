@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use graspopt_e2e::{Cluster, graspopt, wait_until};
+use crate::support::{Cluster, graspopt, wait_until};
 
 #[test]
 fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {

@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use graspopt_e2e::{
+use crate::support::{
     Cluster, Proc, check_journal, completed_now, graspopt, signal, tempdir, wait_until,
 };
 use graspopt_journal::{Journal, RunStatus, TrialState};

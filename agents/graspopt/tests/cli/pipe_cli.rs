@@ -1,9 +1,8 @@
 //! A command whose reader goes away (`graspopt trial ... | head -1`) ends quietly with
 //! status 0: no panic, no "Broken pipe" message.
 
-mod support;
+use crate::support::tempdir;
 use std::process::{Command, Stdio};
-use support::tempdir;
 
 /// Runs `graspopt args` with its stdout a pipe whose reading end is already closed, so its
 /// first write fails as if `head -1` had gone away. Returns the status and stderr.

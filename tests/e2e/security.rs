@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use crate::support::{Cluster, check_journal, cloud_transport, repo_root, report};
 use graspopt_bus::Bus;
-use graspopt_e2e::{Cluster, check_journal, cloud_transport, repo_root, report};
 use graspopt_protocol::{AgentKind, Encoding, RunId, TrialResult};
 use serde_json::json;
 
