@@ -7,7 +7,8 @@
 //! 2 full refits) whose per-round medians are printed, and a batch round of four points with
 //! qEI and with the kriging believer. Run with
 //! `taskset -c 0 cargo bench -p graspopt-bayesopt --bench overhead`; the same sequence, once,
-//! is printed by `cargo run --release --example overhead_suggest`.
+//! is printed by `cargo run --release -p graspopt-bayesopt --features tools --example
+//! overhead_suggest`.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};

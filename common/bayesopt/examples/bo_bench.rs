@@ -1,7 +1,7 @@
-//! Measurement runner: `cargo run --release --example bo_bench -- FUNCTION SEEDS BUDGET INIT Q
-//! [XI|thesis] [THREADS]`. Prints evaluations (and rounds) to regret 5%, 1%, 0.1% per seed and
-//! a summary. XI is a fixed xi on standardised outputs (default 0) or `thesis`
-//! (sigma_f^2 / 100).
+//! Measurement runner: `cargo run --release -p graspopt-bayesopt --features tools --example
+//! bo_bench -- FUNCTION SEEDS BUDGET INIT Q [XI|thesis] [THREADS]`. Prints evaluations (and
+//! rounds) to regret 5%, 1%, 0.1% per seed and a summary. XI is a fixed xi on standardised
+//! outputs (default 0) or `thesis` (sigma_f^2 / 100).
 
 use std::time::Instant;
 

@@ -1,7 +1,8 @@
 //! Planner overhead per proposal at about 100 observations in 6D (Hartmann6, recommended
 //! settings): 100 random observations, then 20 consecutive rounds of `suggest(1)` + `observe`
 //! (all kinds of rounds: plain, diversification, full refit). Prints each round's time and the
-//! median. Run on one core: `taskset -c 0 cargo run --release --example overhead_suggest`.
+//! median. Run on one core: `taskset -c 0 cargo run --release -p graspopt-bayesopt --features
+//! tools --example overhead_suggest`.
 
 use std::time::Instant;
 

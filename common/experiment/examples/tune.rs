@@ -2,7 +2,7 @@
 //! median trials to within 5% of the grid maximum (67 x 33 grid) over seeds. This is how the
 //! `grasp` engine was chosen (docs/benchmarks.md).
 //!
-//! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --example tune -- SEEDS BUDGET VARIANT...`
+//! `[OBJECTS=a,b] [SEED0=n] cargo run --release -p graspopt-experiment --features tools --example tune -- SEEDS BUDGET VARIANT...`
 //! with variants `random`, `thesis`, `benchmark`, `grasp` and `grasp-` followed by one change:
 //! `rank`, `xi0`, `init3`, `init8`, `m52`, `pm` (pessimistic prior mean), `m52-pm`, `noise`
 //! (noise prior 100x larger), `ls01` (length-scale prior 0.1), `ucb`, `explore`, `restart`,

@@ -7,7 +7,7 @@
 //! sent: the numbers include its wake-up, as for sparse traffic.
 //!
 //! ```text
-//! cargo run --release -p graspopt-shm --example latency -- [messages] [bytes] [gap_us]
+//! cargo run --release -p graspopt-shm --features tools --example latency -- [messages] [bytes] [gap_us]
 //! ```
 //! Defaults: 1000 messages of 480000 bytes (10,000 points x 48 bytes), 1000 µs gap.
 

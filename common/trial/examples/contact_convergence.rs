@@ -1,12 +1,12 @@
 //! How much the contact computation's one setting (`CloudSettings::resolution`) moves the
 //! scores, and how often force closure flips along the star prism's approach axis.
 //!
-//! `cargo run --release -p graspopt-trial --example contact_convergence -- convergence [R]`:
+//! `cargo run --release -p graspopt-trial --features tools --example contact_convergence -- convergence [R]`:
 //! for each of the seven objects, the 67 x 33 approach-vertical grid (Barrett hand, default
 //! scoring) at resolution `R` (default: the default resolution) and at `R / 2`, then the 95th
 //! percentile and the maximum of `|BW(R) - BW(R/2)| / |BW(R/2)|` over the grid.
 //!
-//! `cargo run --release -p graspopt-trial --example contact_convergence -- flips [N] [R]`: the
+//! `cargo run --release -p graspopt-trial --features tools --example contact_convergence -- flips [N] [R]`: the
 //! star prism's approach scan of `N` points (default 721) at resolution `R`: how many times
 //! force closure changes from one point to the next.
 

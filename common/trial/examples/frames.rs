@@ -2,7 +2,7 @@
 //! scan lies when torques are taken about the object's centre, the world origin, or the palm
 //! at the reference pose (fixed for the scan), with the torque scale fixed at 0.05 m.
 //!
-//! `cargo run --release -p graspopt-trial --example frames -- [N1] [NX NY]`: for each object,
+//! `cargo run --release -p graspopt-trial --features tools --example frames -- [N1] [NX NY]`: for each object,
 //! the 1D approach scan of `N1` points (default 61) and the 2D approach x vertical scan of
 //! `NX x NY` points (default 15 x 15), default bounds, Barrett hand, default scoring. Prints
 //! the argmax in each frame and, per frame, how many grid cells it lies from the object

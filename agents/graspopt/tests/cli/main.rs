@@ -1,0 +1,12 @@
+//! The `graspopt` command's CLI tests, one module per topic in one test binary (one link
+//! instead of one per file). They run the binary of this build (`CARGO_BIN_EXE_graspopt`).
+//! A new file here needs a `mod` line below.
+
+mod cli_bad_input;
+mod pipe_cli;
+mod quality_cli;
+mod render_cli;
+mod run_pictures_cli;
+mod scene_cli;
+mod sim_cli;
+mod support;

@@ -1,0 +1,5 @@
+//! graspopt-bus's integration tests, one module per topic in one test binary (one link
+//! instead of one per file). A new file here needs a `mod` line below.
+
+mod query;
+mod unique;

@@ -1,0 +1,7 @@
+//! graspopt-trial's integration tests, one module per topic in one test binary (one link
+//! instead of one per file). A new file here needs a `mod` line below.
+
+mod contacts;
+mod qualitative;
+mod scoring;
+mod urdf_hand;

@@ -1,0 +1,138 @@
+//! `graspopt topic list|echo|hz|bw` against a running embedded run, attached from another
+//! process as a user attaches from another terminal.
+
+use std::time::{Duration, Instant};
+
+use crate::support::{free_port, graspopt, long_run, tempdir};
+use graspopt_journal::Journal;
+
+fn topic(endpoint: &str, args: &[&str]) -> String {
+    let mut v = vec!["topic"];
+    v.extend_from_slice(args);
+    v.extend_from_slice(&["--connect", endpoint, "--no-multicast-scouting"]);
+    let o = graspopt(&v);
+    assert!(
+        o.status.success(),
+        "graspopt {v:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// The numbers after `label` in the last line of `text`.
+fn last_value(text: &str, label: &str) -> f64 {
+    let line = text.lines().last().unwrap_or_default();
+    let rest = line
+        .split(label)
+        .nth(1)
+        .unwrap_or_else(|| panic!("no {label:?} in {line:?}"));
+    rest.split_whitespace().next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn topic_tools_list_echo_and_time_a_running_pipeline() {
+    let dir = tempdir("topic");
+    let port = free_port();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let out = dir.join("results");
+    let _run = long_run(&dir, "tp", "cylinder", &endpoint);
+
+    // list: the live agents' topics, types and publishers.
+    let start = Instant::now();
+    let listed = loop {
+        let l = topic(&endpoint, &["list", "--run", "tp"]);
+        if l.contains("hand-2") || start.elapsed() > Duration::from_secs(20) {
+            break l;
+        }
+    };
+    for want in [
+        "graspopt/tp/result",
+        "TrialResult",
+        "metric@",
+        "graspopt/tp/hand/hand-1/command",
+        "graspopt/tp/hand/hand-2/command",
+        "TrialCommand",
+        "graspopt/tp/status",
+        "RunStatus",
+        "graspopt/tp/planner/suggest",
+    ] {
+        assert!(listed.contains(want), "{want} not in\n{listed}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&topic(
+        &endpoint,
+        &["list", "--run", "tp", "--format", "json"],
+    ))
+    .unwrap();
+    let result_row = json
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["key"] == "graspopt/tp/result")
+        .unwrap();
+    assert_eq!(result_row["type"], "TrialResult");
+
+    // echo: two results, decoded; each is the trial the journal records.
+    let echoed = topic(
+        &endpoint,
+        &[
+            "echo", "result", "--run", "tp", "--count", "2", "--format", "json",
+        ],
+    );
+    let lines: Vec<serde_json::Value> = echoed
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2, "{echoed}");
+    let journal = out.join("journal.sqlite");
+    for l in &lines {
+        assert_eq!(l["key"], "graspopt/tp/result");
+        assert_eq!(l["type"], "TrialResult");
+        let m = &l["message"];
+        let id = m["trial_id"].as_u64().unwrap();
+        let score = m["score"].as_f64().unwrap();
+        let start = Instant::now();
+        let recorded = loop {
+            let t = Journal::open(&journal).unwrap().trial("tp", id).unwrap();
+            if let Some(s) = t.and_then(|t| t.score) {
+                break s;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(10),
+                "trial {id} not recorded"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        assert_eq!(recorded, score, "trial {id}");
+    }
+    // The text form names the fields.
+    let text = topic(
+        &endpoint,
+        &["echo", "command", "--run", "tp", "--count", "1"],
+    );
+    assert!(text.starts_with("--- graspopt/tp/hand/hand-"), "{text}");
+    for field in ["trial_id: ", "palm_pose:", "params: [", "worker: hand-"] {
+        assert!(text.contains(field), "{field} not in\n{text}");
+    }
+
+    // hz: the coordinator publishes its status every 500 ms (2 Hz).
+    let hz = topic(
+        &endpoint,
+        &["hz", "status", "--run", "tp", "--duration", "3"],
+    );
+    let rate = last_value(&hz, "average rate");
+    assert!(
+        (rate - 2.0).abs() <= 0.4,
+        "status rate {rate} Hz, want 2 Hz\n{hz}"
+    );
+    // bw: statuses are a few hundred bytes each, 2 per second.
+    let bw = topic(
+        &endpoint,
+        &["bw", "status", "--run", "tp", "--duration", "3"],
+    );
+    assert!(bw.lines().last().unwrap().starts_with("bandwidth "), "{bw}");
+
+    // A bad key is a clear error.
+    let o = graspopt(&["topic", "echo", "results", "--connect", &endpoint]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown topic \"results\""));
+}
