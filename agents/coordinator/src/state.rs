@@ -78,19 +78,19 @@ pub enum Disposition {
 /// The state of one run.
 #[derive(Debug, Clone, Default)]
 pub struct RunState {
-    pub budget: u64,
-    pub trials: BTreeMap<u64, Trial>,
-    pub workers: BTreeMap<String, Worker>,
+    budget: u64,
+    trials: BTreeMap<u64, Trial>,
+    workers: BTreeMap<String, Worker>,
     /// Completed trials in completion order, for the planner.
-    pub observations: Vec<Observation>,
-    pub best: Option<BestTrial>,
-    pub best_history: Vec<f64>,
-    pub errors: ErrorCounts,
+    observations: Vec<Observation>,
+    best: Option<BestTrial>,
+    best_history: Vec<f64>,
+    errors: ErrorCounts,
     /// How long a worker that may still be executing a trial stays busy after the trial no
     /// longer needs it (re-issued elsewhere, or completed by another attempt).
-    pub grace_ms: i64,
+    grace_ms: i64,
     /// How long completed attempts took, issue to result (milliseconds).
-    pub trial_ms: Vec<i64>,
+    trial_ms: Vec<i64>,
 }
 
 impl RunState {
@@ -99,6 +99,53 @@ impl RunState {
             budget,
             ..RunState::default()
         }
+    }
+
+    /// Sets how long a worker stays busy after its trial no longer needs it.
+    pub fn set_grace_ms(&mut self, grace_ms: i64) {
+        self.grace_ms = grace_ms;
+    }
+
+    /// Puts back a trial recorded in the journal (a resumed run).
+    pub fn restore_trial(&mut self, trial_id: u64, trial: Trial) {
+        self.trials.insert(trial_id, trial);
+    }
+
+    /// The trial `trial_id`, if the run has it.
+    pub fn trial(&self, trial_id: u64) -> Option<&Trial> {
+        self.trials.get(&trial_id)
+    }
+
+    /// Number of trials proposed so far.
+    pub fn trial_count(&self) -> usize {
+        self.trials.len()
+    }
+
+    /// Whether any hand worker is alive.
+    pub fn has_workers(&self) -> bool {
+        !self.workers.is_empty()
+    }
+
+    /// Completed trials in completion order, for the planner.
+    pub fn observations(&self) -> &[Observation] {
+        &self.observations
+    }
+
+    pub fn best(&self) -> Option<&BestTrial> {
+        self.best.as_ref()
+    }
+
+    pub fn best_history(&self) -> &[f64] {
+        &self.best_history
+    }
+
+    pub fn errors(&self) -> ErrorCounts {
+        self.errors
+    }
+
+    /// Counts a message that was not acted on.
+    pub fn count_bad_message(&mut self) {
+        self.errors.bad_messages += 1;
     }
 
     /// A worker appeared.

@@ -10,8 +10,10 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use graspopt_protocol::{ContactClouds, FingerCloud, Pose, TrialCommand};
+use graspopt_protocol::{FingerCloud, Pose, TrialCommand};
 use serde::{Deserialize, Serialize};
+
+use crate::driver::{HandDriver, HandError, HandReading};
 
 /// One recorded grasp.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -84,7 +86,7 @@ impl Recording {
                 )));
             }
             // The same checks as a ContactClouds message on the bus.
-            let message = t.clouds_for(&probe_command(&t), "check");
+            let message = crate::serve::tag(&probe_command(&t), "check", None, Ok(t.reading()));
             graspopt_protocol::Message::validate(&message).map_err(bad)?;
             if t.params.iter().any(|v| !v.is_finite()) {
                 return Err(bad("a parameter is not finite".into()));
@@ -111,49 +113,50 @@ impl Recording {
             .min_by(|a, b| dist2(&a.params, params).total_cmp(&dist2(&b.params, params)))
     }
 
-    /// The answer to a command: the nearest recorded grasp's clouds, or a refusal naming the
-    /// mismatch.
-    pub fn answer(&self, command: &TrialCommand, worker: &str) -> ContactClouds {
+    /// The answer to a command: the nearest recorded grasp, or why none fits.
+    pub fn answer(&self, command: &TrialCommand) -> Result<HandReading, HandError> {
         match self.nearest(&command.params) {
-            Some(t) if t.hand == command.hand => t.clouds_for(command, worker),
-            Some(t) => refusal(
-                command,
-                worker,
-                format!(
-                    "the recording {} was made with a {} hand, the trial asks for {}",
-                    self.path.display(),
-                    t.hand,
-                    command.hand
-                ),
-            ),
-            None => refusal(
-                command,
-                worker,
-                format!(
-                    "the recording {} has {} parameters per grasp, the trial has {}",
-                    self.path.display(),
-                    self.trials[0].params.len(),
-                    command.params.len()
-                ),
-            ),
+            Some(t) if t.hand == command.hand => Ok(t.reading()),
+            Some(t) => Err(HandError(format!(
+                "the recording {} was made with a {} hand, the trial asks for {}",
+                self.path.display(),
+                t.hand,
+                command.hand
+            ))),
+            None => Err(HandError(format!(
+                "the recording {} has {} parameters per grasp, the trial has {}",
+                self.path.display(),
+                self.trials[0].params.len(),
+                command.params.len()
+            ))),
         }
     }
 }
 
+/// A hand that answers each trial with the nearest recorded grasp.
+#[derive(Debug, Clone)]
+pub struct ReplayHand {
+    pub recording: Recording,
+}
+
+impl HandDriver for ReplayHand {
+    /// Any: each recorded grasp says its hand.
+    fn hand(&self) -> Option<&str> {
+        None
+    }
+
+    fn execute(&mut self, command: &TrialCommand) -> Result<HandReading, HandError> {
+        self.recording.answer(command)
+    }
+}
+
 impl RecordedTrial {
-    /// This grasp as the answer to `command`.
-    pub fn clouds_for(&self, command: &TrialCommand, worker: &str) -> ContactClouds {
-        ContactClouds {
-            run_id: command.run_id.clone(),
-            trial_id: command.trial_id,
-            attempt: command.attempt,
-            worker: worker.to_string(),
-            hand: self.hand.clone(),
+    /// This grasp as a hand's reading.
+    pub fn reading(&self) -> HandReading {
+        HandReading {
             palm_pose: self.palm_pose,
             fingers: self.fingers.clone(),
             min_gap: self.min_gap,
-            error: None,
-            executed_ms: graspopt_bus::now_ms(),
         }
     }
 
@@ -161,21 +164,6 @@ impl RecordedTrial {
     pub fn write_line(&self, out: &mut impl Write) -> std::io::Result<()> {
         serde_json::to_writer(&mut *out, self)?;
         out.write_all(b"\n")
-    }
-}
-
-fn refusal(command: &TrialCommand, worker: &str, error: String) -> ContactClouds {
-    ContactClouds {
-        run_id: command.run_id.clone(),
-        trial_id: command.trial_id,
-        attempt: command.attempt,
-        worker: worker.to_string(),
-        hand: command.hand.clone(),
-        palm_pose: command.palm_pose,
-        fingers: Vec::new(),
-        min_gap: None,
-        error: Some(error),
-        executed_ms: graspopt_bus::now_ms(),
     }
 }
 
@@ -252,12 +240,11 @@ mod tests {
         let rec = Recording::load(&write(&dir, "ok.jsonl", &lines)).unwrap();
         assert_eq!(rec.trials.len(), 3);
         assert_eq!(rec.nearest(&[1.4, 0.3]).unwrap().score, Some(0.2));
-        let c = rec.answer(&command(vec![1.9, 0.0]), "replay");
-        assert_eq!((c.trial_id, c.attempt, c.error.as_deref()), (5, 2, None));
+        let c = rec.answer(&command(vec![1.9, 0.0])).unwrap();
         assert_eq!(c.fingers, grasp(vec![], 0.0).fingers);
         // Wrong parameter count: a refusal, not a panic.
-        let c = rec.answer(&command(vec![1.0]), "replay");
-        assert!(c.error.unwrap().contains("2 parameters per grasp"));
+        let e = rec.answer(&command(vec![1.0])).unwrap_err();
+        assert!(e.0.contains("2 parameters per grasp"), "{e}");
 
         // Bad recordings name the line and the problem.
         let mut nan = grasp(vec![0.0, 0.0], 0.0);

@@ -14,19 +14,22 @@
 //! history: the same design, the same data, but a model fitted afresh, whose proposals
 //! differ slightly from a warm engine's.
 //!
-//! [`Planner::propose`] is the logic (no network); [`run`] wires it to the bus.
+//! [`Planner::answer`] is the logic (no network); [`run`] wires it to the bus.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+mod engine;
 
 use std::sync::{Arc, Mutex};
 
 use anyhow::Context;
 use graspopt_bayesopt::baseline::{AskTell, RandomSearch};
-use graspopt_bayesopt::optimizer::{Optimizer, Settings};
+use graspopt_bayesopt::error::BoError;
+use graspopt_bayesopt::optimizer::Optimizer;
 use graspopt_bus::Bus;
-use graspopt_protocol::{
-    AgentKind, Observation, PlannerMethod, RunId, SuggestReply, SuggestRequest,
-};
+use graspopt_protocol::{AgentKind, PlannerMethod, RunId, SuggestReply, SuggestRequest};
 use serde::{Deserialize, Serialize};
+
+use crate::engine::{Engine, Warm, bo_settings};
 
 /// Planner settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,191 +46,35 @@ impl Default for PlannerConfig {
     }
 }
 
-#[derive(Serialize, Deserialize)]
-enum Engine {
-    Bo(Box<Optimizer>),
-    Random(RandomSearch),
+/// Why the planner cannot answer.
+#[derive(Debug, thiserror::Error)]
+pub enum PlannerError {
+    /// The engine refused (bounds, a proposal).
+    #[error(transparent)]
+    Bo(#[from] BoError),
+    #[error("observation rejected: {0}")]
+    Observation(BoError),
+    #[error("pending point rejected: {0}")]
+    Pending(BoError),
+    /// A saved engine state that cannot be used or written.
+    #[error("{0}")]
+    State(String),
+    #[error("this planner serves run {serving:?}, not {asked:?}")]
+    OtherRun { serving: RunId, asked: RunId },
+    #[error("planner state poisoned")]
+    Poisoned,
+    #[error("planner state missing")]
+    Missing,
 }
 
-struct Warm {
-    run_id: RunId,
-    method: PlannerMethod,
-    bounds: Vec<[f64; 2]>,
-    seed: u64,
-    initial: Option<u32>,
-    told: Vec<Observation>,
-    engine: Engine,
-}
-
-/// What `engine_state` holds after its header: the engine with what it was built for and a
-/// digest of the observations it was told (the request carries those; the digest shows
-/// they are the same). (`E`: the engine, or a reference to it when saving.)
-#[derive(Serialize, Deserialize)]
-struct SavedEngine<E> {
-    run_id: RunId,
-    method: PlannerMethod,
-    bounds: Vec<[f64; 2]>,
-    seed: u64,
-    initial: Option<u32>,
-    told: u64,
-    told_digest: u64,
-    engine: E,
-}
-
-/// The layout of [`SavedEngine`] and of the engines in it. Bump it when `Optimizer`,
-/// `RandomSearch` or their settings change shape (the test
-/// `the_saved_engine_layout_is_pinned` fails until then): bincode reads fields by position,
-/// so a state of another layout would be misread rather than refused.
-const STATE_FORMAT: u32 = 1;
-
-/// Starts every `engine_state`, then an FNV-1a checksum of the rest (8 bytes, little
-/// endian), then the bincode of a [`SavedEngine`]. A state of another format or graspopt
-/// version, or a damaged one, is not read: the history is used instead.
-fn state_header() -> Vec<u8> {
-    format!(
-        "graspopt-engine {STATE_FORMAT} {}\n",
-        env!("CARGO_PKG_VERSION")
-    )
-    .into_bytes()
-}
-
-fn state_config() -> impl bincode::config::Config {
-    bincode::config::standard().with_limit::<{ graspopt_protocol::codec::MAX_PAYLOAD }>()
-}
-
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-
-fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
-/// FNV-1a over the bits of every coordinate and value, in order.
-fn digest(observations: &[Observation]) -> u64 {
-    observations.iter().fold(FNV_OFFSET, |h, o| {
-        let h =
-            o.x.iter()
-                .chain(std::iter::once(&o.y))
-                .fold(h, |h, v| fnv(h, &v.to_bits().to_le_bytes()));
-        fnv(h, &[0xff])
-    })
-}
-
-fn same_values(a: f64, b: f64) -> bool {
-    a.to_bits() == b.to_bits()
-}
-
-/// The engine settings for a request: the ones a rebuilt engine gets, and the only ones a
-/// restored engine may have.
-fn bo_settings(req: &SuggestRequest) -> Settings {
-    Settings {
-        n_init: req.initial.map(|n| n as usize),
-        ..Settings::for_grasps()
-    }
-}
-
-impl Warm {
-    /// Whether `req` continues this engine's run and history.
-    fn continued_by(&self, req: &SuggestRequest) -> bool {
-        self.run_id == req.run_id
-            && self.method == req.method
-            && self.bounds == req.bounds
-            && self.seed == req.seed
-            && self.initial == req.initial
-            && req.observations.len() >= self.told.len()
-            && req.observations[..self.told.len()] == self.told[..]
-    }
-
-    /// The `engine_state` of this engine.
-    fn save(&self) -> Result<Vec<u8>, String> {
-        let saved = SavedEngine {
-            run_id: self.run_id.clone(),
-            method: self.method,
-            bounds: self.bounds.clone(),
-            seed: self.seed,
-            initial: self.initial,
-            told: self.told.len() as u64,
-            told_digest: digest(&self.told),
-            engine: &self.engine,
-        };
-        let body = bincode::serde::encode_to_vec(&saved, state_config())
-            .map_err(|e| format!("cannot encode the engine state: {e}"))?;
-        let mut out = state_header();
-        out.extend_from_slice(&fnv(FNV_OFFSET, &body).to_le_bytes());
-        out.extend_from_slice(&body);
-        Ok(out)
-    }
-
-    /// The engine `bytes` hold, if it is intact, of this format and version, and `req`
-    /// continues it with the settings a rebuilt engine would have.
-    fn restore(bytes: &[u8], req: &SuggestRequest) -> Result<Warm, String> {
-        let rest = bytes
-            .strip_prefix(state_header().as_slice())
-            .ok_or("it was saved in another format or by another graspopt version")?;
-        let (sum, body) = rest.split_first_chunk::<8>().ok_or("it is truncated")?;
-        if u64::from_le_bytes(*sum) != fnv(FNV_OFFSET, body) {
-            return Err("it is damaged (checksum)".into());
-        }
-        let (saved, used): (SavedEngine<Engine>, usize) =
-            bincode::serde::decode_from_slice(body, state_config())
-                .map_err(|e| format!("it does not decode: {e}"))?;
-        if used != body.len() {
-            return Err(format!("{} bytes follow it", body.len() - used));
-        }
-        let told = usize::try_from(saved.told)
-            .ok()
-            .filter(|&n| n <= req.observations.len())
-            .ok_or("it was told more observations than the request holds")?;
-        let history = &req.observations[..told];
-        if digest(history) != saved.told_digest {
-            return Err("the request's history does not start with its observations".into());
-        }
-        let engine_bounds: Vec<[f64; 2]> = match (&saved.engine, saved.method) {
-            (Engine::Bo(opt), PlannerMethod::Bo) => {
-                if *opt.settings() != bo_settings(req) || opt.seed() != req.seed {
-                    return Err("its engine has other settings or another seed".into());
-                }
-                opt.check_state()
-                    .map_err(|e| format!("it is inconsistent: {e}"))?;
-                let same = opt.len() == told
-                    && opt.observations().zip(history).all(|((x, y), o)| {
-                        same_values(y, o.y)
-                            && x.len() == o.x.len()
-                            && x.iter().zip(&o.x).all(|(a, b)| same_values(*a, *b))
-                    });
-                if !same {
-                    return Err("its engine was told other observations".into());
-                }
-                opt.bounds().into_iter().map(|(l, u)| [l, u]).collect()
-            }
-            (Engine::Random(r), PlannerMethod::Random) => {
-                r.check_state()
-                    .map_err(|e| format!("it is inconsistent: {e}"))?;
-                if r.observation_count() != told {
-                    return Err("its engine was told another number of observations".into());
-                }
-                r.bounds().into_iter().map(|(l, u)| [l, u]).collect()
-            }
-            _ => return Err("its engine is not of its method".into()),
-        };
-        if engine_bounds != saved.bounds {
-            return Err("its engine has other bounds".into());
-        }
-        let warm = Warm {
-            run_id: saved.run_id,
-            method: saved.method,
-            bounds: saved.bounds,
-            seed: saved.seed,
-            initial: saved.initial,
-            told: history.to_vec(),
-            engine: saved.engine,
-        };
-        if !warm.continued_by(req) {
-            return Err("it belongs to another run, method, space, seed or design".into());
-        }
-        Ok(warm)
+/// The reply to `req` saying why there are no proposals.
+pub fn failed_reply(req: &SuggestRequest, error: &PlannerError) -> SuggestReply {
+    SuggestReply {
+        run_id: req.run_id.clone(),
+        request_id: req.request_id,
+        points: Vec::new(),
+        error: Some(error.to_string()),
+        engine_state: None,
     }
 }
 
@@ -253,12 +100,37 @@ pub struct Planner {
 }
 
 impl Planner {
+    /// The reply to `req` from the planner of run `serving`: the proposal, or a reply whose
+    /// `error` says why there is none. A request of another run is refused (the error).
+    pub fn answer(
+        &mut self,
+        serving: &RunId,
+        req: &SuggestRequest,
+    ) -> Result<SuggestReply, PlannerError> {
+        if req.run_id != *serving {
+            return Err(PlannerError::OtherRun {
+                serving: serving.clone(),
+                asked: req.run_id.clone(),
+            });
+        }
+        Ok(match self.propose_and_save(req) {
+            Ok(proposal) => SuggestReply {
+                run_id: req.run_id.clone(),
+                request_id: req.request_id,
+                points: proposal.points,
+                error: None,
+                engine_state: proposal.engine_state,
+            },
+            Err(e) => failed_reply(req, &e),
+        })
+    }
+
     /// Makes `self.warm` the engine for `req`: the warm one if the request continues it and
     /// carries the state of this planner's last reply (a request carrying another state
     /// follows a reply that was lost, or another planner's: the warm engine has moved on
     /// without the coordinator), else the request's state if `use_state` and it is usable,
     /// else a new engine told nothing. Returns whether the engine was restored.
-    fn engine_for(&mut self, req: &SuggestRequest, use_state: bool) -> Result<bool, String> {
+    fn engine_for(&mut self, req: &SuggestRequest, use_state: bool) -> Result<bool, PlannerError> {
         let in_step = req.engine_state.is_none() || req.engine_state == self.last_saved;
         let warm_fits = self.warm.as_ref().is_some_and(|w| w.continued_by(req));
         if warm_fits && (in_step || !use_state) {
@@ -280,12 +152,12 @@ impl Planner {
         }
         let bounds: Vec<(f64, f64)> = req.bounds.iter().map(|b| (b[0], b[1])).collect();
         let engine = match req.method {
-            PlannerMethod::Bo => Engine::Bo(Box::new(
-                Optimizer::new(&bounds, bo_settings(req), req.seed).map_err(|e| e.to_string())?,
-            )),
-            PlannerMethod::Random => Engine::Random(
-                RandomSearch::new(&bounds, false, req.seed).map_err(|e| e.to_string())?,
-            ),
+            PlannerMethod::Bo => Engine::Bo(Box::new(Optimizer::new(
+                &bounds,
+                bo_settings(req),
+                req.seed,
+            )?)),
+            PlannerMethod::Random => Engine::Random(RandomSearch::new(&bounds, false, req.seed)?),
         };
         self.rebuilds += 1;
         self.warm = Some(Warm {
@@ -302,7 +174,7 @@ impl Planner {
 
     /// Proposes `req.count` points given the request's history, with the engine state to
     /// reply with.
-    pub fn propose_and_save(&mut self, req: &SuggestRequest) -> Result<Proposal, String> {
+    pub fn propose_and_save(&mut self, req: &SuggestRequest) -> Result<Proposal, PlannerError> {
         let points = self.propose(req)?;
         let engine_state = match self.warm.as_ref().map(Warm::save) {
             Some(Ok(bytes)) => Some(bytes),
@@ -321,7 +193,7 @@ impl Planner {
 
     /// Proposes `req.count` points given the request's history. An engine restored from
     /// the request's state that fails is dropped for one rebuilt from the history.
-    pub fn propose(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, String> {
+    pub fn propose(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, PlannerError> {
         let restored = self.engine_for(req, true)?;
         match self.propose_with_warm(req) {
             Err(e) if restored => {
@@ -338,25 +210,22 @@ impl Planner {
         }
     }
 
-    fn propose_with_warm(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, String> {
-        let warm = self
-            .warm
-            .as_mut()
-            .ok_or_else(|| "planner state missing".to_string())?;
+    fn propose_with_warm(&mut self, req: &SuggestRequest) -> Result<Vec<Vec<f64>>, PlannerError> {
+        let warm = self.warm.as_mut().ok_or(PlannerError::Missing)?;
         for o in &req.observations[warm.told.len()..] {
             let told = match &mut warm.engine {
                 Engine::Bo(opt) => opt.observe(&o.x, o.y),
                 Engine::Random(r) => r.observe(&o.x, o.y),
             };
-            told.map_err(|e| format!("observation rejected: {e}"))?;
+            told.map_err(PlannerError::Observation)?;
             warm.told.push(o.clone());
         }
         let count = req.count as usize;
         match &mut warm.engine {
             Engine::Bo(opt) => {
                 opt.set_pending(req.pending.clone())
-                    .map_err(|e| format!("pending point rejected: {e}"))?;
-                opt.suggest(count).map_err(|e| e.to_string())
+                    .map_err(PlannerError::Pending)?;
+                Ok(opt.suggest(count)?)
             }
             Engine::Random(r) => {
                 // A rebuilt search continues the stream after the points already issued.
@@ -367,7 +236,7 @@ impl Planner {
                     .chain(req.pending.iter().map(Vec::as_slice))
                     .collect();
                 r.resume_after(&known);
-                r.suggest(count).map_err(|e| e.to_string())
+                Ok(r.suggest(count)?)
             }
         }
     }
@@ -381,63 +250,38 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
         .await?;
     let planner = Arc::new(Mutex::new(Planner::default()));
     let mut bad = 0u64;
+    let id = &config.id;
     while let Some(incoming) = server.recv().await {
         let req = match &incoming.request {
-            Ok(r) if r.run_id == *run => r.clone(),
-            Ok(r) => {
-                bad += 1;
-                tracing::warn!(
-                    "planner {}: request of run {:?} refused ({bad} bad messages)",
-                    config.id,
-                    r.run_id
-                );
-                let _ = incoming
-                    .reply_error(&format!(
-                        "this planner serves run {run:?}, not {:?}",
-                        r.run_id
-                    ))
-                    .await;
-                continue;
-            }
+            Ok(r) => r.clone(),
             Err(e) => {
                 bad += 1;
-                tracing::warn!(
-                    "planner {}: bad request ({bad} bad messages): {e}",
-                    config.id
-                );
+                tracing::warn!("planner {id}: bad request ({bad} bad messages): {e}");
                 let _ = incoming.reply_error(&e.to_string()).await;
                 continue;
             }
         };
-        let p = planner.clone();
-        let r2 = req.clone();
-        let outcome = tokio::task::spawn_blocking(move || match p.lock() {
-            Ok(mut planner) => planner.propose_and_save(&r2),
-            Err(_) => Err("planner state poisoned".to_string()),
+        let (p, serving) = (planner.clone(), run.clone());
+        let reply = tokio::task::spawn_blocking(move || match p.lock() {
+            Ok(mut planner) => planner.answer(&serving, &req),
+            Err(_) => Ok(failed_reply(&req, &PlannerError::Poisoned)),
         })
         .await
         .context("planner: proposal thread panicked")?;
-        let reply = match outcome {
-            Ok(proposal) => SuggestReply {
-                run_id: req.run_id.clone(),
-                request_id: req.request_id,
-                points: proposal.points,
-                error: None,
-                engine_state: proposal.engine_state,
-            },
+        let reply = match reply {
+            Ok(reply) => reply,
             Err(e) => {
-                tracing::warn!("planner {}: cannot propose: {e}", config.id);
-                SuggestReply {
-                    run_id: req.run_id.clone(),
-                    request_id: req.request_id,
-                    points: Vec::new(),
-                    error: Some(e),
-                    engine_state: None,
-                }
+                bad += 1;
+                tracing::warn!("planner {id}: request refused: {e} ({bad} bad messages)");
+                let _ = incoming.reply_error(&e.to_string()).await;
+                continue;
             }
         };
+        if let Some(e) = &reply.error {
+            tracing::warn!("planner {id}: cannot propose: {e}");
+        }
         if let Err(e) = incoming.reply(&reply).await {
-            tracing::warn!("planner {}: cannot reply: {e}", config.id);
+            tracing::warn!("planner {id}: cannot reply: {e}");
         }
     }
     Ok(())
@@ -446,6 +290,9 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::{FNV_OFFSET, STATE_FORMAT, fnv, state_header};
+    use graspopt_bayesopt::optimizer::Settings;
+    use graspopt_protocol::Observation;
 
     fn request(
         observations: Vec<Observation>,
@@ -615,9 +462,13 @@ mod tests {
         Engine::Bo(Box::new(opt))
     }
 
-    #[test]
-    fn an_unusable_engine_state_is_passed_over_for_the_history() {
-        let (mut warm, history, good) = after(6);
+    /// Unusable engine states for a run with `history` whose good state is `good`: what is
+    /// wrong, the state, the request's history and seed.
+    fn unusable_states(
+        history: &[Observation],
+        good: &[u8],
+    ) -> Vec<(&'static str, Vec<u8>, Vec<Observation>, u64)> {
+        let (history, good) = (history.to_vec(), good.to_vec());
         let mut flipped = good.clone();
         let last = flipped.len() - 1;
         flipped[last] ^= 0x55;
@@ -678,7 +529,13 @@ mod tests {
                 3,
             ),
         ];
-        for (what, bytes, observations, seed) in cases {
+        cases
+    }
+
+    #[test]
+    fn an_unusable_engine_state_is_passed_over_for_the_history() {
+        let (mut warm, history, good) = after(6);
+        for (what, bytes, observations, seed) in unusable_states(&history, &good) {
             let req = SuggestRequest {
                 seed,
                 engine_state: Some(bytes),
@@ -829,6 +686,6 @@ mod tests {
         let e = p
             .propose(&request(history, vec![vec![5.0, 0.0]], 1))
             .unwrap_err();
-        assert!(e.contains("pending"), "{e}");
+        assert!(e.to_string().contains("pending"), "{e}");
     }
 }

@@ -991,9 +991,21 @@ impl Optimizer {
         if q == 0 {
             return Err(BoError::InvalidSetting("q must be >= 1".into()));
         }
-        let d = self.dim();
         let mut out: Vec<Vec<f64>> = Vec::with_capacity(q);
         let mut info = RoundInfo::default();
+        self.restart_if_stagnant();
+        self.initial_points(q, &mut out, &mut info);
+        if out.len() < q {
+            self.model_points(q, &mut out, &mut info)?;
+        }
+        self.pending.extend(out.iter().cloned());
+        self.last_round = info;
+        Ok(out)
+    }
+
+    /// A new epoch when the restart rule says this one stagnates: its best point becomes a
+    /// tabu centre.
+    fn restart_if_stagnant(&mut self) {
         if let Some(rule) = self.settings.restart
             && self.epoch_stagnates(&rule)
         {
@@ -1006,164 +1018,220 @@ impl Optimizer {
             }
             self.epoch_start = self.ys.len();
         }
+    }
+
+    /// Adds to `out` (up to `q` points) the epoch's initial design (and random points while
+    /// fewer than 2 observations exist).
+    fn initial_points(&mut self, q: usize, out: &mut Vec<Vec<f64>>, info: &mut RoundInfo) {
         let epoch_init = match self.settings.restart {
             Some(rule) if self.epoch_start > 0 => rule.init.max(2),
             _ => self.n_init(),
         };
         let epoch_len = self.xs.len() - self.epoch_start.min(self.xs.len());
-        // Initial design (and fallback while fewer than 2 observations exist).
         while out.len() < q
             && (epoch_len + self.pending.len() + out.len() < epoch_init || epoch_len < 2)
         {
-            // The first epoch's design is drawn whole when first needed and handed out in
-            // order, skipping its points already observed or pending: an engine rebuilt from a
-            // run's history continues the same design, and a design point whose trial failed
-            // (dropped from both) is not followed by a point still pending.
             let u = if self.epoch_start == 0 {
-                if self.design.is_empty() {
-                    let n = epoch_init.max(2);
-                    self.design = match self.settings.initial_design {
-                        InitialDesign::Random => (0..n).map(|_| self.rng.unit_point(d)).collect(),
-                        InitialDesign::MaximinLatinHypercube { candidates } => {
-                            maximin_latin_hypercube(&mut self.rng, n, d, candidates)
-                        }
-                    };
-                }
-                let next = (self.design_next..self.design.len()).find(|&i| {
-                    let x = self.unit_to_box(&self.design[i]);
-                    !self
-                        .xs
-                        .iter()
-                        .chain(&self.pending)
-                        .chain(&out)
-                        .any(|p| same_point(p, &x, &self.lower, &self.upper))
-                });
-                match next {
-                    Some(i) => {
-                        self.design_next = i + 1;
-                        self.design[i].clone()
-                    }
-                    None => self.rng.unit_point(d),
-                }
+                self.next_design_point(epoch_init, out)
             } else {
-                self.rng.unit_point(d)
+                self.rng.unit_point(self.dim())
             };
             out.push(self.unit_to_box(&u));
             info.random_points += 1;
         }
-        if out.len() < q {
-            let data = self.standardised();
-            let full = self.rounds.is_multiple_of(self.settings.full_refit_every);
-            let mut gp = self.fit_model(&data, full)?;
-            let signal = gp.kernel().signal_variance;
-            let xi = self.settings.xi.xi(signal);
-            info.xi = Some(xi);
-            let mut incumbent = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let y_mean_std = data.y.iter().sum::<f64>() / data.y.len().max(1) as f64;
-            let y_min_std = data.y.iter().copied().fold(f64::INFINITY, f64::min);
-            let mut taken: Vec<Vec<f64>> = data.x.clone();
-            let fantasies: Vec<Vec<f64>> = self
-                .pending
+    }
+
+    /// The next point (unit cube) of the first epoch's design. The design is drawn whole when
+    /// first needed and handed out in order, skipping its points already observed, pending or
+    /// in `out`: an engine rebuilt from a run's history continues the same design, and a
+    /// design point whose trial failed (dropped from both) is not followed by a point still
+    /// pending. Past its end: a random point.
+    fn next_design_point(&mut self, epoch_init: usize, out: &[Vec<f64>]) -> Vec<f64> {
+        let d = self.dim();
+        if self.design.is_empty() {
+            let n = epoch_init.max(2);
+            self.design = match self.settings.initial_design {
+                InitialDesign::Random => (0..n).map(|_| self.rng.unit_point(d)).collect(),
+                InitialDesign::MaximinLatinHypercube { candidates } => {
+                    maximin_latin_hypercube(&mut self.rng, n, d, candidates)
+                }
+            };
+        }
+        let next = (self.design_next..self.design.len()).find(|&i| {
+            let x = self.unit_to_box(&self.design[i]);
+            !self
+                .xs
                 .iter()
-                .chain(out.iter())
-                .map(|p| self.to_unit(p))
-                .collect();
-            // Sequential-greedy qEI: the pending and chosen points enter jointly through the
-            // GP's posterior (no fantasy values), with base samples from a generator of this
-            // round (the main stream is left as it is).
-            let qei = match self.settings.batch {
+                .chain(&self.pending)
+                .chain(out)
+                .any(|p| same_point(p, &x, &self.lower, &self.upper))
+        });
+        match next {
+            Some(i) => {
+                self.design_next = i + 1;
+                self.design[i].clone()
+            }
+            None => self.rng.unit_point(d),
+        }
+    }
+
+    /// Fills `out` up to `q` points from the model: EI maximisers (or qEI points), each
+    /// conditioning the next through a lie or the joint posterior.
+    fn model_points(
+        &mut self,
+        q: usize,
+        out: &mut Vec<Vec<f64>>,
+        info: &mut RoundInfo,
+    ) -> Result<()> {
+        let data = self.standardised();
+        let full = self.rounds.is_multiple_of(self.settings.full_refit_every);
+        let gp = self.fit_model(&data, full)?;
+        let xi = self.settings.xi.xi(gp.kernel().signal_variance);
+        info.xi = Some(xi);
+        let mut round = self.open_round(gp, &data, xi, out)?;
+        while out.len() < q {
+            let qei_point = round.qei.is_some() && !round.chosen.is_empty();
+            let (u, ei) = self.propose_one(&mut round, qei_point, q, out.is_empty())?;
+            let u = self.settle_point(&round, u, ei, qei_point, info);
+            if info.best_ei.is_none() {
+                info.best_ei = Some(ei);
+                info.relative_ei = Some(if round.y_range > 0.0 {
+                    ei / round.y_range
+                } else {
+                    f64::INFINITY
+                });
+            }
+            if round.qei.is_some() {
+                round.chosen.push(u.clone());
+            } else {
+                let lie = self.lie(&round.gp, &u, round.incumbent, round.y_mean, round.y_min);
+                if out.len() + 1 < q {
+                    round.incumbent = round.incumbent.max(lie);
+                    round.gp.push(u.clone(), lie)?;
+                }
+            }
+            round.taken.push(u.clone());
+            out.push(self.unit_to_box(&u));
+        }
+        if let Some(rel) = info.relative_ei {
+            if rel < self.settings.stop.relative_ei_threshold {
+                self.low_ei_streak = self.low_ei_streak.saturating_add(1);
+            } else {
+                self.low_ei_streak = 0;
+            }
+        }
+        self.rounds = self.rounds.saturating_add(1);
+        Ok(())
+    }
+
+    /// A model-based round on `gp` fitted to `data`, with the pending points and those
+    /// already in `out` entered: by lies into the GP, or (qEI) as chosen points that enter
+    /// jointly through the GP's posterior (no fantasy values).
+    fn open_round(&self, gp: Gp, data: &Standardised, xi: f64, out: &[Vec<f64>]) -> Result<Round> {
+        let y_max = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let y_min = data.y.iter().copied().fold(f64::INFINITY, f64::min);
+        let fantasies: Vec<Vec<f64>> = self
+            .pending
+            .iter()
+            .chain(out.iter())
+            .map(|p| self.to_unit(p))
+            .collect();
+        let mut round = Round {
+            gp,
+            xi,
+            incumbent: y_max,
+            y_mean: data.y.iter().sum::<f64>() / data.y.len().max(1) as f64,
+            y_min,
+            // The range of the modelled outputs (standardised, after the output transform,
+            // this epoch): without a transform, EI over the observed range of y; with one, a
+            // few compressed misses do not inflate the range.
+            y_range: y_max - y_min,
+            taken: data.x.clone(),
+            chosen: Vec::new(),
+            qei: match self.settings.batch {
                 BatchStrategy::Qei { samples } => Some(samples.max(1)),
                 _ => None,
-            };
-            let mut chosen: Vec<Vec<f64>> = Vec::new();
-            let mut qei_rng = Rng::new(
+            },
+            // qEI's base samples come from a generator of this round (the main stream is
+            // left as it is).
+            qei_rng: Rng::new(
                 self.seed
                     .wrapping_mul(0x9E37_79B9_7F4A_7C15)
                     .wrapping_add(self.rounds as u64),
-            );
-            for u in fantasies {
-                if qei.is_some() {
-                    chosen.push(u.clone());
-                    taken.push(u);
-                    continue;
-                }
-                let lie = self.lie(&gp, &u, incumbent, y_mean_std, y_min_std);
-                incumbent = incumbent.max(lie);
-                gp.push(u.clone(), lie)?;
-                taken.push(u);
+            ),
+        };
+        for u in fantasies {
+            if round.qei.is_some() {
+                round.chosen.push(u.clone());
+                round.taken.push(u);
+                continue;
             }
-            while out.len() < q {
-                let qei_point = qei.is_some() && !chosen.is_empty();
-                let (u, ei) = match qei {
-                    Some(samples) if qei_point => {
-                        let ctx =
-                            QeiContext::new(&gp, &chosen, incumbent + xi, samples, &mut qei_rng)?;
-                        self.maximize_qei(ctx)?
-                    }
-                    _ => {
-                        // A qEI batch spreads its points itself: only a round of one point
-                        // with nothing pending is diversified.
-                        let alone = qei.is_none() || (q == 1 && self.pending.is_empty());
-                        self.ei_point(&gp, incumbent, xi, y_min_std, alone && out.is_empty())?
-                    }
-                };
-                let duplicate = taken.iter().any(|t| {
-                    t.iter()
-                        .zip(&u)
-                        .map(|(a, b)| (a - b) * (a - b))
-                        .sum::<f64>()
-                        < 1e-16
-                });
-                // A qEI gain is not an EI: the exploration rule applies to EI points only.
-                let explore =
-                    !qei_point && matches!(self.settings.explore_below_ei, Some(th) if ei < th);
-                let u = if explore {
-                    info.exploration_points += 1;
-                    self.exploration_point(&gp)
-                } else if duplicate {
-                    self.rng.unit_point(d)
-                } else {
-                    u
-                };
-                if info.best_ei.is_none() {
-                    info.best_ei = Some(ei);
-                    // The range of the modelled outputs (standardised, after the output
-                    // transform, this epoch): without a transform, EI over the observed range
-                    // of y; with one, a few compressed misses do not inflate the range.
-                    let ymax = data.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                    let ymin = data.y.iter().copied().fold(f64::INFINITY, f64::min);
-                    let range = ymax - ymin;
-                    let rel = if range > 0.0 {
-                        ei / range
-                    } else {
-                        f64::INFINITY
-                    };
-                    info.relative_ei = Some(rel);
-                }
-                if qei.is_some() {
-                    chosen.push(u.clone());
-                } else {
-                    let lie = self.lie(&gp, &u, incumbent, y_mean_std, y_min_std);
-                    if out.len() + 1 < q {
-                        incumbent = incumbent.max(lie);
-                        gp.push(u.clone(), lie)?;
-                    }
-                }
-                taken.push(u.clone());
-                out.push(self.unit_to_box(&u));
-            }
-            if let Some(rel) = info.relative_ei {
-                if rel < self.settings.stop.relative_ei_threshold {
-                    self.low_ei_streak = self.low_ei_streak.saturating_add(1);
-                } else {
-                    self.low_ei_streak = 0;
-                }
-            }
-            self.rounds = self.rounds.saturating_add(1);
+            let lie = self.lie(&round.gp, &u, round.incumbent, round.y_mean, y_min);
+            round.incumbent = round.incumbent.max(lie);
+            round.gp.push(u.clone(), lie)?;
+            round.taken.push(u);
         }
-        self.pending.extend(out.iter().cloned());
-        self.last_round = info;
-        Ok(out)
+        Ok(round)
+    }
+
+    /// The next maximiser of the round and its EI (or qEI gain, for a `qei_point`); `first`:
+    /// the round's first point.
+    fn propose_one(
+        &self,
+        round: &mut Round,
+        qei_point: bool,
+        q: usize,
+        first: bool,
+    ) -> Result<(Vec<f64>, f64)> {
+        match round.qei {
+            Some(samples) if qei_point => {
+                let target = round.incumbent + round.xi;
+                let ctx = QeiContext::new(
+                    &round.gp,
+                    &round.chosen,
+                    target,
+                    samples,
+                    &mut round.qei_rng,
+                )?;
+                self.maximize_qei(ctx)
+            }
+            _ => {
+                // A qEI batch spreads its points itself: only a round of one point with
+                // nothing pending is diversified.
+                let alone = round.qei.is_none() || (q == 1 && self.pending.is_empty());
+                let (gp, incumbent, xi) = (&round.gp, round.incumbent, round.xi);
+                self.ei_point(gp, incumbent, xi, round.y_min, alone && first)
+            }
+        }
+    }
+
+    /// The point to propose for the maximiser `u` of EI `ei`: an exploration step when EI is
+    /// below [`Settings::explore_below_ei`] (EI points only: a qEI gain is not an EI), a
+    /// random point when `u` was already taken, else `u`.
+    fn settle_point(
+        &mut self,
+        round: &Round,
+        u: Vec<f64>,
+        ei: f64,
+        qei_point: bool,
+        info: &mut RoundInfo,
+    ) -> Vec<f64> {
+        let duplicate = round.taken.iter().any(|t| {
+            t.iter()
+                .zip(&u)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                < 1e-16
+        });
+        let explore = !qei_point && matches!(self.settings.explore_below_ei, Some(th) if ei < th);
+        if explore {
+            info.exploration_points += 1;
+            self.exploration_point(&round.gp)
+        } else if duplicate {
+            self.rng.unit_point(self.dim())
+        } else {
+            u
+        }
     }
 
     /// The EI (or UCB) maximiser on `gp` and its value. When `first` and this is a
@@ -1353,23 +1421,8 @@ impl Optimizer {
             let (m, v) = if reuse.is_none() && record.is_none() {
                 gp.predict_with_buffer(u, &mut buffer)
             } else {
-                let key: Vec<u64> = u.iter().map(|c| c.to_bits()).collect();
-                let mut from = 0;
-                if let Some((len, row)) = reuse.and_then(|r| r.rows.get(&key).map(|w| (r.len, w))) {
-                    k_row.clear();
-                    k_row.extend_from_slice(&row[..len]);
-                    v_row.clear();
-                    v_row.extend_from_slice(&row[len..]);
-                    from = len;
-                }
-                let mv = gp.predict_extending(u, from, &mut k_row, &mut v_row);
-                if let Some(rec) = record.as_deref_mut() {
-                    let mut row = Vec::with_capacity(2 * k_row.len());
-                    row.extend_from_slice(&k_row);
-                    row.extend_from_slice(&v_row);
-                    rec.rows.insert(key, row);
-                }
-                mv
+                let rows = (&mut k_row, &mut v_row);
+                predict_with_memo(gp, u, reuse, record.as_deref_mut(), rows)
             };
             let a = match acq {
                 AcquisitionKind::ExpectedImprovement => {
@@ -1385,36 +1438,8 @@ impl Optimizer {
             ..DirectSettings::default()
         };
         let res = direct::maximize(value, &lo, &hi, &ds, self.settings.polish_starts.max(1))?;
-        let mut best_u = res.x.clone();
-        let mut best_v = res.value;
-        if self.settings.polish_starts > 0 {
-            let mut dm = vec![0.0; d];
-            let mut dv = vec![0.0; d];
-            for (start, _) in res.top.iter().take(self.settings.polish_starts) {
-                let (u, v) = direct::polish(
-                    |u, g| {
-                        let (m, var) = gp.predict_with_grad(u, &mut dm, &mut dv);
-                        let a = match acq {
-                            AcquisitionKind::ExpectedImprovement => {
-                                acquisition::log_ei_with_grad(m, var, &dm, &dv, incumbent, xi, g)
-                            }
-                            AcquisitionKind::Ucb { beta } => {
-                                acquisition::ucb_with_grad(m, var, &dm, &dv, beta, g)
-                            }
-                        };
-                        a + self.tabu_penalty(u, Some(g))
-                    },
-                    start,
-                    &lo,
-                    &hi,
-                    self.settings.polish_iters,
-                );
-                if v > best_v && v.is_finite() {
-                    best_u = u;
-                    best_v = v;
-                }
-            }
-        }
+        let (best_u, best_v) =
+            self.polish_acquisition(gp, &res.top, incumbent, xi, (res.x, res.value));
         let (m, var) = gp.predict(&best_u);
         let ei = match acq {
             AcquisitionKind::ExpectedImprovement => {
@@ -1428,6 +1453,100 @@ impl Optimizer {
         };
         Ok((best_u, ei))
     }
+
+    /// `best` (DIRECT's maximum of the acquisition on `gp`), improved by an L-BFGS polish
+    /// from each of the first [`Settings::polish_starts`] of DIRECT's `top` points.
+    fn polish_acquisition(
+        &self,
+        gp: &Gp,
+        top: &[(Vec<f64>, f64)],
+        incumbent: f64,
+        xi: f64,
+        best: (Vec<f64>, f64),
+    ) -> (Vec<f64>, f64) {
+        let (mut best_u, mut best_v) = best;
+        if self.settings.polish_starts == 0 {
+            return (best_u, best_v);
+        }
+        let d = self.dim();
+        let (lo, hi) = (vec![0.0; d], vec![1.0; d]);
+        let acq = self.settings.acquisition;
+        let mut dm = vec![0.0; d];
+        let mut dv = vec![0.0; d];
+        for (start, _) in top.iter().take(self.settings.polish_starts) {
+            let (u, v) = direct::polish(
+                |u, g| {
+                    let (m, var) = gp.predict_with_grad(u, &mut dm, &mut dv);
+                    let a = match acq {
+                        AcquisitionKind::ExpectedImprovement => {
+                            acquisition::log_ei_with_grad(m, var, &dm, &dv, incumbent, xi, g)
+                        }
+                        AcquisitionKind::Ucb { beta } => {
+                            acquisition::ucb_with_grad(m, var, &dm, &dv, beta, g)
+                        }
+                    };
+                    a + self.tabu_penalty(u, Some(g))
+                },
+                start,
+                &lo,
+                &hi,
+                self.settings.polish_iters,
+            );
+            if v > best_v && v.is_finite() {
+                best_u = u;
+                best_v = v;
+            }
+        }
+        (best_u, best_v)
+    }
+}
+
+/// The posterior at `u` on `gp` through the kernel rows `rows` (`k`, `L^{-1} k`): those of
+/// the first conditioning points come from `reuse` when it kept them for `u`, and the full
+/// rows are kept in `record`.
+fn predict_with_memo(
+    gp: &Gp,
+    u: &[f64],
+    reuse: Option<&RowMemo>,
+    record: Option<&mut RowMemo>,
+    (k_row, v_row): (&mut Vec<f64>, &mut Vec<f64>),
+) -> (f64, f64) {
+    let key: Vec<u64> = u.iter().map(|c| c.to_bits()).collect();
+    let mut from = 0;
+    if let Some((len, row)) = reuse.and_then(|r| r.rows.get(&key).map(|w| (r.len, w))) {
+        k_row.clear();
+        k_row.extend_from_slice(&row[..len]);
+        v_row.clear();
+        v_row.extend_from_slice(&row[len..]);
+        from = len;
+    }
+    let mv = gp.predict_extending(u, from, k_row, v_row);
+    if let Some(rec) = record {
+        let mut row = Vec::with_capacity(2 * k_row.len());
+        row.extend_from_slice(k_row);
+        row.extend_from_slice(v_row);
+        rec.rows.insert(key, row);
+    }
+    mv
+}
+
+/// One model-based round of [`Optimizer::suggest`] (standardised outputs, unit cube).
+struct Round {
+    /// The model, with the lies of the points entered so far (not with qEI).
+    gp: Gp,
+    xi: f64,
+    incumbent: f64,
+    y_mean: f64,
+    y_min: f64,
+    /// The range of the modelled outputs, for the relative EI.
+    y_range: f64,
+    /// Observed, pending and proposed points: a maximiser among them is replaced.
+    taken: Vec<Vec<f64>>,
+    /// With qEI: the points pending or proposed, which enter the joint posterior.
+    chosen: Vec<Vec<f64>>,
+    /// With qEI: its number of base samples.
+    qei: Option<usize>,
+    qei_rng: Rng,
 }
 
 /// Kernel rows `k(u, x_i)` and `L^{-1} k` of the first `len` conditioning points at every

@@ -8,6 +8,7 @@
 //!   they are never dropped under congestion. Payloads that do not decode are handed to the
 //!   caller as errors (to count and log), never acted on.
 //! - [`alive`]: liveliness tokens and watching who is alive.
+//! - [`inbox`]: accepting the messages of one run, counting and logging the bad ones.
 //! - [`clouds`]: the contact-cloud channel: iceoryx2 shared memory when a metric agent listens
 //!   on the same host, Zenoh otherwise, chosen per message.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -16,12 +17,14 @@ pub mod alive;
 pub mod args;
 pub mod clouds;
 pub mod error;
+pub mod inbox;
 pub mod session;
 
 pub use alive::{AliveEvent, AliveWatch, Claim};
 pub use args::{BusArgs, BusMode};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
 pub use error::BusError;
+pub use inbox::Inbox;
 pub use session::{
     Bus, Incoming, RawSample, RawSubscription, Received, Server, Subscription, host_name,
     protocol_encoding, zenoh_encoding,

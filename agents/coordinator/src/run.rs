@@ -1,0 +1,307 @@
+//! The coordinator's async loop: it owns the bus, the timers and the journal, turns each
+//! event into one call of the [`Coordinator`] core and carries out the actions it returns.
+
+use std::time::Duration;
+
+use anyhow::Context;
+use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Server, Subscription, now_ms};
+use graspopt_journal::{Journal, ResultOutcome, RunStatus as JournalStatus};
+use graspopt_protocol::{
+    AgentKind, Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, TrialResult,
+};
+use tokio::sync::watch;
+
+use crate::CoordinatorConfig;
+use crate::core::{Action, Coordinator, Write};
+use crate::spec::{RunSpec, open_run};
+use crate::waits;
+
+/// A proposal request on its way to the planner.
+type PlannerCall<'a> = std::pin::Pin<
+    Box<dyn std::future::Future<Output = Result<SuggestReply, BusError>> + Send + 'a>,
+>;
+
+/// Runs the coordinator until the run finishes; returns the final status. `progress`
+/// receives every status published.
+pub async fn run(
+    bus: &Bus,
+    run: &RunId,
+    spec: &RunSpec,
+    config: &CoordinatorConfig,
+    resume: bool,
+    progress: Option<watch::Sender<RunStatus>>,
+) -> anyhow::Result<RunStatus> {
+    let forever = std::future::pending();
+    run_until(bus, run, spec, config, resume, progress, forever).await
+}
+
+/// [`run`], stopping early when `stop` resolves (Ctrl-C, say): the journal then records the
+/// run as stopped (every result already in stays; `--resume` continues it) and the status
+/// returned has the phase it had.
+pub async fn run_until(
+    bus: &Bus,
+    run: &RunId,
+    spec: &RunSpec,
+    config: &CoordinatorConfig,
+    resume: bool,
+    progress: Option<watch::Sender<RunStatus>>,
+    stop: impl std::future::Future<Output = ()>,
+) -> anyhow::Result<RunStatus> {
+    // Two coordinators on one run would issue each trial twice and fight over the journal.
+    let _place = bus
+        .wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
+        .await?;
+    let journal_path = config.journal_path(run);
+    let mut journal = Journal::open(&journal_path)
+        .with_context(|| format!("cannot open the journal {}", journal_path.display()))?;
+    let (spec, state) = open_run(&mut journal, run, spec, resume)?;
+    let engine_state = journal.planner_state(run.as_str())?;
+    let inputs = Inputs::open(bus, run).await?;
+    let _token = bus
+        .declare_alive(run, AgentKind::Coordinator, &config.id)
+        .await?;
+    let mut core = Coordinator::new(run, spec, state, engine_state, config.lease_ms, now_ms());
+    let mut io = Io {
+        bus,
+        run,
+        journal: &mut journal,
+        progress,
+        planner_timeout: Duration::from_millis(config.planner_timeout_ms),
+    };
+    let period = Duration::from_millis(config.status_period_ms.max(20));
+    if drive(&mut core, &inputs, &mut io, period, stop).await? {
+        io.stopped(&core, &journal_path)
+    } else {
+        io.finished(&core).await
+    }
+}
+
+/// What the coordinator listens to.
+struct Inputs {
+    results: Subscription<TrialResult>,
+    objects: Subscription<ObjectEstimate>,
+    hands: AliveWatch,
+    metrics: AliveWatch,
+    planners: AliveWatch,
+    state_server: Server<RunStatus>,
+}
+
+impl Inputs {
+    async fn open(bus: &Bus, run: &RunId) -> anyhow::Result<Inputs> {
+        let alive = |kind| run.alive_kind_key(kind);
+        Ok(Inputs {
+            results: bus.subscribe(&run.result_key()).await?,
+            objects: bus.subscribe(&run.object_key()).await?,
+            hands: bus.watch_alive(&alive(AgentKind::Hand)).await?,
+            // Trials wait for a metric agent: clouds published before one listens would be
+            // lost.
+            metrics: bus.watch_alive(&alive(AgentKind::Metric)).await?,
+            // A planner (re)appearing answers at once: a question in flight when the
+            // network was cut would otherwise wait for its timeout.
+            planners: bus.watch_alive(&alive(AgentKind::Planner)).await?,
+            state_server: bus.serve(&run.state_key()).await?,
+        })
+    }
+}
+
+/// Feeds events to `core` until the run finishes (false) or `stop` resolves (true). The
+/// planner's answer is awaited beside everything else, so results, leases and workers are
+/// still handled while it thinks or while the bus cannot reach it.
+async fn drive<'a>(
+    core: &mut Coordinator,
+    inputs: &Inputs,
+    io: &mut Io<'a>,
+    status_period: Duration,
+    stop: impl std::future::Future<Output = ()>,
+) -> anyhow::Result<bool> {
+    tokio::pin!(stop);
+    let mut tick = tokio::time::interval(status_period);
+    let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
+    let mut planning: Option<PlannerCall<'a>> = None;
+    let mut inbox = Inbox::new("coordinator", core.run());
+    loop {
+        if core.finished() {
+            return Ok(false);
+        }
+        let actions = core.poll(now_ms())?;
+        io.apply(actions, &mut planning).await?;
+        let actions = tokio::select! {
+            reply = async {
+                match planning.as_mut() {
+                    Some(call) => call.await,
+                    None => std::future::pending().await,
+                }
+            }, if planning.is_some() => {
+                planning = None;
+                core.on_reply(reply, now_ms())?
+            },
+            Some(r) = inputs.results.recv() => match inbox.accept(r, "result") {
+                Some(result) => core.on_result(&result, now_ms()),
+                None => bad(core),
+            },
+            Some(r) = inputs.objects.recv() => match inbox.accept(r, "object estimate") {
+                Some(estimate) => {
+                    core.on_estimate(&estimate)?;
+                    Vec::new()
+                }
+                None => bad(core),
+            },
+            Some(ev) = inputs.hands.recv() => {
+                core.on_hand(&ev.agent, ev.alive);
+                Vec::new()
+            },
+            Some(ev) = inputs.planners.recv() => core.on_planner_alive(&ev.agent, ev.alive, now_ms()),
+            Some(ev) = inputs.metrics.recv() => {
+                core.on_metric(&ev.agent, ev.alive, now_ms());
+                Vec::new()
+            },
+            Some(q) = inputs.state_server.recv() => {
+                let _ = q.reply(&core.status(now_ms())).await;
+                Vec::new()
+            },
+            _ = lease_tick.tick() => {
+                core.on_lease_tick(now_ms());
+                Vec::new()
+            },
+            _ = &mut stop => return Ok(true),
+            _ = tick.tick() => core.on_status_tick(now_ms()),
+        };
+        io.apply(actions, &mut planning).await?;
+    }
+}
+
+/// Counts a message that was not acted on; nothing to do.
+fn bad(core: &mut Coordinator) -> Vec<Action> {
+    core.on_bad_message();
+    Vec::new()
+}
+
+/// What carries out the core's actions.
+struct Io<'a> {
+    bus: &'a Bus,
+    run: &'a RunId,
+    journal: &'a mut Journal,
+    progress: Option<watch::Sender<RunStatus>>,
+    planner_timeout: Duration,
+}
+
+impl<'a> Io<'a> {
+    async fn apply(
+        &mut self,
+        actions: Vec<Action>,
+        planning: &mut Option<PlannerCall<'a>>,
+    ) -> anyhow::Result<()> {
+        for action in actions {
+            match action {
+                Action::Record(write) => self.record(write)?,
+                Action::Send {
+                    worker,
+                    encoding,
+                    command,
+                } => {
+                    let key = self.run.command_key(&worker);
+                    self.bus.put(&key, &command, encoding).await?;
+                }
+                Action::Ask(request) => {
+                    let (bus, key) = (self.bus, self.run.suggest_key());
+                    let timeout = self.planner_timeout;
+                    *planning = Some(Box::pin(
+                        async move { bus.query(&key, &request, timeout).await },
+                    ));
+                }
+                Action::CancelAsk => *planning = None,
+                Action::Publish(s) => {
+                    let key = self.run.status_key();
+                    let _ = self.bus.put_droppable(&key, &s, Encoding::Bincode).await;
+                }
+                Action::Progress(s) => {
+                    if let Some(p) = &self.progress {
+                        let _ = p.send(s);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, write: Write) -> anyhow::Result<()> {
+        let run = self.run.as_str();
+        match write {
+            Write::Issue(issue) => self.journal.record_issue(&issue)?,
+            Write::Failure {
+                trial_id,
+                attempt,
+                error,
+                at_ms,
+            } => {
+                self.journal
+                    .record_failure(run, trial_id, attempt, &error, at_ms)?;
+            }
+            Write::Result(r) => match self.journal.record_result(&r)? {
+                ResultOutcome::Accepted => {}
+                other => tracing::warn!(
+                    "coordinator: journal says {other:?} for trial {}",
+                    r.trial_id
+                ),
+            },
+            Write::PlannerState { engine, at_ms } => {
+                if let Err(e) = self.journal.set_planner_state(run, &engine, at_ms) {
+                    tracing::warn!(
+                        "coordinator: cannot keep the planner's state in the journal: {e}"
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The run finished: recorded, its final status published.
+    async fn finished(self, core: &Coordinator) -> anyhow::Result<RunStatus> {
+        let run = self.run.as_str();
+        self.journal
+            .set_run_status(run, JournalStatus::Finished, now_ms())?;
+        let s = core.status_at(RunPhase::Finished, now_ms());
+        let _ = self
+            .bus
+            .put(&self.run.status_key(), &s, Encoding::Bincode)
+            .await;
+        if let Some(p) = &self.progress {
+            let _ = p.send(s.clone());
+        }
+        Ok(s)
+    }
+
+    /// The run was stopped: recorded, and said how to go on.
+    fn stopped(self, core: &Coordinator, path: &std::path::Path) -> anyhow::Result<RunStatus> {
+        let run = self.run;
+        self.journal
+            .set_run_status(run.as_str(), JournalStatus::Stopped, now_ms())?;
+        let s = core.status(now_ms());
+        let waiting = if s.waiting.is_empty() {
+            String::new()
+        } else {
+            let waits = waits::describe(&s.waiting, s.stamp_ms);
+            format!(" while waiting ({waits})")
+        };
+        // A run that issued no trial is started afresh by the same command (see `open_run`).
+        let unstarted = s.completed + s.failed + s.running == 0
+            && self
+                .journal
+                .trials(run.as_str())
+                .is_ok_and(|t| t.is_empty());
+        let next = if unstarted {
+            "no trial was issued: the same command starts it afresh"
+        } else {
+            "resume with --resume"
+        };
+        tracing::warn!(
+            "coordinator: run {run:?} stopped with {} of {} trials completed ({} failed, {} running){waiting}; every result is in {}; {next}",
+            s.completed,
+            s.budget,
+            s.failed,
+            s.running,
+            path.display()
+        );
+        Ok(s)
+    }
+}

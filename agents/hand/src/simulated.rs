@@ -1,0 +1,107 @@
+//! The simulated hand: a [`HandDriver`] on the grasp simulator.
+
+use anyhow::Context;
+use graspopt_convert::{TrialTag, clouds_from_outcome, isometry};
+use graspopt_protocol::{ObjectEstimate, TrialCommand};
+use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
+
+use crate::HandConfig;
+use crate::driver::{HandDriver, HandError, HandReading};
+
+/// A simulated hand in a simulated world: the world holds the configured object, or the one
+/// perception names at its true pose.
+#[derive(Debug)]
+pub struct SimulatedHand {
+    hand: Box<dyn Hand>,
+    settings: ContactModelSettings,
+    config: HandConfig,
+    world: Option<Object>,
+    /// The object the estimate that built `world` named.
+    world_name: Option<String>,
+}
+
+impl SimulatedHand {
+    /// The hand `config.hand` in the world of `config` (empty until an object estimate
+    /// arrives when no object is configured).
+    pub fn new(config: &HandConfig) -> anyhow::Result<SimulatedHand> {
+        Ok(SimulatedHand {
+            hand: hand_by_name(&config.hand).context("hand agent")?,
+            settings: ContactModelSettings::default(),
+            config: config.clone(),
+            world: world_object(config, None),
+            world_name: None,
+        })
+    }
+
+    /// Executes one command on `world` (the object at its true pose).
+    pub fn execute_on(
+        &self,
+        world: &Object,
+        command: &TrialCommand,
+    ) -> Result<HandReading, HandError> {
+        let palm = isometry(&command.palm_pose);
+        let outcome = run_trial(world, self.hand.as_ref(), &palm, &self.settings)
+            .map_err(|e| HandError(format!("hand could not execute the trial: {e}")))?;
+        let tag = TrialTag {
+            run_id: command.run_id.clone(),
+            trial_id: command.trial_id,
+            attempt: command.attempt,
+            worker: command.worker.clone(),
+        };
+        let clouds = clouds_from_outcome(&tag, &outcome, 0);
+        Ok(HandReading {
+            palm_pose: clouds.palm_pose,
+            fingers: clouds.fingers,
+            min_gap: clouds.min_gap,
+        })
+    }
+}
+
+impl HandDriver for SimulatedHand {
+    fn hand(&self) -> Option<&str> {
+        Some(self.hand.name())
+    }
+
+    fn needs_object(&self) -> bool {
+        self.world.is_none()
+    }
+
+    /// Builds the world from the estimate when it has none yet, or when no object is
+    /// configured and the estimate names another object.
+    fn set_object(&mut self, estimate: &ObjectEstimate) {
+        let follows = self.config.object.is_none() && self.config.mesh.is_none();
+        if self.world.is_none() || (follows && self.world_name.as_deref() != Some(&estimate.object))
+        {
+            self.world = world_object(&self.config, Some(estimate));
+            self.world_name = Some(estimate.object.clone());
+        }
+    }
+
+    fn execute(&mut self, command: &TrialCommand) -> Result<HandReading, HandError> {
+        match &self.world {
+            Some(world) => self.execute_on(world, command),
+            None => Err(HandError("the hand's world holds no object".into())),
+        }
+    }
+}
+
+/// The world's object: the configured one, or the one the estimate names at its true pose.
+pub fn world_object(config: &HandConfig, estimate: Option<&ObjectEstimate>) -> Option<Object> {
+    let loaded = match (&config.mesh, &config.object, estimate) {
+        (Some(path), _, _) => Object::from_file_scaled(path, config.mesh_scale),
+        (None, Some(name), _) => Object::by_name(name),
+        (None, None, Some(e)) => {
+            let mut truth = e.clone();
+            truth.pose = graspopt_protocol::Pose::IDENTITY;
+            graspopt_convert::object_from_estimate(&truth)
+        }
+        (None, None, None) => return None,
+    };
+    match loaded {
+        Ok(o) => Some(o),
+        Err(e) => {
+            tracing::error!("hand {}: cannot build the world's object: {e}", config.id);
+            None
+        }
+    }
+}
