@@ -115,6 +115,12 @@ fn clip(poly: &[Vector], n: Vector, offset: f64) -> Option<Vec<Vector>> {
     if f.iter().all(|v| *v <= 0.0) {
         return Some(poly.to_vec());
     }
+    clip_where(poly, &f)
+}
+
+/// The part of the convex polygon `poly` where the linear interpolation of the values `f` at
+/// its corners is at most 0 (`None` when empty).
+pub(super) fn clip_where(poly: &[Vector], f: &[f64]) -> Option<Vec<Vector>> {
     if f.iter().all(|v| *v > 0.0) {
         return None;
     }
@@ -133,7 +139,7 @@ fn clip(poly: &[Vector], n: Vector, offset: f64) -> Option<Vec<Vector>> {
 }
 
 /// Area and centroid of a planar convex polygon in 3D (`None` when degenerate).
-fn polygon_area(poly: &[Vector]) -> Option<(f64, Vector)> {
+pub(super) fn polygon_area(poly: &[Vector]) -> Option<(f64, Vector)> {
     let mut area = 0.0;
     let mut moment = Vector::ZERO;
     for k in 1..poly.len() - 1 {

@@ -487,28 +487,7 @@ impl RegionBuilder<'_> {
 /// The part of the triangle `q` where the linear interpolation of `f` is at most 0: area and
 /// centroid (`None` when empty).
 fn clip(q: [Vector; 3], f: [f64; 3]) -> Option<(f64, Vector)> {
-    let mut poly: Vec<Vector> = Vec::with_capacity(4);
-    for i in 0..3 {
-        let j = (i + 1) % 3;
-        if f[i] <= 0.0 {
-            poly.push(q[i]);
-        }
-        if (f[i] <= 0.0) != (f[j] <= 0.0) {
-            let t = f[i] / (f[i] - f[j]);
-            poly.push(q[i] + (q[j] - q[i]) * t);
-        }
-    }
-    if poly.len() < 3 {
-        return None;
-    }
-    let mut area = 0.0;
-    let mut moment = Vector::ZERO;
-    for k in 1..poly.len() - 1 {
-        let a = 0.5 * (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]).length();
-        area += a;
-        moment += (poly[0] + poly[k] + poly[k + 1]) * (a / 3.0);
-    }
-    (area > 0.0).then(|| (area, moment / area))
+    cuboid::clip_where(&q, &f).and_then(|poly| cuboid::polygon_area(&poly))
 }
 
 /// The contact region of one link at `link_world` (world pose of the link frame): the object's
