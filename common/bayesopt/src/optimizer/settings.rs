@@ -1,0 +1,250 @@
+//! The optimizer's settings: batch strategy, initial design, stopping and restart rules.
+
+use super::*;
+
+/// Value assumed for pending points when proposing a batch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum BatchStrategy {
+    /// Kriging believer: the posterior mean at the pending point.
+    #[default]
+    KrigingBeliever,
+    /// Constant liar with the worst observed value (pessimistic, spreads points most).
+    ConstantLiarMin,
+    /// Constant liar with the mean of the observations.
+    ConstantLiarMean,
+    /// Constant liar with the best observed value (optimistic).
+    ConstantLiarMax,
+    /// Sequential-greedy q-Expected-Improvement (see [`crate::qei`]): each point of a round
+    /// after the first (every point when others are pending) maximises the joint qEI of the
+    /// pending points, the round's earlier points and itself under the GP's joint posterior,
+    /// estimated with `samples` fixed base samples of the others and the candidate's own
+    /// value integrated exactly, maximised by DIRECT and a short finite-difference polish. No
+    /// fantasy values; rounds of more than one point (or with points pending) are not
+    /// diversified (see [`Settings::diversify_every`]): measured on Hartmann6, qEI with the
+    /// diversification rounds was no better than the kriging believer. The qEI points are
+    /// chosen by (q)EI whatever [`Settings::acquisition`] says (it picks the round's first
+    /// point), and [`Settings::explore_below_ei`] does not apply to them.
+    Qei {
+        /// Base samples per maximisation (1 to [`MAX_QEI_SAMPLES`]).
+        samples: usize,
+    },
+}
+
+/// How the points of the initial design are placed (the first epoch's; a restarted epoch's
+/// points are always uniform).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum InitialDesign {
+    /// Independent uniform points (the thesis's random initial design).
+    #[default]
+    Random,
+    /// A Latin hypercube (one point in each of `n` equal slices of every axis), the one with
+    /// the largest smallest pairwise distance among `candidates` random ones, so a small design
+    /// leaves no large region unsampled.
+    MaximinLatinHypercube {
+        /// Random Latin hypercubes compared (>= 1).
+        candidates: usize,
+    },
+}
+
+/// When to stop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StopRule {
+    /// Stop once this many observations are in (None: no budget).
+    pub budget: Option<usize>,
+    /// Stop on small EI only after this many observations (None: 10 x d).
+    pub min_evals: Option<usize>,
+    /// Threshold on the best EI divided by the observed range of y (of the current epoch,
+    /// after the output transform if any; see [`RoundInfo::relative_ei`]).
+    pub relative_ei_threshold: f64,
+    /// Number of consecutive proposal rounds below the threshold needed to stop.
+    pub patience: usize,
+}
+
+impl Default for StopRule {
+    fn default() -> Self {
+        StopRule {
+            budget: None,
+            min_evals: None,
+            relative_ei_threshold: 1e-6,
+            patience: 3,
+        }
+    }
+}
+
+/// Restart of a stagnating search (trust-region-style): once the best value of the current
+/// epoch has not improved by more than `tol` times the epoch's observed range over its last
+/// `window` observations, a new epoch starts with `init` random points and a model of the new
+/// epoch's observations only, and the acquisition is penalised inside a ball of radius
+/// `tabu_radius * sqrt(d)` (unit cube) around the incumbent of every earlier epoch, so the
+/// search looks for another basin instead of polishing the old one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RestartRule {
+    /// Observations without significant improvement before restarting (>= 1).
+    pub window: usize,
+    /// Significant improvement, as a fraction of the epoch's observed range of y.
+    pub tol: f64,
+    /// Random points at the start of each new epoch (>= 2).
+    pub init: usize,
+    /// Radius of the balls around earlier incumbents, as a fraction of `sqrt(d)`.
+    pub tabu_radius: f64,
+}
+
+/// Why the optimizer says to stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StopReason {
+    /// The evaluation budget is used up.
+    Budget,
+    /// The best EI stayed below the threshold for `patience` rounds after `min_evals`.
+    SmallExpectedImprovement,
+}
+
+/// Engine settings. Defaults follow the thesis (Matern 3/2, EI with xi = sigma_f^2/100,
+/// DIRECT) plus the robustness measures listed in the module doc.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Minimise instead of maximise.
+    pub minimize: bool,
+    /// Kernel family.
+    pub kernel: KernelKind,
+    /// Size of the initial design (None: `max(5, ceil(5 d / 3))`, i.e. 5 in 2D, 10 in 6D).
+    pub n_init: Option<usize>,
+    /// Placement of the initial design.
+    #[serde(default)]
+    pub initial_design: InitialDesign,
+    /// Acquisition function.
+    pub acquisition: AcquisitionKind,
+    /// EI exploration margin rule (thesis default `sigma_f^2 / 100`).
+    pub xi: XiRule,
+    /// Hyperparameter priors, bounds and effort.
+    pub fit: FitSettings,
+    /// Random restarts of the fit every this many proposal rounds (1 = always; others are
+    /// warm-started only).
+    pub full_refit_every: usize,
+    /// DIRECT budget per input dimension for the acquisition maximisation.
+    pub direct_evals_per_dim: usize,
+    /// Local polish starts (best DIRECT centres); 0 disables the polish.
+    pub polish_starts: usize,
+    /// L-BFGS iterations per polish start.
+    pub polish_iters: usize,
+    /// Batch strategy for pending points.
+    pub batch: BatchStrategy,
+    /// When the best EI (standardised units) falls below this, propose instead the most
+    /// uncertain of 100 d random candidates (a space-filling exploration step that helps leave
+    /// a local optimum in higher dimensions). None disables it.
+    pub explore_below_ei: Option<f64>,
+    /// GP prior mean at this quantile of the (transformed) observations instead of their
+    /// mean (None: the mean). Low quantiles are pessimistic away from data.
+    pub prior_mean_quantile: Option<f64>,
+    /// Every this many proposal rounds (0 = never), the first point of the round is the
+    /// second point of a pessimistic constant-liar batch: the EI maximiser is assumed to be as
+    /// bad as the worst observation and the next EI maximiser is proposed instead, which
+    /// moves the search away from an exhausted local optimum. With [`BatchStrategy::Qei`],
+    /// only rounds of one point with nothing pending are diversified.
+    pub diversify_every: usize,
+    /// How many pessimistic fantasies a diversification round stacks (>= 1).
+    pub diversify_depth: usize,
+    /// Monotone transform of the outputs applied before standardising.
+    pub output_transform: OutputTransform,
+    /// Restart of a stagnating search (None: off). See [`RestartRule`].
+    #[serde(default)]
+    pub restart: Option<RestartRule>,
+    /// Stopping rule.
+    pub stop: StopRule,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            minimize: false,
+            kernel: KernelKind::Matern32,
+            n_init: None,
+            initial_design: InitialDesign::Random,
+            acquisition: AcquisitionKind::ExpectedImprovement,
+            xi: XiRule::ThesisSignalVariance,
+            fit: FitSettings::default(),
+            full_refit_every: 10,
+            direct_evals_per_dim: 150,
+            polish_starts: 3,
+            polish_iters: 30,
+            batch: BatchStrategy::KrigingBeliever,
+            output_transform: OutputTransform::None,
+            prior_mean_quantile: None,
+            diversify_every: 0,
+            diversify_depth: 1,
+            explore_below_ei: None,
+            restart: None,
+            stop: StopRule::default(),
+        }
+    }
+}
+
+impl Settings {
+    /// Settings for grasp scores: the thesis's (the defaults) with the bad tail of the
+    /// outputs compressed ([`OutputTransform::TailLog`]) and a space-filling initial design
+    /// ([`InitialDesign::MaximinLatinHypercube`] of 50 candidates). A trial that misses the
+    /// object scores far below every grasp; without the compression those few values set the
+    /// model's scale. The best of the settings measured on the simulator's seven objects
+    /// (`graspopt experiment bo`, docs/benchmarks.md); maximising.
+    pub fn for_grasps() -> Self {
+        Settings {
+            output_transform: OutputTransform::TailLog,
+            initial_design: InitialDesign::MaximinLatinHypercube { candidates: 50 },
+            ..Settings::default()
+        }
+    }
+
+    /// Default initial-design size for dimension `d`.
+    pub fn default_n_init(d: usize) -> usize {
+        (5 * d).div_ceil(3).max(5)
+    }
+
+    pub(super) fn validate(&self) -> Result<()> {
+        self.fit.validate()?;
+        if self.direct_evals_per_dim == 0 || self.full_refit_every == 0 {
+            return Err(BoError::InvalidSetting(
+                "direct_evals_per_dim and full_refit_every must be >= 1".into(),
+            ));
+        }
+        match self.xi {
+            XiRule::Fixed(v) | XiRule::SignalVarianceTimes(v) if !(v >= 0.0 && v.is_finite()) => {
+                return Err(BoError::InvalidSetting(format!("xi must be >= 0, got {v}")));
+            }
+            _ => {}
+        }
+        if let AcquisitionKind::Ucb { beta } = self.acquisition
+            && !(beta > 0.0 && beta.is_finite())
+        {
+            return Err(BoError::InvalidSetting(format!(
+                "UCB beta must be > 0, got {beta}"
+            )));
+        }
+        if let Some(r) = self.restart
+            && !(r.tol >= 0.0
+                && r.tol.is_finite()
+                && r.tabu_radius >= 0.0
+                && r.tabu_radius.is_finite())
+        {
+            return Err(BoError::InvalidSetting(
+                "restart tol and tabu_radius must be finite and >= 0".into(),
+            ));
+        }
+        if let BatchStrategy::Qei { samples } = self.batch
+            && !(1..=MAX_QEI_SAMPLES).contains(&samples)
+        {
+            return Err(BoError::InvalidSetting(format!(
+                "a qEI batch strategy needs 1 to {MAX_QEI_SAMPLES} samples, got {samples}"
+            )));
+        }
+        if let InitialDesign::MaximinLatinHypercube { candidates: 0 } = self.initial_design {
+            return Err(BoError::InvalidSetting(
+                "a Latin hypercube design needs candidates >= 1".into(),
+            ));
+        }
+        if self.stop.relative_ei_threshold.is_nan() || self.stop.relative_ei_threshold < 0.0 {
+            return Err(BoError::InvalidSetting(
+                "relative_ei_threshold must be >= 0".into(),
+            ));
+        }
+        Ok(())
+    }
+}
