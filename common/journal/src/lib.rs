@@ -16,6 +16,7 @@
 mod error;
 pub mod export;
 mod journal;
+mod rows;
 mod schema;
 mod types;
 
