@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Server, Subscription, now_ms};
-use graspopt_journal::{Journal, ResultOutcome, RunStatus as JournalStatus};
+use graspopt_journal::{Journal, ResultOutcome, RunLifecycle};
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, TrialResult,
 };
@@ -259,7 +259,7 @@ impl<'a> Io<'a> {
     async fn finished(self, core: &Coordinator) -> anyhow::Result<RunStatus> {
         let run = self.run.as_str();
         self.journal
-            .set_run_status(run, JournalStatus::Finished, now_ms())?;
+            .set_run_status(run, RunLifecycle::Finished, now_ms())?;
         let s = core.status_at(RunPhase::Finished, now_ms());
         let _ = self
             .bus
@@ -275,7 +275,7 @@ impl<'a> Io<'a> {
     fn stopped(self, core: &Coordinator, path: &std::path::Path) -> anyhow::Result<RunStatus> {
         let run = self.run;
         self.journal
-            .set_run_status(run.as_str(), JournalStatus::Stopped, now_ms())?;
+            .set_run_status(run.as_str(), RunLifecycle::Stopped, now_ms())?;
         let s = core.status(now_ms());
         let waiting = if s.waiting.is_empty() {
             String::new()

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{Context, bail};
 use graspopt_bus::now_ms;
-use graspopt_journal::{Journal, RunRecord, RunStatus as JournalStatus, TrialState, event_kind};
+use graspopt_journal::{Journal, RunLifecycle, RunRecord, TrialState, event_kind};
 use graspopt_protocol::{ObjectEstimate, PlannerMethod, RunId};
 use graspopt_sim::{ParamKind, ParamSpec, TrialSpace, reference_pose};
 use serde::{Deserialize, Serialize};
@@ -264,7 +264,7 @@ pub fn open_run(
                 created_ms: now_ms(),
                 config_json: serde_json::to_string(spec)?,
                 param_names: param_names(spec),
-                status: JournalStatus::Running,
+                status: RunLifecycle::Running,
             })?;
             spec.clone()
         }
@@ -299,8 +299,8 @@ fn continue_run(
     } else {
         recorded
     };
-    if record.status != JournalStatus::Running {
-        journal.set_run_status(run.as_str(), JournalStatus::Running, now_ms())?;
+    if record.status != RunLifecycle::Running {
+        journal.set_run_status(run.as_str(), RunLifecycle::Running, now_ms())?;
     }
     Ok(spec)
 }
@@ -420,13 +420,13 @@ mod tests {
         let (started, _) = open_run(&mut journal, &run, &spec(5), true).unwrap();
         assert_eq!(started.trials, 5);
         journal
-            .set_run_status("r", JournalStatus::Finished, 10)
+            .set_run_status("r", RunLifecycle::Finished, 10)
             .unwrap();
         let (resumed, state) = open_run(&mut journal, &run, &spec(8), true).unwrap();
         assert_eq!(resumed.trials, 8);
         assert!(!state.finished());
         let record = journal.run("r").unwrap().unwrap();
-        assert_eq!(record.status, JournalStatus::Running);
+        assert_eq!(record.status, RunLifecycle::Running);
         let stored: RunSpec = serde_json::from_str(&record.config_json).unwrap();
         assert_eq!(stored.trials, 8);
         // The same budget again (or less) leaves the record as it is.
@@ -457,13 +457,13 @@ mod tests {
         open_run(&mut journal, &run, &spec(5), false).unwrap();
         journal.set_planner_state("r", &[1, 2, 3], 5).unwrap();
         journal
-            .set_run_status("r", JournalStatus::Stopped, 10)
+            .set_run_status("r", RunLifecycle::Stopped, 10)
             .unwrap();
         let (again, state) = open_run(&mut journal, &run, &spec(7), false).unwrap();
         assert_eq!(again, spec(7));
         assert_eq!(state.trial_count(), 0);
         let record = journal.run("r").unwrap().unwrap();
-        assert_eq!(record.status, JournalStatus::Running);
+        assert_eq!(record.status, RunLifecycle::Running);
         assert_eq!(
             serde_json::from_str::<RunSpec>(&record.config_json).unwrap(),
             spec(7)

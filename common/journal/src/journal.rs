@@ -9,7 +9,7 @@ use crate::error::{JournalError, Result};
 use crate::rows::{run_from_row, trial_from_row, u64_col};
 use crate::schema;
 use crate::types::{
-    EventRow, ResultOutcome, RunExport, RunRecord, RunStatus, StateCounts, TrialIssue,
+    EventRow, ResultOutcome, RunExport, RunLifecycle, RunRecord, StateCounts, TrialIssue,
     TrialResultRecord, TrialRow, TrialState, event_kind,
 };
 
@@ -154,7 +154,7 @@ impl Journal {
     }
 
     /// Sets a run's status; [`JournalError::UnknownRun`] if there is no such run.
-    pub fn set_run_status(&mut self, run_id: &str, status: RunStatus, at_ms: i64) -> Result<()> {
+    pub fn set_run_status(&mut self, run_id: &str, status: RunLifecycle, at_ms: i64) -> Result<()> {
         let tx = self.write_tx()?;
         let n = tx.execute(
             "UPDATE runs SET status = ?2, status_ms = ?3 WHERE run_id = ?1",

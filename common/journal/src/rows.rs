@@ -3,7 +3,7 @@
 use rusqlite::Row;
 use rusqlite::types::Type;
 
-use crate::types::{MetricValues, RunRecord, RunStatus, TrialRow, TrialState};
+use crate::types::{MetricValues, RunLifecycle, RunRecord, TrialRow, TrialState};
 
 pub(crate) fn conversion_error(
     idx: usize,
@@ -23,7 +23,7 @@ pub(crate) fn run_from_row(r: &Row<'_>) -> rusqlite::Result<RunRecord> {
     let param_names: Vec<String> =
         serde_json::from_str(&names).map_err(|e| conversion_error(3, Type::Text, e))?;
     let status: String = r.get(4)?;
-    let status = RunStatus::parse(&status)
+    let status = RunLifecycle::parse(&status)
         .ok_or_else(|| conversion_error(4, Type::Text, format!("unknown run status {status:?}")))?;
     Ok(RunRecord {
         run_id: r.get(0)?,

@@ -12,34 +12,34 @@ pub struct RunRecord {
     pub config_json: String,
     /// Names of the search-space dimensions, in the order of `TrialIssue::params`.
     pub param_names: Vec<String>,
-    pub status: RunStatus,
+    pub status: RunLifecycle,
 }
 
 /// Lifecycle of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum RunStatus {
+pub enum RunLifecycle {
     Running,
     Finished,
     Stopped,
 }
 
-impl RunStatus {
+impl RunLifecycle {
     /// The text stored in the database (the serde name).
     pub fn as_str(self) -> &'static str {
         match self {
-            RunStatus::Running => "running",
-            RunStatus::Finished => "finished",
-            RunStatus::Stopped => "stopped",
+            RunLifecycle::Running => "running",
+            RunLifecycle::Finished => "finished",
+            RunLifecycle::Stopped => "stopped",
         }
     }
 
-    /// Inverse of [`RunStatus::as_str`].
-    pub fn parse(s: &str) -> Option<RunStatus> {
+    /// Inverse of [`RunLifecycle::as_str`].
+    pub fn parse(s: &str) -> Option<RunLifecycle> {
         match s {
-            "running" => Some(RunStatus::Running),
-            "finished" => Some(RunStatus::Finished),
-            "stopped" => Some(RunStatus::Stopped),
+            "running" => Some(RunLifecycle::Running),
+            "finished" => Some(RunLifecycle::Finished),
+            "stopped" => Some(RunLifecycle::Stopped),
             _ => None,
         }
     }

@@ -391,11 +391,11 @@ fn durability_reopen_and_wal_reader() {
         assert_eq!(reader.trials(RUN).unwrap().len(), 2);
         assert_eq!(reader.counts(RUN).unwrap().running, 1);
         writer
-            .set_run_status(RUN, RunStatus::Finished, 900)
+            .set_run_status(RUN, RunLifecycle::Finished, 900)
             .unwrap();
         assert_eq!(
             reader.run(RUN).unwrap().unwrap().status,
-            RunStatus::Finished
+            RunLifecycle::Finished
         );
     }
     let reopened = Journal::open(&db).unwrap();
@@ -414,7 +414,7 @@ fn durability_reopen_and_wal_reader() {
     assert_eq!(
         run,
         RunRecord {
-            status: RunStatus::Finished,
+            status: RunLifecycle::Finished,
             ..run_record(RUN)
         }
     );

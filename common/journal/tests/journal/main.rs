@@ -9,8 +9,9 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use graspopt_journal::export::{write_csv, write_json};
 use graspopt_journal::{
-    EventRow, Journal, JournalError, MetricValues, ResultOutcome, RunExport, RunRecord, RunStatus,
-    SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+    EventRow, Journal, JournalError, MetricValues, ResultOutcome, RunExport, RunLifecycle,
+    RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState,
+    event_kind,
 };
 
 // ------------------------------------------------------------------ helpers
@@ -53,7 +54,7 @@ fn run_record(run_id: &str) -> RunRecord {
         created_ms: 1_000,
         config_json: r#"{"objective":"epsilon","budget":50,"hand":{"fingers":3}}"#.to_string(),
         param_names: vec!["approach_x".into(), "roll".into(), "aperture".into()],
-        status: RunStatus::Running,
+        status: RunLifecycle::Running,
     }
 }
 
@@ -273,11 +274,14 @@ fn create_run_idempotent_and_config_mismatch() {
     let ids: Vec<String> = j.runs().unwrap().into_iter().map(|r| r.run_id).collect();
     assert_eq!(ids, ["z-early", RUN, "a-late"]);
 
-    j.set_run_status("a-late", RunStatus::Stopped, 6_000)
+    j.set_run_status("a-late", RunLifecycle::Stopped, 6_000)
         .unwrap();
-    assert_eq!(j.run("a-late").unwrap().unwrap().status, RunStatus::Stopped);
+    assert_eq!(
+        j.run("a-late").unwrap().unwrap().status,
+        RunLifecycle::Stopped
+    );
     let err = j
-        .set_run_status("ghost", RunStatus::Stopped, 6_000)
+        .set_run_status("ghost", RunLifecycle::Stopped, 6_000)
         .unwrap_err();
     assert!(
         matches!(&err, JournalError::UnknownRun(r) if r == "ghost"),
@@ -288,7 +292,7 @@ fn create_run_idempotent_and_config_mismatch() {
     j.set_run_config("a-late", r#"{"trials":90}"#).unwrap();
     let late = j.run("a-late").unwrap().unwrap();
     assert_eq!(late.config_json, r#"{"trials":90}"#);
-    assert_eq!(late.status, RunStatus::Stopped);
+    assert_eq!(late.status, RunLifecycle::Stopped);
     assert!(matches!(
         j.set_run_config("ghost", "{}").unwrap_err(),
         JournalError::UnknownRun(r) if r == "ghost"
