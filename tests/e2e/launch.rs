@@ -8,7 +8,7 @@ use crate::support::{
     check_journal, completed_now, free_port, graspopt_bin, journal_best, repo_root, tempdir,
     wait_until,
 };
-use graspopt_journal::{Journal, RunStatus, TrialState};
+use graspopt_journal::{Journal, RunLifecycle, TrialState};
 
 #[test]
 fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
@@ -165,5 +165,5 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journ
         );
     }
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("lr").unwrap().unwrap().status, RunStatus::Finished);
+    assert_eq!(j.run("lr").unwrap().unwrap().status, RunLifecycle::Finished);
 }

@@ -7,7 +7,7 @@ use std::time::Duration;
 use crate::support::{
     Cluster, Proc, check_journal, completed_now, graspopt, signal, tempdir, wait_until,
 };
-use graspopt_journal::{Journal, RunStatus, TrialState};
+use graspopt_journal::{Journal, RunLifecycle, TrialState};
 
 fn text(o: &std::process::Output) -> String {
     format!(
@@ -48,7 +48,10 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
     }
     let j = Journal::open(&journal).unwrap();
     assert_eq!(j.trials("run").unwrap().len(), 12);
-    assert_eq!(j.run("run").unwrap().unwrap().status, RunStatus::Finished);
+    assert_eq!(
+        j.run("run").unwrap().unwrap().status,
+        RunLifecycle::Finished
+    );
     drop(j);
 
     // Resumed with only a larger budget: the sphere, scored by epsilon, six more trials.
@@ -70,7 +73,7 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
     }
     let j = Journal::open(&journal).unwrap();
     let record = j.run("run").unwrap().unwrap();
-    assert_eq!(record.status, RunStatus::Finished);
+    assert_eq!(record.status, RunLifecycle::Finished);
     let spec: serde_json::Value = serde_json::from_str(&record.config_json).unwrap();
     assert_eq!(spec["object"], "sphere");
     assert_eq!(spec["trials"], 18);
@@ -185,7 +188,7 @@ fn ctrl_c_stops_a_run_that_resume_then_finishes() {
         "{stdout}"
     );
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("run").unwrap().unwrap().status, RunStatus::Stopped);
+    assert_eq!(j.run("run").unwrap().unwrap().status, RunLifecycle::Stopped);
     let done = j
         .trials("run")
         .unwrap()
@@ -201,7 +204,10 @@ fn ctrl_c_stops_a_run_that_resume_then_finishes() {
     assert!(o.status.success(), "{}", text(&o));
     check_journal(&journal, "run", 60);
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("run").unwrap().unwrap().status, RunStatus::Finished);
+    assert_eq!(
+        j.run("run").unwrap().unwrap().status,
+        RunLifecycle::Finished
+    );
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use crate::support::{
     Cluster, Proc, check_journal, completed_now, graspopt, signal, tempdir, wait_until,
 };
-use graspopt_journal::{Journal, RunStatus, TrialState};
+use graspopt_journal::{Journal, RunLifecycle, TrialState};
 
 const TRIALS: usize = 20;
 
@@ -232,7 +232,7 @@ fn a_run_stopped_before_its_first_trial_starts_afresh_with_the_same_command() {
         c.log("coordinator")
     );
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("q").unwrap().unwrap().status, RunStatus::Stopped);
+    assert_eq!(j.run("q").unwrap().unwrap().status, RunLifecycle::Stopped);
     assert!(j.trials("q").unwrap().is_empty());
     drop(j);
 
