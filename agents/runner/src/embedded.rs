@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use graspopt_bus::{Bus, BusArgs};
+use graspopt_bus::{Bus, BusArgs, free_loopback_port};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{RunId, RunStatus};
 use tokio::sync::watch;
@@ -22,6 +22,24 @@ pub struct Embedded {
     pub bus: BusArgs,
     /// The trials as simulated here (for the pictures of the results).
     pub evaluator: graspopt_trial::Evaluator,
+}
+
+/// The bus of an embedded run: unless `bus` names an endpoint or a Zenoh configuration, a free
+/// loopback port with multicast scouting off (no other run on the network hears it); unless
+/// it names a shared-memory prefix, one of this run and this process.
+pub fn own_bus(mut bus: BusArgs, run: &RunId) -> Result<BusArgs> {
+    if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
+        bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
+        bus.no_multicast_scouting = true;
+    }
+    if bus.shm_prefix.is_none() {
+        bus.shm_prefix = Some(graspopt_shm::run_prefix(&format!(
+            "{}_{}",
+            run.as_str(),
+            std::process::id()
+        )));
+    }
+    Ok(bus)
 }
 
 /// Runs every agent in this process until the coordinator finishes (or Ctrl-C stops it:

@@ -1,6 +1,6 @@
 //! An embedded run, in-process: every agent on one loopback bus, no binary spawned.
 
-use graspopt_bus::{BusArgs, free_loopback_port};
+use graspopt_bus::BusArgs;
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId, RunPhase};
 use graspopt_runner::{Embedded, run_embedded};
@@ -13,15 +13,7 @@ fn mug_run(out: &std::path::Path, trials: u64) -> Embedded {
     let space = TrialSpace::approach_vertical_2d(&object);
     let evaluator = Evaluator::new(object, hand_by_name("barrett").unwrap(), space);
     let run = RunId::new("inproc").unwrap();
-    let bus = BusArgs {
-        listen: vec![format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap())],
-        no_multicast_scouting: true,
-        shm_prefix: Some(graspopt_shm::run_prefix(&format!(
-            "inproc_{}",
-            std::process::id()
-        ))),
-        ..BusArgs::default()
-    };
+    let bus = graspopt_runner::embedded::own_bus(BusArgs::default(), &run).unwrap();
     Embedded {
         spec: RunSpec {
             object: "mug".into(),

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use graspopt_bus::{BusArgs, free_loopback_port};
+use graspopt_bus::BusArgs;
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId, RunPhase, RunStatus};
 use graspopt_sim::ParamKind;
@@ -356,18 +356,7 @@ pub fn embedded_with(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
         .collect::<Result<Vec<_>>>()?;
     let evaluator = args.sim.evaluator(&kinds)?;
     let object_name = evaluator.object.name().to_string();
-    let mut bus = args.bus.clone();
-    if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
-        bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
-        bus.no_multicast_scouting = true;
-    }
-    if bus.shm_prefix.is_none() {
-        bus.shm_prefix = Some(graspopt_shm::run_prefix(&format!(
-            "{}_{}",
-            run.as_str(),
-            std::process::id()
-        )));
-    }
+    let bus = graspopt_runner::embedded::own_bus(args.bus.clone(), &run)?;
     let perception = graspopt_perception::PerceptionConfig {
         object: object_name.clone(),
         mesh: args.sim.mesh.clone(),
