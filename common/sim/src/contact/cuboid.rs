@@ -24,6 +24,8 @@ use std::f64::consts::{PI, TAU};
 
 use parry3d_f64::math::Vector;
 
+use crate::convert::{g2v, v2g};
+
 /// The cell of a point around a box, per axis: -1 below `-h_i`, 0 between, +1 above `h_i`.
 pub(super) type Cell = [i8; 3];
 
@@ -150,15 +152,11 @@ pub(super) fn polygon_area(poly: &[Vector]) -> Option<(f64, Vector)> {
     (area > 0.0).then(|| (area, moment / area))
 }
 
-/// Two unit vectors spanning the plane orthogonal to the unit vector `n`.
+/// Two unit vectors spanning the plane orthogonal to the unit vector `n` (the contact models'
+/// basis, [`super::plane_basis`]).
 fn plane_basis(n: Vector) -> (Vector, Vector) {
-    let a = if n.x.abs() < 0.9 {
-        Vector::X
-    } else {
-        Vector::Y
-    };
-    let e1 = n.cross(a).normalize();
-    (e1, n.cross(e1))
+    let (e1, e2) = super::plane_basis(&g2v(n));
+    (v2g(&e1), v2g(&e2))
 }
 
 /// The part of the convex polygon `poly` (on the plane of unit normal `n`) within `r` of the
