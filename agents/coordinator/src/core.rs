@@ -8,7 +8,7 @@ use std::collections::{HashMap, HashSet};
 
 use anyhow::{Context, bail};
 use graspopt_bus::BusError;
-use graspopt_journal::{MetricValues as JournalMetrics, TrialIssue, TrialResultRecord};
+use graspopt_journal::{TrialIssue, TrialResultRecord};
 use graspopt_protocol::keys::AliveKey;
 use graspopt_protocol::{
     Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, SuggestRequest,
@@ -533,14 +533,7 @@ fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
         worker: r.worker.clone(),
         at_ms,
         score: r.score,
-        metrics: r.metrics.map(|m| JournalMetrics {
-            rank: m.rank,
-            force_closure: m.force_closure,
-            epsilon: m.epsilon,
-            volume: m.volume,
-            distance: m.distance,
-            bw: m.bw,
-        }),
+        metrics: r.metrics,
         contacts: r.contacts,
         fingers_in_contact: r.fingers_in_contact,
         cloud_points: r.cloud_points,

@@ -8,7 +8,7 @@ use anyhow::{Context, bail};
 use graspopt_bus::now_ms;
 use graspopt_journal::{Journal, RunLifecycle, RunRecord, TrialState, event_kind};
 use graspopt_protocol::{ObjectEstimate, PlannerMethod, RunId};
-use graspopt_sim::{ParamKind, ParamSpec, TrialSpace, reference_pose};
+use graspopt_sim::{ParamKind, TrialSpace};
 use serde::{Deserialize, Serialize};
 
 use crate::state::{RunState, Trial, TrialPhase};
@@ -178,30 +178,16 @@ pub fn trial_space(
 ) -> anyhow::Result<(TrialSpace, Vec<[f64; 2]>)> {
     let object = graspopt_convert::object_from_estimate(estimate)
         .context("coordinator: the object estimate")?;
-    let defaults = graspopt_sim::pose::default_bounds(&object);
-    let mut params = Vec::with_capacity(spec.params.len());
-    for (i, kind) in spec.params.iter().enumerate() {
-        let default = defaults
-            .iter()
-            .find(|d| d.kind == *kind)
-            .copied()
-            .context("coordinator: no default bounds for a parameter")?;
-        let (lower, upper) = match &spec.bounds {
-            Some(b) => {
-                let b = b
-                    .get(i)
-                    .with_context(|| format!("run spec: no bounds for parameter {i}"))?;
-                (b[0], b[1])
-            }
-            None => (default.lower, default.upper),
-        };
-        params.push(ParamSpec {
-            kind: *kind,
-            lower,
-            upper,
-        });
+    let mut space = TrialSpace::with_params(&object, &spec.params).context("run spec")?;
+    if let Some(bounds) = &spec.bounds {
+        for (i, p) in space.params.iter_mut().enumerate() {
+            let b = bounds
+                .get(i)
+                .with_context(|| format!("run spec: no bounds for parameter {i}"))?;
+            (p.lower, p.upper) = (b[0], b[1]);
+        }
+        space = TrialSpace::new(space.reference, space.params).context("run spec")?;
     }
-    let space = TrialSpace::new(reference_pose(&object), params).context("run spec")?;
     let bounds = space.bounds().iter().map(|b| [b.0, b.1]).collect();
     Ok((space, bounds))
 }

@@ -1,10 +1,17 @@
-//! Runs graspopt's agents: every agent of a run in this process ([`embedded`]), and the
-//! signals that stop them ([`signal`]).
+//! Runs graspopt's agents: every agent of a run in this process ([`embedded`]), from
+//! settings resolved for a new or a resumed run ([`run_settings`]); the pipeline
+//! benchmarks ([`bench`]); launch files and their processes ([`launch`]); an agent's settings file ([`config`]); and the signals that
+//! stop them ([`signal`]).
 //!
 //! Tests call it in-process. It knows nothing of command-line flags: the `graspopt` binary
-//! resolves them into an [`Embedded`] run.
+//! fills a [`RunSettings`] from them.
 
+pub mod bench;
+pub mod config;
 pub mod embedded;
+pub mod launch;
+pub mod run_settings;
 pub mod signal;
 
 pub use embedded::{Embedded, placeholder, run_embedded};
+pub use run_settings::RunSettings;

@@ -71,3 +71,71 @@ async fn an_embedded_run_records_every_trial_in_its_journal() {
     assert_eq!(trials.iter().filter(|t| t.score.is_some()).count(), 6);
     assert_eq!(status.best.map(|b| b.score), Some(best));
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_resumed_run_restores_its_recorded_settings_and_refuses_contrary_ones() {
+    use graspopt_runner::RunSettings;
+    use graspopt_sim::ContactModel;
+    use graspopt_trial::TrialSettings;
+
+    let dir = tempfile::tempdir().unwrap();
+    let first = RunSettings {
+        run: "again".into(),
+        trial: TrialSettings {
+            contacts: ContactModel::CircularPatch,
+            ..TrialSettings::default()
+        },
+        workers: 1,
+        trials: 3,
+        method: PlannerMethod::Random,
+        seed: 3,
+        out: Some(dir.path().to_path_buf()),
+        ..RunSettings::default()
+    };
+    let e = first.embedded().unwrap();
+    let status = run_embedded(&e, None).await.unwrap();
+    assert_eq!((status.phase, status.completed), (RunPhase::Finished, 3));
+
+    // Resumed with the defaults and a larger budget: the record wins where nothing was given.
+    let again = RunSettings {
+        trials: 5,
+        resume: true,
+        out: Some(dir.path().to_path_buf()),
+        ..RunSettings::default()
+    };
+    let given = |name: &str| name == "trials";
+    let e = again.resolve(&given).unwrap();
+    assert_eq!(e.run.as_str(), "again");
+    assert_eq!(e.metric.score.contacts, ContactModel::CircularPatch);
+    assert_eq!((e.workers, e.spec.trials, e.spec.seed), (1, 5, 3));
+    assert_eq!(e.spec.method, PlannerMethod::Random);
+    let status = run_embedded(&e, None).await.unwrap();
+    assert_eq!((status.phase, status.completed), (RunPhase::Finished, 5));
+
+    // A contact model given explicitly that contradicts the record is refused by name.
+    let contrary = RunSettings {
+        trial: TrialSettings {
+            contacts: ContactModel::MeanPoint,
+            ..TrialSettings::default()
+        },
+        ..again.clone()
+    };
+    let err = contrary
+        .resolve(&|name| name == "contacts")
+        .err()
+        .expect("a contrary contact model must be refused");
+    let msg = format!("{err:#}");
+    assert!(
+        msg.contains("--contacts mean") && msg.contains("patch"),
+        "{msg}"
+    );
+
+    // A new run in the same folder would overwrite the recorded one's files.
+    let other = RunSettings {
+        run: "other".into(),
+        out: Some(dir.path().to_path_buf()),
+        ..RunSettings::default()
+    };
+    let msg = format!("{:#}", other.embedded().err().expect("the folder is taken"));
+    assert!(msg.contains("holds run \"again\" already"), "{msg}");
+}

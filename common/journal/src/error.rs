@@ -68,6 +68,9 @@ pub enum JournalError {
         expected: usize,
         found: usize,
     },
+    /// An export's output file that cannot be written, or must not be (the journal).
+    #[error("output {path}: {reason}")]
+    Output { path: String, reason: String },
     /// Trial ids are stored as SQLite integers (i64); larger ids are refused.
     #[error("trial id {0} is too large for the journal (max {max})", max = i64::MAX)]
     TrialIdRange(u64),

@@ -5,17 +5,19 @@
 //! This crate owns the journal's database: its schema and version, the
 //! recording rules (a trial is issued, maybe re-issued, and ends exactly once,
 //! completed by one result or failed), the event log of every issue, result,
-//! duplicate and failure, and the CSV/JSON exports of a run.
+//! duplicate and failure, and the CSV/JSON exports of a run (written safely by
+//! [`output`]).
 //!
 //! It must not know the network or the bus, the planner, the simulator or any
-//! other graspopt crate: it defines its own plain record types, and the caller
-//! converts. It reads no clock (every timestamp is given by the caller) and
+//! other graspopt crate but protocol's plain data (a result's `MetricValues`): it
+//! defines its own record types, and the caller converts. It reads no clock (every timestamp is given by the caller) and
 //! starts no thread: one owner (a thread, a task or a mutex) calls it; a
 //! [`Journal`] is `Send`, not `Sync`.
 
 mod error;
 pub mod export;
 mod journal;
+pub mod output;
 mod rows;
 mod schema;
 mod types;

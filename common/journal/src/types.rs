@@ -77,16 +77,9 @@ pub struct TrialResultRecord {
     pub details_json: String,
 }
 
-/// Grasp-quality metrics of one trial, stored as real columns.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MetricValues {
-    pub rank: u32,
-    pub force_closure: bool,
-    pub epsilon: f64,
-    pub volume: Option<f64>,
-    pub distance: f64,
-    pub bw: f64,
-}
+/// Grasp-quality metrics of one trial, stored as real columns: the result message's own
+/// type, so a result is journaled without a copy of its fields.
+pub use graspopt_protocol::MetricValues;
 
 /// What `record_result` did with a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

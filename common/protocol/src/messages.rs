@@ -339,6 +339,24 @@ pub enum PlannerMethod {
     Random,
 }
 
+impl PlannerMethod {
+    /// Every method, in the order `--help` lists them.
+    pub const ALL: [PlannerMethod; 2] = [PlannerMethod::Bo, PlannerMethod::Random];
+
+    /// The name users type and see (the serde name): `bo`, `random`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlannerMethod::Bo => "bo",
+            PlannerMethod::Random => "random",
+        }
+    }
+
+    /// A method from its name.
+    pub fn parse(name: &str) -> Option<PlannerMethod> {
+        Self::ALL.into_iter().find(|m| m.name() == name.trim())
+    }
+}
+
 /// coordinator -> planner (query): propose `count` trials.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SuggestRequest {

@@ -5,6 +5,7 @@
 //! simulator: callers hand it contacts (positions and unit normals pointing into the
 //! object) or wrenches, and get metrics back.
 //!
+//! - [`cases`]: grasp cases as data (the case file's serde types).
 //! - [`wrench`]: wrench vectors and frame changes (eq. 2.1-2.3).
 //! - [`contact`]: contacts, contact models (frictionless, friction cone, soft finger)
 //!   and the wrenches each produces (eq. 2.4-2.11).
@@ -18,6 +19,7 @@
 //!   Bimodal Wrench metric (section 2.6).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod cases;
 pub mod cloud;
 pub mod contact;
 pub mod error;

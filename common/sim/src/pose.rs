@@ -41,6 +41,35 @@ pub enum ParamKind {
 }
 
 impl ParamKind {
+    /// Every parameter, in the order of [`TrialSpace::full_6d`].
+    pub const ALL: [ParamKind; 6] = [
+        ParamKind::Approach,
+        ParamKind::Lateral,
+        ParamKind::Vertical,
+        ParamKind::RotX,
+        ParamKind::RotY,
+        ParamKind::RotZ,
+    ];
+
+    /// A parameter from any of its spellings: the thesis's `x` (approach) and `y` (vertical),
+    /// the names users see ([`ParamKind::name`]), the stored (serde) names of journals and
+    /// CSV headers (`rot_x`), and `z`, `roll`, `pitch`, `yaw`.
+    pub fn parse(name: &str) -> Result<ParamKind> {
+        Ok(match name.trim() {
+            "x" | "approach" => ParamKind::Approach,
+            "z" | "lateral" => ParamKind::Lateral,
+            "y" | "vertical" => ParamKind::Vertical,
+            "rx" | "rot_x" | "roll" => ParamKind::RotX,
+            "ry" | "rot_y" | "pitch" => ParamKind::RotY,
+            "rz" | "rot_z" | "yaw" => ParamKind::RotZ,
+            other => {
+                return Err(SimError::InvalidInput(format!(
+                    "unknown trial parameter {other:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
+                )));
+            }
+        })
+    }
+
     /// The name users type and see: `approach`, `lateral`, `vertical`, `rx`, `ry`, `rz`.
     pub fn name(self) -> &'static str {
         match self {
@@ -129,6 +158,25 @@ impl TrialSpace {
             reference: reference_pose(object),
             params: default_bounds(object).to_vec(),
         }
+    }
+
+    /// The object's default space ([`TrialSpace::full_6d`]) restricted to `kinds`, in that
+    /// order.
+    pub fn with_params(object: &Object, kinds: &[ParamKind]) -> Result<Self> {
+        let defaults = default_bounds(object);
+        let params = kinds
+            .iter()
+            .map(|k| {
+                defaults
+                    .iter()
+                    .find(|p| p.kind == *k)
+                    .copied()
+                    .ok_or_else(|| {
+                        SimError::InvalidInput(format!("no default bounds for the parameter {k}"))
+                    })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Self::new(reference_pose(object), params)
     }
 
     /// Number of parameters.
@@ -270,5 +318,39 @@ mod tests {
             two.from_unit(&[0.0, 1.0]).unwrap(),
             vec![two.params[0].lower, two.params[1].upper]
         );
+    }
+
+    #[test]
+    fn a_parameter_parses_from_every_spelling_and_nothing_else() {
+        for k in ParamKind::ALL {
+            assert_eq!(ParamKind::parse(k.name()).unwrap(), k);
+            // The stored (serde) name of journals and CSV headers.
+            let stored = serde_json::to_value(k).unwrap();
+            assert_eq!(ParamKind::parse(stored.as_str().unwrap()).unwrap(), k);
+        }
+        for (name, k) in [
+            ("x", ParamKind::Approach),
+            ("y", ParamKind::Vertical),
+            ("z", ParamKind::Lateral),
+            (" roll ", ParamKind::RotX),
+            ("pitch", ParamKind::RotY),
+            ("yaw", ParamKind::RotZ),
+        ] {
+            assert_eq!(ParamKind::parse(name).unwrap(), k, "{name}");
+        }
+        let err = ParamKind::parse("q").unwrap_err().to_string();
+        assert!(err.contains("unknown trial parameter \"q\""), "{err}");
+        assert!(ParamKind::parse("").is_err());
+    }
+
+    #[test]
+    fn a_space_with_chosen_parameters_keeps_their_order_and_default_bounds() {
+        let o = Object::by_name("mug").unwrap();
+        let full = TrialSpace::full_6d(&o);
+        let s = TrialSpace::with_params(&o, &[ParamKind::RotZ, ParamKind::Approach]).unwrap();
+        assert_eq!(s.params, vec![full.params[5], full.params[0]]);
+        assert_eq!(s.reference, full.reference);
+        let twice = TrialSpace::with_params(&o, &[ParamKind::Approach, ParamKind::Approach]);
+        assert!(twice.unwrap_err().to_string().contains("given twice"));
     }
 }

@@ -19,6 +19,6 @@ pub mod scan;
 pub mod score;
 
 pub use error::TrialError;
-pub use evaluator::{Evaluation, Evaluator};
+pub use evaluator::{Evaluation, Evaluator, TrialSettings};
 pub use scan::{ScanPoint, scan_grid};
 pub use score::{Metric, ReferenceFrame, ScoreSettings, TrialScore, score_outcome};

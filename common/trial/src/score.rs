@@ -34,6 +34,15 @@ pub enum Metric {
 }
 
 impl Metric {
+    /// The name users see: `bw`, `epsilon`, `volume`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Bw => "bw",
+            Metric::Epsilon => "epsilon",
+            Metric::Volume => "volume",
+        }
+    }
+
     /// Parses `bw`, `epsilon` (or `ls`), `volume` (or `gwv`).
     pub fn parse(name: &str) -> Result<Self, TrialError> {
         match name {
@@ -44,6 +53,12 @@ impl Metric {
                 "unknown metric {other:?}: expected bw, epsilon (ls) or volume (gwv)"
             ))),
         }
+    }
+}
+
+impl std::fmt::Display for Metric {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -60,6 +75,37 @@ pub enum ReferenceFrame {
     Palm,
     /// A given point (world).
     Point([f64; 3]),
+}
+
+impl ReferenceFrame {
+    /// The frames users choose by name (`--frame`), in the order `--help` lists them.
+    pub const NAMED: [ReferenceFrame; 3] = [
+        ReferenceFrame::Object,
+        ReferenceFrame::World,
+        ReferenceFrame::Palm,
+    ];
+
+    /// `object`, `world`, `palm`, or `point` (a given point).
+    pub fn name(&self) -> &'static str {
+        match self {
+            ReferenceFrame::Object => "object",
+            ReferenceFrame::World => "world",
+            ReferenceFrame::Palm => "palm",
+            ReferenceFrame::Point(_) => "point",
+        }
+    }
+
+    /// One of the named frames: `object`, `world` or `palm`.
+    pub fn parse(name: &str) -> Result<Self, TrialError> {
+        Self::NAMED
+            .into_iter()
+            .find(|f| f.name() == name.trim())
+            .ok_or_else(|| {
+                TrialError::Settings(format!(
+                    "unknown reference frame {name:?}: expected object, world or palm"
+                ))
+            })
+    }
 }
 
 /// How a trial outcome is scored.

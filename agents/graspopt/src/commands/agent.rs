@@ -2,20 +2,21 @@
 //! Settings come from `--config FILE` (TOML, the agent's settings struct) and flags override
 //! them.
 
-use graspopt_runner::signal::shutdown_signal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
+use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::RunId;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
+use graspopt_runner::config::load;
+use graspopt_runner::signal::{shutdown_signal, until_signal};
+use graspopt_sim::ParamKind;
 
-use super::run::Method;
-use super::setup::{SimArgs, param_kind};
+use super::run::{planner_method, trial_param};
+use super::setup::SimArgs;
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -110,12 +111,13 @@ pub enum Kind {
             long,
             visible_alias = "axes",
             default_value = "x,y",
-            value_delimiter = ','
+            value_delimiter = ',',
+            value_parser = trial_param()
         )]
-        params: Vec<String>,
-        /// How trials are proposed.
-        #[arg(long, value_enum, default_value_t = Method::Bo)]
-        method: Method,
+        params: Vec<ParamKind>,
+        /// How trials are proposed: bo or random.
+        #[arg(long, default_value = "bo", value_parser = planner_method())]
+        method: PlannerMethod,
         /// Size of the initial design (space-filling, not model-based) (default: the
         /// engine's).
         #[arg(long)]
@@ -133,66 +135,6 @@ pub enum Kind {
         #[arg(long)]
         resume: bool,
     },
-}
-
-/// Reads a TOML settings file (defaults when none): keys left out keep their defaults, and a
-/// key the settings do not have is refused, naming the keys of its table (the settings'
-/// format: docs/agent-config.md).
-pub fn load<T: DeserializeOwned + Serialize + Default>(path: Option<&Path>) -> Result<T> {
-    let Some(p) = path else {
-        return Ok(T::default());
-    };
-    let text = std::fs::read_to_string(p)
-        .with_context(|| format!("cannot read the settings file {}", p.display()))?;
-    let context = || format!("settings file {}", p.display());
-    let table: toml::Table = toml::from_str(&text).with_context(context)?;
-    // Every key, with `null` for the settings that are none by default.
-    let known = serde_json::to_value(T::default())?;
-    unknown_key(&table, &known, "")
-        .map_or(Ok(()), |e| Err(anyhow::anyhow!(e)))
-        .with_context(context)?;
-    toml::from_str(&text).with_context(context)
-}
-
-/// The first key of `table` (at `path`, a dotted table name, empty at the top) that
-/// `known` (the settings' defaults as JSON) does not have, as a message listing the keys
-/// there; tables are checked recursively where the default is a table too.
-fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Option<String> {
-    let serde_json::Value::Object(keys) = known else {
-        return None;
-    };
-    for (key, value) in table {
-        let Some(default) = keys.get(key) else {
-            let names: Vec<&str> = keys.keys().map(String::as_str).collect();
-            let place = if path.is_empty() {
-                "at the top level".to_string()
-            } else {
-                format!("in [{path}]")
-            };
-            return Some(format!(
-                "unknown key `{key}` {place}; the keys there are {}",
-                names.join(", ")
-            ));
-        };
-        if let toml::Value::Table(inner) = value {
-            let inner_path = if path.is_empty() {
-                key.clone()
-            } else {
-                format!("{path}.{key}")
-            };
-            if let Some(e) = unknown_key(inner, default, &inner_path) {
-                return Some(e);
-            }
-        }
-    }
-    None
-}
-
-async fn until_signal<F: std::future::Future<Output = Result<()>>>(agent: F) -> Result<()> {
-    tokio::select! {
-        r = agent => r,
-        _ = shutdown_signal() => Ok(()),
-    }
 }
 
 /// `graspopt agent`; `explicit(name)` says whether `--name` was given on the command line.
@@ -289,10 +231,6 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 c.journal = v.clone();
             }
             c.lease_ms = lease_ms.unwrap_or(c.lease_ms);
-            let kinds = params
-                .iter()
-                .map(|p| param_kind(p))
-                .collect::<Result<Vec<_>>>()?;
             anyhow::ensure!(*trials >= 1, "--trials must be at least 1");
             let mut run_id = RunId::new(&common.run)?;
             // `--resume --journal FILE` continues the run of FILE: its id need not be given.
@@ -305,11 +243,11 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             let given = RunSpec {
                 object: sim.object()?.name().to_string(),
                 hand: sim.hand.clone(),
-                params: kinds,
+                params: params.clone(),
                 bounds: None,
                 trials: *trials,
                 seed: *seed,
-                method: method.planner(),
+                method: *method,
                 initial: *initial,
                 settings: None,
             };
@@ -360,79 +298,4 @@ async fn join(common: &Common) -> Result<(Bus, RunId)> {
     let run = RunId::new(&common.run)?;
     let bus = Bus::open(&common.bus).await?;
     Ok((bus, run))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The TOML example under the heading `## {kind}` of docs/agent-config.md.
-    fn documented(kind: &str) -> String {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/agent-config.md");
-        let doc = std::fs::read_to_string(path).unwrap();
-        let section = doc.split(&format!("\n## {kind}\n")).nth(1).unwrap();
-        let block = section.split("```toml\n").nth(1).unwrap();
-        block.split("```").next().unwrap().to_string()
-    }
-
-    fn load_text<T: DeserializeOwned + Serialize + Default>(name: &str, text: &str) -> Result<T> {
-        let dir = std::env::temp_dir().join(format!("graspopt-config-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
-        std::fs::write(&path, text).unwrap();
-        load(Some(&path))
-    }
-
-    #[test]
-    fn the_documented_settings_files_are_the_defaults() {
-        fn check<T>(kind: &str)
-        where
-            T: DeserializeOwned + Serialize + Default + PartialEq + std::fmt::Debug,
-        {
-            let loaded: T = load_text(&format!("{kind}.toml"), &documented(kind))
-                .unwrap_or_else(|e| panic!("{kind}: {e:#}"));
-            assert_eq!(loaded, T::default(), "{kind}");
-        }
-        check::<graspopt_perception::PerceptionConfig>("perception");
-        check::<graspopt_hand::HandConfig>("hand");
-        check::<graspopt_metric::MetricConfig>("metric");
-        check::<graspopt_planner::PlannerConfig>("planner");
-        check::<CoordinatorConfig>("coordinator");
-    }
-
-    #[test]
-    fn an_unknown_key_is_refused_with_the_keys_of_its_table() {
-        let err = load_text::<graspopt_hand::HandConfig>("h.toml", "trial_cost = 5\n").unwrap_err();
-        let msg = format!("{err:#}");
-        assert!(msg.contains("h.toml"), "{msg}");
-        assert!(
-            msg.contains("unknown key `trial_cost` at the top level"),
-            "{msg}"
-        );
-        assert!(
-            msg.contains("hand, id, mesh, mesh_scale, object, replay, trial_cost_ms"),
-            "{msg}"
-        );
-        // In a table, the table's own keys.
-        let text = documented("metric").replace("include_palm = true", "include_palms = true");
-        let err = load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err();
-        let msg = format!("{err:#}");
-        assert!(
-            msg.contains("unknown key `include_palms` in [score]"),
-            "{msg}"
-        );
-        assert!(
-            msg.contains("contacts, frame, include_palm, metric, model, torque_scale"),
-            "{msg}"
-        );
-        let text = documented("metric").replace("resolution = ", "resolutoin = ");
-        let msg = format!(
-            "{:#}",
-            load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err()
-        );
-        assert!(msg.contains("`resolutoin` in [contacts.cloud]"), "{msg}");
-        // Keys left out keep their defaults; flags of other kinds are not keys.
-        let c: graspopt_hand::HandConfig = load_text("h.toml", "trial_cost_ms = 5\n").unwrap();
-        assert_eq!((c.trial_cost_ms, c.hand.as_str()), (5, "barrett"));
-    }
 }

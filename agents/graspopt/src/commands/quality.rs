@@ -8,14 +8,14 @@
 //! (only `volume`, with `--no-volume`) nor as `-0.0`.
 //!
 //! Keys (any other key is an error naming it, so a misspelling is not silently replaced
-//! by a default):
-//! - case: [`CASE_KEYS`]: `params`, `contacts`, `wrenches`, and the descriptive keys
-//!   `kind`, `name`, `description`, `notes`, `comment`, `expected`, which are ignored.
-//! - `params`: [`PARAM_KEYS`]: `model` (`frictionless`, `point_friction` or
-//!   `soft_finger`), `mu` (`0..=1e6`), `edges` (`3..=4096`), `gamma` (`0..=1e12`),
-//!   `reference_point` (default the origin), `torque_scale` (default 1, `> 0`). A key
-//!   the model does not use (`gamma` of a point contact) is accepted and ignored.
-//! - each contact: [`CONTACT_KEYS`]: `position`, `normal` (unit length).
+//! by a default): see [`graspopt_quality::cases`].
+//! - case: `params`, `contacts`, `wrenches`, and the descriptive keys `kind`, `name`,
+//!   `description`, `notes`, `comment`, `expected`, which are ignored.
+//! - `params`: `model` (`frictionless`, `point_friction` or `soft_finger`), `mu`
+//!   (`0..=1e6`), `edges` (`3..=4096`), `gamma` (`0..=1e12`), `reference_point` (default
+//!   the origin), `torque_scale` (default 1, `> 0`). A key the model does not use (`gamma`
+//!   of a point contact) is accepted and ignored.
+//! - each contact: `position`, `normal` (unit length).
 //!
 //! Limits (`graspopt_quality::limits`): at most 2,000,000 wrenches per case (contacts x
 //! wrenches per contact, or given), every coordinate and every wrench component (given
@@ -28,9 +28,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use graspopt_quality::cases::Case;
 use graspopt_quality::metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
-use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, QualityError, Wrench};
-use nalgebra::Vector3;
+use graspopt_quality::{GraspMap, QualityError};
 use serde::Serialize;
 use serde_json::{Value, json};
 
@@ -126,30 +126,6 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
         ExitCode::FAILURE
     })
 }
-
-/// The keys a case may have: its data, then descriptive keys that are ignored.
-pub const CASE_KEYS: [&str; 9] = [
-    "params",
-    "contacts",
-    "wrenches",
-    "kind",
-    "name",
-    "description",
-    "notes",
-    "comment",
-    "expected",
-];
-/// The keys of a case's `params`.
-pub const PARAM_KEYS: [&str; 6] = [
-    "model",
-    "mu",
-    "edges",
-    "gamma",
-    "reference_point",
-    "torque_scale",
-];
-/// The keys of a contact.
-pub const CONTACT_KEYS: [&str; 2] = ["position", "normal"];
 
 type Row = std::result::Result<(Metrics, Option<f64>), String>;
 
@@ -254,141 +230,17 @@ fn median_micros(grasp: &GraspMap, options: &MetricsOptions) -> f64 {
     samples[samples.len() / 2]
 }
 
-/// The grasp map of one case: from `params` + `contacts` when contacts are present,
-/// else from `wrenches`.
+/// The grasp map of one case of the file ([`graspopt_quality::cases::Case`]); an error names
+/// the field at fault by its path (`contacts[0].position`).
 fn parse_case(case: &Value) -> Result<GraspMap> {
-    let Some(obj) = case.as_object() else {
-        bail!("expected an object");
-    };
-    known_keys(obj, &CASE_KEYS)?;
-    let params = obj.get("params");
-    if let Some(params) = params {
-        let map = params.as_object().context("params: expected an object")?;
-        known_keys(map, &PARAM_KEYS).context("params")?;
-    }
-    if let Some(contacts) = obj.get("contacts") {
-        let params = params.context("`contacts` given without `params`")?;
-        let model = parse_params(params)?;
-        let contacts = parse_contacts(contacts)?;
-        return GraspMap::from_contacts(&contacts, &model)
-            .map_err(|e| anyhow::anyhow!("contacts: {e}"));
-    }
-    if let Some(wrenches) = obj.get("wrenches") {
-        let list = wrenches.as_array().context("wrenches: expected an array")?;
-        let parsed = list
-            .iter()
-            .enumerate()
-            .map(|(k, w)| {
-                let v = numbers(w, 6).with_context(|| format!("wrenches[{k}]"))?;
-                Ok(Wrench::from_row_slice(&v))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        return GraspMap::from_wrenches(parsed).map_err(|e| anyhow::anyhow!("wrenches: {e}"));
-    }
-    bail!("neither `contacts` (with `params`) nor `wrenches` given")
-}
-
-/// Errors on the first key of `obj` that is not in `allowed`, naming it.
-fn known_keys(obj: &serde_json::Map<String, Value>, allowed: &[&str]) -> Result<()> {
-    match obj.keys().find(|k| !allowed.contains(&k.as_str())) {
-        Some(key) => bail!(
-            "unknown field {key:?} (expected one of: {})",
-            allowed.join(", ")
-        ),
-        None => Ok(()),
-    }
-}
-
-fn parse_params(params: &Value) -> Result<GraspModel> {
-    let obj = params.as_object().context("params: expected an object")?;
-    let number = |name: &str| -> Result<f64> {
-        obj.get(name)
-            .with_context(|| format!("params.{name}: missing"))?
-            .as_f64()
-            .with_context(|| format!("params.{name}: expected a number"))
-    };
-    let model = obj.get("model").and_then(Value::as_str).context(
-        "params.model: expected \"frictionless\", \"point_friction\" or \"soft_finger\"",
-    )?;
-    let edges = || -> Result<usize> {
-        let e = obj.get("edges").context("params.edges: missing")?;
-        let n = e
-            .as_u64()
-            .context("params.edges: expected a whole number of cone edges")?;
-        usize::try_from(n).context("params.edges: too large")
-    };
-    let contact = match model {
-        "frictionless" => FrictionModel::Frictionless,
-        "point_friction" => FrictionModel::PointFriction {
-            mu: number("mu")?,
-            edges: edges()?,
-        },
-        "soft_finger" => FrictionModel::SoftFinger {
-            mu: number("mu")?,
-            edges: edges()?,
-            gamma: number("gamma")?,
-        },
-        other => bail!(
-            "params.model: unknown model {other:?} (expected frictionless, point_friction or soft_finger)"
-        ),
-    };
-    let reference_point = match obj.get("reference_point") {
-        Some(v) => vector3(v).context("params.reference_point")?,
-        None => Vector3::zeros(),
-    };
-    let torque_scale = match obj.get("torque_scale") {
-        Some(_) => number("torque_scale")?,
-        None => 1.0,
-    };
-    let model = GraspModel {
-        contact,
-        reference_point,
-        torque_scale,
-    };
-    model
-        .validate()
-        .map_err(|e| anyhow::anyhow!("params: {e}"))?;
-    Ok(model)
-}
-
-fn parse_contacts(contacts: &Value) -> Result<Vec<Contact>> {
-    let list = contacts.as_array().context("contacts: expected an array")?;
-    list.iter()
-        .enumerate()
-        .map(|(k, c)| {
-            let map = c
-                .as_object()
-                .with_context(|| format!("contacts[{k}]: expected an object"))?;
-            known_keys(map, &CONTACT_KEYS).with_context(|| format!("contacts[{k}]"))?;
-            let position = c
-                .get("position")
-                .with_context(|| format!("contacts[{k}].position: missing"))
-                .and_then(|v| vector3(v).with_context(|| format!("contacts[{k}].position")))?;
-            let normal = c
-                .get("normal")
-                .with_context(|| format!("contacts[{k}].normal: missing"))
-                .and_then(|v| vector3(v).with_context(|| format!("contacts[{k}].normal")))?;
-            Ok(Contact::new(position, normal))
-        })
-        .collect()
-}
-
-fn vector3(v: &Value) -> Result<Vector3<f64>> {
-    let n = numbers(v, 3)?;
-    Ok(Vector3::new(n[0], n[1], n[2]))
-}
-
-fn numbers(v: &Value, len: usize) -> Result<Vec<f64>> {
-    let list = v
-        .as_array()
-        .with_context(|| format!("expected an array of {len} numbers"))?;
-    if list.len() != len {
-        bail!("expected {len} numbers, got {}", list.len());
-    }
-    list.iter()
-        .map(|x| {
-            x.as_f64()
-                .with_context(|| format!("expected a number, got {x}"))
-        })
-        .collect()
+    let case: Case = serde_path_to_error::deserialize(case).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if path == "." {
+            anyhow::anyhow!("{inner}")
+        } else {
+            anyhow::anyhow!("{path}: {inner}")
+        }
+    })?;
+    Ok(case.grasp_map()?)
 }

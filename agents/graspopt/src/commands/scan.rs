@@ -140,7 +140,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
     let title = format!(
         "{} on the {} ({} contacts)",
-        args.sim.metric.to_uppercase(),
+        args.sim.metric.name().to_uppercase(),
         ev.object.name(),
         ev.score.contacts
     );
@@ -149,7 +149,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         1 => Some(chart::line_plot(
             &title,
             &format!("{} offset (m)", names[0]),
-            &args.sim.metric,
+            args.sim.metric.name(),
             &axes[0],
             &points.iter().map(|p| p.score.score).collect::<Vec<_>>(),
         )),

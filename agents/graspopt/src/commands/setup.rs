@@ -3,11 +3,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, ValueEnum};
-use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec, TrialSpace};
-use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
+use graspopt_sim::{ContactModel, Object, ParamKind, TrialSpace};
+use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
 pub struct SimArgs {
@@ -25,19 +25,42 @@ pub struct SimArgs {
     #[arg(long, default_value = "barrett")]
     pub hand: String,
     /// Contact model: surface (thesis 2.3), patch (circular patch) or mean (mean point).
-    #[arg(long, value_enum, default_value_t = Contacts::Surface)]
-    pub contacts: Contacts,
+    #[arg(long, default_value = "surface", value_parser = contact_model())]
+    pub contacts: ContactModel,
     /// Metric scored: bw, epsilon (ls) or volume (gwv).
-    #[arg(long, default_value = "bw")]
-    pub metric: String,
+    #[arg(long, default_value = "bw", value_parser = metric())]
+    pub metric: Metric,
     /// Reference point for torques: object (centre of mass), world or palm.
-    #[arg(long, value_enum, default_value_t = Frame::Object)]
-    pub frame: Frame,
+    #[arg(long, default_value = "object", value_parser = frame())]
+    pub frame: ReferenceFrame,
     /// Torque scale in metres (default: the object's bounding radius).
     #[arg(long)]
     pub torque_scale: Option<f64>,
 }
 
+/// `--contacts`: the simulator's contact models by name.
+pub fn contact_model() -> impl TypedValueParser<Value = ContactModel> {
+    PossibleValuesParser::new(ContactModel::ALL.map(|m| m.name()))
+        .try_map(|s| ContactModel::parse(&s))
+}
+
+/// `--metric`: the scored metrics, with their short names as aliases.
+fn metric() -> impl TypedValueParser<Value = Metric> {
+    PossibleValuesParser::new([
+        PossibleValue::new("bw"),
+        PossibleValue::new("epsilon").alias("ls"),
+        PossibleValue::new("volume").alias("gwv"),
+    ])
+    .try_map(|s| Metric::parse(&s))
+}
+
+/// `--frame`: the named reference frames.
+fn frame() -> impl TypedValueParser<Value = ReferenceFrame> {
+    PossibleValuesParser::new(ReferenceFrame::NAMED.map(|f| f.name()))
+        .try_map(|s| ReferenceFrame::parse(&s))
+}
+
+/// The clap copy of [`ContactModel`] that `experiment bo` still uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Contacts {
     Surface,
@@ -55,73 +78,38 @@ impl From<Contacts> for ContactModel {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Frame {
-    Object,
-    World,
-    Palm,
-}
-
 impl SimArgs {
+    /// The settings the flags name.
+    pub fn settings(&self) -> TrialSettings {
+        TrialSettings {
+            object: self.object.clone(),
+            mesh: self.mesh.clone(),
+            mesh_scale: self.mesh_scale,
+            hand: self.hand.clone(),
+            contacts: self.contacts,
+            metric: self.metric,
+            frame: self.frame,
+            torque_scale: self.torque_scale,
+        }
+    }
+
     /// The object named by the flags.
     pub fn object(&self) -> Result<Object> {
-        match &self.mesh {
-            Some(path) => Object::from_file_scaled(path, self.mesh_scale)
-                .with_context(|| format!("cannot load the mesh {}", path.display())),
-            None => Ok(Object::by_name(&self.object)?),
-        }
+        Ok(self.settings().object()?)
     }
 
     /// An evaluator over the trial space with the given parameters (full default bounds).
     pub fn evaluator(&self, kinds: &[ParamKind]) -> Result<Evaluator> {
-        let object = self.object()?;
-        let space = space_for(&object, kinds)?;
-        let hand = hand_by_name(&self.hand)?;
-        let mut ev = Evaluator::new(object, hand, space);
-        ev.score.contacts = self.contacts.into();
-        ev.score.metric = Metric::parse(&self.metric)?;
-        ev.score.frame = match self.frame {
-            Frame::Object => ReferenceFrame::Object,
-            Frame::World => ReferenceFrame::World,
-            Frame::Palm => ReferenceFrame::Palm,
-        };
-        if let Some(rho) = self.torque_scale {
-            if !(rho.is_finite() && rho > 0.0) {
-                bail!("--torque-scale must be a positive length in metres, got {rho}");
-            }
-            ev.score.torque_scale = Some(rho);
-        }
-        Ok(ev)
+        Ok(Evaluator::from_settings(&self.settings(), kinds)?)
     }
 }
 
-/// Parameter names users type: the thesis's x (approach) and y (vertical), plus the rest.
+/// Parameter names users type (see [`ParamKind::parse`]).
 pub fn param_kind(name: &str) -> Result<ParamKind> {
-    Ok(match name.trim() {
-        "x" | "approach" => ParamKind::Approach,
-        "lateral" | "z" => ParamKind::Lateral,
-        "y" | "vertical" => ParamKind::Vertical,
-        "rx" | "roll" => ParamKind::RotX,
-        "ry" | "pitch" => ParamKind::RotY,
-        "rz" | "yaw" => ParamKind::RotZ,
-        other => bail!(
-            "unknown trial parameter {other:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
-        ),
-    })
+    Ok(ParamKind::parse(name)?)
 }
 
 /// The object's default trial space restricted to `kinds`, in that order.
 pub fn space_for(object: &Object, kinds: &[ParamKind]) -> Result<TrialSpace> {
-    let full = TrialSpace::full_6d(object);
-    let params: Vec<ParamSpec> = kinds
-        .iter()
-        .map(|k| {
-            full.params
-                .iter()
-                .find(|p| p.kind == *k)
-                .copied()
-                .with_context(|| format!("no bounds for {}", k.name()))
-        })
-        .collect::<Result<_>>()?;
-    Ok(TrialSpace::new(full.reference, params)?)
+    Ok(TrialSpace::with_params(object, kinds)?)
 }

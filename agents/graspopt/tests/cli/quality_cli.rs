@@ -157,12 +157,18 @@ fn check_bad_output(out: &Output, with_infinity: bool) {
         (2, "case 2: params: edges = 2 is invalid"),
         (3, "case 3: params.gamma: missing"),
         (4, "case 4: contacts: contact 0: normal is zero"),
-        (5, "case 5: contacts[0].position: expected 3 numbers, got 2"),
+        (
+            5,
+            "case 5: contacts[0].position: invalid length 2, expected an array of length 3",
+        ),
         (6, "case 6: contacts: no contacts given"),
         (7, "case 7: params: torque_scale = 0 is invalid"),
-        (8, "case 8: wrenches[0]: expected 6 numbers, got 3"),
+        (
+            8,
+            "case 8: wrenches[0]: invalid length 3, expected an array of length 6",
+        ),
         (9, "case 9: contacts: contact 0: normal has length 2"),
-        (10, "case 10: params.model: unknown model \"sticky\""),
+        (10, "case 10: params.model: unknown variant `sticky`"),
     ];
     for (i, text) in expect {
         let message = rows[i]["error"].as_str().unwrap_or_default();
@@ -310,10 +316,10 @@ fn unknown_fields_are_errors_and_descriptive_keys_are_accepted() {
     let (code, rows, stderr) = quality(&file, &[]);
     assert_eq!(code, Some(1));
     let expect = [
-        r#"case 0: params: unknown field "torque_scal" (expected one of: model, mu, edges, gamma, reference_point, torque_scale)"#,
-        r#"case 1: unknown field "wrench" (expected one of: params, contacts, wrenches, kind, name, description, notes, comment, expected)"#,
-        r#"case 2: contacts[0]: unknown field "force" (expected one of: position, normal)"#,
-        r#"case 3: params: unknown field "edge""#,
+        "case 0: params.torque_scal: unknown field `torque_scal`, expected one of `model`, `mu`, `edges`, `gamma`, `reference_point`, `torque_scale`",
+        "case 1: wrench: unknown field `wrench`, expected one of `params`, `contacts`, `wrenches`, `expected`, `kind`, `name`, `description`, `notes`, `comment`",
+        "case 2: contacts[0].force: unknown field `force`, expected `position` or `normal`",
+        "case 3: params.edge: unknown field `edge`",
     ];
     for (i, text) in expect.iter().enumerate() {
         let message = rows[i]["error"].as_str().unwrap_or_default();

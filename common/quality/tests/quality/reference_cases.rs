@@ -3,63 +3,30 @@
 //! closure exactly; the wrenches generated from the contacts equal the file's; Clarabel
 //! agrees with the min-norm solver; the expanding polytope agrees with the full hull.
 
+use graspopt_quality::cases::{Case, CaseFile};
 use graspopt_quality::hull::{epa, quickhull};
 use graspopt_quality::metrics::{DistanceSolver, MetricsOptions, distance_to_hull, evaluate};
-use graspopt_quality::{Contact, FrictionModel, GraspMap, GraspModel, Wrench};
-use nalgebra::Vector3;
+use graspopt_quality::{GraspMap, Wrench};
 use serde_json::Value;
 
-fn cases() -> Vec<Value> {
+fn cases() -> Vec<Case> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../tests/data/metric-cases.json"
     );
     let text = std::fs::read_to_string(path).expect("reference file");
-    let doc: Value = serde_json::from_str(&text).expect("json");
-    doc["cases"].as_array().expect("cases").clone()
+    serde_json::from_str::<CaseFile>(&text)
+        .expect("the case file's types")
+        .cases
 }
 
-fn v3(v: &Value) -> Vector3<f64> {
-    let a = v.as_array().expect("array");
-    Vector3::new(
-        a[0].as_f64().unwrap(),
-        a[1].as_f64().unwrap(),
-        a[2].as_f64().unwrap(),
-    )
+fn grasp(case: &Case) -> GraspMap {
+    case.grasp_map().unwrap()
 }
 
-fn model(params: &Value) -> GraspModel {
-    let mu = params["mu"].as_f64().unwrap();
-    let edges = params["edges"].as_u64().unwrap() as usize;
-    let gamma = params["gamma"].as_f64().unwrap();
-    let contact = match params["model"].as_str().unwrap() {
-        "frictionless" => FrictionModel::Frictionless,
-        "point_friction" => FrictionModel::PointFriction { mu, edges },
-        "soft_finger" => FrictionModel::SoftFinger { mu, edges, gamma },
-        other => panic!("unknown model {other}"),
-    };
-    GraspModel::new(contact)
-        .with_reference_point(v3(&params["reference_point"]))
-        .with_torque_scale(params["torque_scale"].as_f64().unwrap())
-}
-
-fn grasp(case: &Value) -> GraspMap {
-    let contacts: Vec<Contact> = case["contacts"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| Contact::new(v3(&c["position"]), v3(&c["normal"])))
-        .collect();
-    GraspMap::from_contacts(&contacts, &model(&case["params"])).unwrap()
-}
-
-fn reference_wrenches(case: &Value) -> Vec<Wrench> {
-    case["wrenches"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|w| Wrench::from_iterator(w.as_array().unwrap().iter().map(|x| x.as_f64().unwrap())))
-        .collect()
+fn reference_wrenches(case: &Case) -> Vec<Wrench> {
+    let wrenches = case.wrenches.as_ref().expect("the reference wrenches");
+    wrenches.iter().map(|w| Wrench::from_row_slice(w)).collect()
 }
 
 fn close(actual: f64, expected: f64) -> bool {
@@ -74,30 +41,30 @@ fn all_reference_cases_match() {
     for (i, case) in cases.iter().enumerate() {
         let g = grasp(case);
         let m = evaluate(&g, &MetricsOptions::default()).unwrap();
-        let e = &case["expected"];
+        let e = case.expected.expect("the expected values");
         let mut bad = Vec::new();
-        if m.rank as u64 != e["rank"].as_u64().unwrap() {
-            bad.push(format!("rank {} vs {}", m.rank, e["rank"]));
+        if Some(m.rank) != e.rank {
+            bad.push(format!("rank {} vs {:?}", m.rank, e.rank));
         }
-        if m.force_closure != e["force_closure"].as_bool().unwrap() {
+        if Some(m.force_closure) != e.force_closure {
             bad.push(format!(
-                "force_closure {} vs {}",
-                m.force_closure, e["force_closure"]
+                "force_closure {} vs {:?}",
+                m.force_closure, e.force_closure
             ));
         }
-        for (name, value) in [
-            ("epsilon", m.epsilon),
-            ("volume", m.volume.unwrap()),
-            ("distance", m.distance),
-            ("bw", m.bw),
+        for (name, value, expected) in [
+            ("epsilon", m.epsilon, e.epsilon),
+            ("volume", m.volume.unwrap(), e.volume),
+            ("distance", m.distance, e.distance),
+            ("bw", m.bw, e.bw),
         ] {
-            let expected = e[name].as_f64().unwrap();
+            let expected = expected.unwrap_or_else(|| panic!("case {i}: no expected {name}"));
             if !close(value, expected) {
                 bad.push(format!("{name} {value:e} vs {expected:e}"));
             }
         }
         if !bad.is_empty() {
-            failures.push(format!("case {i} ({}): {}", case["kind"], bad.join(", ")));
+            failures.push(format!("case {i}: {}", bad.join(", ")));
         }
     }
     assert!(

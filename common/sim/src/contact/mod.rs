@@ -96,6 +96,25 @@ pub enum ContactModel {
 }
 
 impl ContactModel {
+    /// Every model, in the order `--help` lists them.
+    pub const ALL: [ContactModel; 3] = [
+        ContactModel::Surface,
+        ContactModel::CircularPatch,
+        ContactModel::MeanPoint,
+    ];
+
+    /// A model from its name ([`ContactModel::name`]).
+    pub fn parse(name: &str) -> crate::error::Result<ContactModel> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == name.trim())
+            .ok_or_else(|| {
+                crate::error::SimError::InvalidInput(format!(
+                    "unknown contact model {name:?}: expected surface, patch or mean"
+                ))
+            })
+    }
+
     /// The name users type and see (`--contacts`): `mean`, `patch`, `surface`.
     pub fn name(self) -> &'static str {
         match self {

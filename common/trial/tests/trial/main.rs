@@ -4,4 +4,5 @@
 mod contacts;
 mod qualitative;
 mod scoring;
+mod settings;
 mod urdf_hand;

@@ -1,0 +1,136 @@
+//! An agent's settings file: TOML, the agent's settings struct (`HandConfig`, ...), keys left
+//! out keep their defaults and an unknown key is refused by name (the format:
+//! docs/agent-config.md). Flags given on the command line go on top (the binary's job).
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+/// Reads a TOML settings file (defaults when none): keys left out keep their defaults, and a
+/// key the settings do not have is refused, naming the keys of its table (the settings'
+/// format: docs/agent-config.md).
+pub fn load<T: DeserializeOwned + Serialize + Default>(path: Option<&Path>) -> Result<T> {
+    let Some(p) = path else {
+        return Ok(T::default());
+    };
+    let text = std::fs::read_to_string(p)
+        .with_context(|| format!("cannot read the settings file {}", p.display()))?;
+    let context = || format!("settings file {}", p.display());
+    let table: toml::Table = toml::from_str(&text).with_context(context)?;
+    // Every key, with `null` for the settings that are none by default.
+    let known = serde_json::to_value(T::default())?;
+    unknown_key(&table, &known, "")
+        .map_or(Ok(()), |e| Err(anyhow::anyhow!(e)))
+        .with_context(context)?;
+    toml::from_str(&text).with_context(context)
+}
+
+/// The first key of `table` (at `path`, a dotted table name, empty at the top) that
+/// `known` (the settings' defaults as JSON) does not have, as a message listing the keys
+/// there; tables are checked recursively where the default is a table too.
+fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Option<String> {
+    let serde_json::Value::Object(keys) = known else {
+        return None;
+    };
+    for (key, value) in table {
+        let Some(default) = keys.get(key) else {
+            let names: Vec<&str> = keys.keys().map(String::as_str).collect();
+            let place = if path.is_empty() {
+                "at the top level".to_string()
+            } else {
+                format!("in [{path}]")
+            };
+            return Some(format!(
+                "unknown key `{key}` {place}; the keys there are {}",
+                names.join(", ")
+            ));
+        };
+        if let toml::Value::Table(inner) = value {
+            let inner_path = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            if let Some(e) = unknown_key(inner, default, &inner_path) {
+                return Some(e);
+            }
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The TOML example under the heading `## {kind}` of docs/agent-config.md.
+    fn documented(kind: &str) -> String {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/agent-config.md");
+        let doc = std::fs::read_to_string(path).unwrap();
+        let section = doc.split(&format!("\n## {kind}\n")).nth(1).unwrap();
+        let block = section.split("```toml\n").nth(1).unwrap();
+        block.split("```").next().unwrap().to_string()
+    }
+
+    fn load_text<T: DeserializeOwned + Serialize + Default>(name: &str, text: &str) -> Result<T> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        load(Some(&path))
+    }
+
+    #[test]
+    fn the_documented_settings_files_are_the_defaults() {
+        fn check<T>(kind: &str)
+        where
+            T: DeserializeOwned + Serialize + Default + PartialEq + std::fmt::Debug,
+        {
+            let loaded: T = load_text(&format!("{kind}.toml"), &documented(kind))
+                .unwrap_or_else(|e| panic!("{kind}: {e:#}"));
+            assert_eq!(loaded, T::default(), "{kind}");
+        }
+        check::<graspopt_perception::PerceptionConfig>("perception");
+        check::<graspopt_hand::HandConfig>("hand");
+        check::<graspopt_metric::MetricConfig>("metric");
+        check::<graspopt_planner::PlannerConfig>("planner");
+        check::<graspopt_coordinator::CoordinatorConfig>("coordinator");
+    }
+
+    #[test]
+    fn an_unknown_key_is_refused_with_the_keys_of_its_table() {
+        let err = load_text::<graspopt_hand::HandConfig>("h.toml", "trial_cost = 5\n").unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(msg.contains("h.toml"), "{msg}");
+        assert!(
+            msg.contains("unknown key `trial_cost` at the top level"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("hand, id, mesh, mesh_scale, object, replay, trial_cost_ms"),
+            "{msg}"
+        );
+        // In a table, the table's own keys.
+        let text = documented("metric").replace("include_palm = true", "include_palms = true");
+        let err = load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("unknown key `include_palms` in [score]"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("contacts, frame, include_palm, metric, model, torque_scale"),
+            "{msg}"
+        );
+        let text = documented("metric").replace("resolution = ", "resolutoin = ");
+        let msg = format!(
+            "{:#}",
+            load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err()
+        );
+        assert!(msg.contains("`resolutoin` in [contacts.cloud]"), "{msg}");
+        // Keys left out keep their defaults; flags of other kinds are not keys.
+        let c: graspopt_hand::HandConfig = load_text("h.toml", "trial_cost_ms = 5\n").unwrap();
+        assert_eq!((c.trial_cost_ms, c.hand.as_str()), (5, "barrett"));
+    }
+}
