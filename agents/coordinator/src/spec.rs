@@ -339,6 +339,46 @@ fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<
     Ok(state)
 }
 
+/// The run a coordinator started on its own serves (`graspopt agent coordinator`): `run`,
+/// or with `resume` and no run id given explicitly (`explicit("run")`), the only run of the
+/// journal; its spec is `given`, or with `resume` the recorded one reconciled with `given`
+/// (contrary explicit settings refused). A run not recorded yet is started, so that a
+/// supervised coordinator can be restarted with one command line. The journal's folder is
+/// created.
+pub fn standalone_run(
+    run: &str,
+    config: &crate::CoordinatorConfig,
+    given: RunSpec,
+    resume: bool,
+    explicit: &dyn Fn(&str) -> bool,
+) -> anyhow::Result<(RunId, RunSpec)> {
+    anyhow::ensure!(given.trials >= 1, "--trials must be at least 1");
+    let mut run_id = RunId::new(run)?;
+    if resume
+        && !explicit("run")
+        && let Some(only) = sole_run(&config.journal_path(&run_id))?
+    {
+        run_id = only;
+    }
+    let journal = config.journal_path(&run_id);
+    let recorded = if resume {
+        recorded_spec(&journal, &run_id)?
+    } else {
+        None
+    };
+    let spec = match recorded {
+        Some(recorded) => reconcile(&run_id, &recorded, &given, explicit)?,
+        None => given,
+    };
+    if let Some(dir) = journal.parent()
+        && !dir.as_os_str().is_empty()
+    {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    }
+    Ok((run_id, spec))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

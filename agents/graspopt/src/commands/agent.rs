@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
@@ -231,15 +231,6 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 c.journal = v.clone();
             }
             c.lease_ms = lease_ms.unwrap_or(c.lease_ms);
-            anyhow::ensure!(*trials >= 1, "--trials must be at least 1");
-            let mut run_id = RunId::new(&common.run)?;
-            // `--resume --journal FILE` continues the run of FILE: its id need not be given.
-            if *resume
-                && !explicit("run")
-                && let Some(only) = graspopt_coordinator::sole_run(&c.journal_path(&run_id))?
-            {
-                run_id = only;
-            }
             let given = RunSpec {
                 object: sim.object()?.name().to_string(),
                 hand: sim.hand.clone(),
@@ -251,27 +242,8 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 initial: *initial,
                 settings: None,
             };
-            let journal_path = c.journal_path(&run_id);
-            // With --resume, the recorded run's settings win (flags that contradict them are
-            // refused); a run not recorded yet is started, so that a supervised coordinator
-            // can be restarted with one command line.
-            let recorded = if *resume {
-                graspopt_coordinator::recorded_spec(&journal_path, &run_id)?
-            } else {
-                None
-            };
-            let spec = match recorded {
-                Some(recorded) => {
-                    graspopt_coordinator::reconcile(&run_id, &recorded, &given, explicit)?
-                }
-                None => given,
-            };
-            if let Some(dir) = journal_path.parent()
-                && !dir.as_os_str().is_empty()
-            {
-                std::fs::create_dir_all(dir)
-                    .with_context(|| format!("cannot create the folder {}", dir.display()))?;
-            }
+            let (run_id, spec) =
+                graspopt_coordinator::standalone_run(&common.run, &c, given, *resume, explicit)?;
             let bus = Bus::open(&common.bus).await?;
             let status = graspopt_coordinator::run_until(
                 &bus,
