@@ -226,8 +226,7 @@ fn median_micros(grasp: &GraspMap, options: &MetricsOptions) -> f64 {
         let _ = std::hint::black_box(evaluate(std::hint::black_box(grasp), options));
         samples.push(t.elapsed().as_secs_f64() * 1e6);
     }
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
+    graspopt_bayesopt::benchmark::median(&samples).unwrap_or(f64::NAN)
 }
 
 /// The grasp map of one case of the file ([`graspopt_quality::cases::Case`]); an error names
