@@ -180,14 +180,6 @@ mod tests {
         assert!((r.offset - 0.5).abs() < 1e-12);
     }
 
-    /// A fixed-seed generator for the random sets below.
-    fn uniform(state: &mut u64) -> f64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-
     #[test]
     fn six_dimensional_cross_polytope_and_cube() {
         let mut cross = Vec::new();
@@ -210,7 +202,8 @@ mod tests {
 
     #[test]
     fn agrees_with_the_full_hull_on_random_sets() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x9e37_79b9_7f4a_7c15);
         for (n, grid) in [(20, 0.0), (48, 0.0), (48, 0.25), (120, 0.0), (200, 0.5)] {
             for _ in 0..5 {
                 // Points in a box around the origin; with a grid, rounded to it, which
@@ -218,7 +211,7 @@ mod tests {
                 let points: Vec<SVector<f64, 6>> = (0..n)
                     .map(|_| {
                         SVector::from_fn(|_, _| {
-                            let x = 2.0 * uniform(&mut state) + 0.1;
+                            let x: f64 = rng.random_range(-1.0..1.0) + 0.1;
                             if grid > 0.0 {
                                 (x / grid).round() * grid
                             } else {
@@ -240,11 +233,14 @@ mod tests {
 
     #[test]
     fn origin_outside_random_sets_give_non_positive_certificates() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x2545_f491_4f6c_dd1d);
         for shift in [0.6, 1.0, 3.0] {
             let points: Vec<SVector<f64, 6>> = (0..48)
                 .map(|_| {
-                    SVector::from_fn(|k, _| uniform(&mut state) + if k == 0 { shift } else { 0.0 })
+                    SVector::from_fn(|k, _| {
+                        rng.random_range(-0.5..0.5) + if k == 0 { shift } else { 0.0 }
+                    })
                 })
                 .collect();
             let r = inner_distance(&points).unwrap();

@@ -438,13 +438,9 @@ mod tests {
         // Random points on and inside a sphere in 5D, added in order: after every step
         // each live facet's neighbours are live, point back, and share all vertices
         // but one with it; every input point ends up inside.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x2545_f491_4f6c_dd1d);
+        let mut uniform = move || rng.random_range(-0.5..0.5);
         let pts: Vec<SVector<f64, 5>> = (0..80)
             .map(|i| {
                 let p = SVector::<f64, 5>::from_fn(|_, _| uniform());

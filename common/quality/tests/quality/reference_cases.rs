@@ -7,6 +7,9 @@ use graspopt_quality::cases::{Case, CaseFile};
 use graspopt_quality::hull::{epa, quickhull};
 use graspopt_quality::metrics::{DistanceSolver, MetricsOptions, distance_to_hull, evaluate};
 use graspopt_quality::{GraspMap, Wrench};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
 use serde_json::Value;
 
 fn cases() -> Vec<Case> {
@@ -157,17 +160,8 @@ fn expanding_polytope_terminates_on_a_near_degenerate_surface_model() {
         .iter()
         .flat_map(|x| x.iter())
         .fold(0.0f64, |a, b| a.max(b.abs()));
-    let mut state = 0x1234_5678_9abc_def1u64;
-    let mut normal = move || {
-        // Box-Muller on xorshift uniforms.
-        let mut u = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        };
-        (-2.0 * u().ln()).sqrt() * (std::f64::consts::TAU * u()).cos()
-    };
+    let mut rng = ChaCha8Rng::seed_from_u64(0x1234_5678_9abc_def1);
+    let mut normal = move || rng.sample::<f64, _>(StandardNormal);
     let mut tightest = f64::INFINITY;
     for _ in 0..20_000 {
         let u = Wrench::from_fn(|_, _| normal()).normalize();
