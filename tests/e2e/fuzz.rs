@@ -17,6 +17,8 @@ use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Message, MetricValues, ObjectEstimate,
     PlannerMethod, Pose, RunId, SuggestRequest, TrialCommand, TrialResult, decode, encode,
 };
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde_json::json;
 
 const RUN: &str = "fz";
@@ -25,17 +27,17 @@ const SEED: &str = "9";
 /// Messages per stream (six streams).
 const PER_STREAM: usize = 1_800;
 
-/// A small deterministic generator (xorshift64*), so a failure replays.
-struct Rng(u64);
+/// A seeded generator (ChaCha8), so a failure replays.
+struct Rng(ChaCha8Rng);
 impl Rng {
+    fn seeded(seed: u64) -> Rng {
+        Rng(ChaCha8Rng::seed_from_u64(seed))
+    }
     fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        self.0.random()
     }
     fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
+        self.0.random_range(0..n.max(1))
     }
 }
 
@@ -245,7 +247,7 @@ struct Sent {
 
 fn send_noise(c: &Cluster) -> Sent {
     let run = RunId::new(RUN).unwrap();
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut rng = Rng::seeded(0x9E37_79B9_7F4A_7C15);
     let (result, object, clouds, command, suggest) = templates();
     let runtime = tokio::runtime::Runtime::new().unwrap();
     runtime.block_on(async {

@@ -2,6 +2,8 @@
 
 use graspopt_protocol::codec::BINCODE_MIME;
 use graspopt_protocol::*;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 fn run() -> RunId {
     RunId::new("run-1").unwrap()
@@ -174,16 +176,9 @@ fn garbage_truncation_and_trailing_bytes_are_refused() {
     huge.extend_from_slice(&u64::MAX.to_le_bytes());
     assert!(decode::<ContactClouds>(&huge, Encoding::Bincode).is_err());
     // Pseudo-random bytes.
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut rng = ChaCha8Rng::seed_from_u64(0x9e37_79b9_7f4a_7c15);
     for len in 0..2000 {
-        let junk: Vec<u8> = (0..len % 300)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 32) as u8
-            })
-            .collect();
+        let junk: Vec<u8> = (0..len % 300).map(|_| rng.random::<u8>()).collect();
         let _ = decode::<ContactClouds>(&junk, Encoding::Bincode);
         let _ = decode::<TrialResult>(&junk, Encoding::Json);
     }
