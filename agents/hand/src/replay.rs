@@ -231,8 +231,8 @@ mod tests {
 
     #[test]
     fn the_nearest_recorded_grasp_answers() {
-        let dir = std::env::temp_dir().join(format!("graspopt-replay-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path().to_path_buf();
         let lines: Vec<String> = [(0.0, 0.1), (1.0, 0.2), (2.0, 0.3)]
             .iter()
             .map(|(x, s)| serde_json::to_string(&grasp(vec![*x, 0.0], *s)).unwrap())
@@ -267,6 +267,5 @@ mod tests {
             .to_string();
         assert!(e.contains("no grasps"), "{e}");
         assert!(Recording::load(&dir.join("missing.jsonl")).is_err());
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -177,10 +177,12 @@ fn the_barrett_settings_make_the_spread_hold_and_the_distal_joints_break_away() 
     );
 }
 
-fn temp_dir(tag: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("graspopt-urdf-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder, deleted when dropped.
+fn temp_dir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("graspopt-urdf-{tag}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn parse_err(urdf: &str, settings: Option<&str>) -> String {
@@ -294,7 +296,8 @@ fn bad_urdf_gives_errors_that_name_the_joint_link_or_file() {
 
 #[test]
 fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
-    let dir = temp_dir("mesh");
+    let scratch = temp_dir("mesh");
+    let dir = scratch.path().to_path_buf();
     let urdf = |file: &str| {
         format!(
             r#"<robot name="r"><link name="palm"><collision><geometry><mesh filename="{file}"/></geometry></collision></link></robot>"#
@@ -322,5 +325,4 @@ fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("nope.urdf"), "{e}");
-    std::fs::remove_dir_all(&dir).ok();
 }

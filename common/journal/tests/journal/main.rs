@@ -4,8 +4,7 @@ use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
 use graspopt_journal::export::{write_csv, write_json};
 use graspopt_journal::{
@@ -16,33 +15,17 @@ use graspopt_journal::{
 
 // ------------------------------------------------------------------ helpers
 
-/// A directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
+/// A scratch folder, removed on drop.
+struct TempDir(tempfile::TempDir);
 
 impl TempDir {
     fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let nanos = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .unwrap()
-            .as_nanos();
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!(
-            "graspopt-journal-{tag}-{}-{nanos}-{n}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        let prefix = format!("graspopt-journal-{tag}-");
+        TempDir(tempfile::Builder::new().prefix(&prefix).tempdir().unwrap())
     }
 
     fn db(&self) -> PathBuf {
-        self.0.join("journal.sqlite")
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
+        self.0.path().join("journal.sqlite")
     }
 }
 
@@ -213,7 +196,7 @@ fn schema_version_checked_at_open() {
     assert!(err.to_string().contains("99"), "{err}");
 
     // Some other SQLite database is not taken for an empty journal.
-    let other = dir.0.join("other.sqlite");
+    let other = dir.0.path().join("other.sqlite");
     {
         let raw = rusqlite::Connection::open(&other).unwrap();
         raw.execute_batch("CREATE TABLE notes (body TEXT)").unwrap();
@@ -222,7 +205,7 @@ fn schema_version_checked_at_open() {
     assert!(matches!(err, JournalError::Schema(_)), "{err}");
 
     // Right version number, wrong layout.
-    let tampered = dir.0.join("tampered.sqlite");
+    let tampered = dir.0.path().join("tampered.sqlite");
     Journal::open(&tampered).unwrap();
     {
         let raw = rusqlite::Connection::open(&tampered).unwrap();

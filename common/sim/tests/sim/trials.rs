@@ -388,15 +388,18 @@ fn bad_input_gives_clear_errors() {
     assert!(sphere.clone().with_pose(nan).is_err());
 }
 
-fn temp_dir(tag: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("graspopt-sim-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder, deleted when dropped.
+fn temp_dir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("graspopt-sim-{tag}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
 fn obj_and_stl_meshes_load_and_can_be_grasped() {
-    let dir = temp_dir("meshes");
+    let scratch = temp_dir("meshes");
+    let dir = scratch.path().to_path_buf();
     // A 4 cm cube standing on z = 0, as OBJ with quads (1-based indices, one `v/vt/vn` face).
     let obj = "# cube\nv -0.02 -0.02 0\nv 0.02 -0.02 0\nv 0.02 0.02 0\nv -0.02 0.02 0\n\
                v -0.02 -0.02 0.04\nv 0.02 -0.02 0.04\nv 0.02 0.02 0.04\nv -0.02 0.02 0.04\n\
@@ -473,7 +476,6 @@ fn obj_and_stl_meshes_load_and_can_be_grasped() {
         Object::from_file(&empty).unwrap_err(),
         SimError::EmptyMesh { .. }
     ));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
