@@ -21,6 +21,7 @@ use super::setup::{Contacts, Frame, SimArgs, param_kind};
 use crate::out::outln;
 use graspopt_pictures::chart;
 use graspopt_runner::{Embedded, placeholder, run_embedded};
+use graspopt_watch::named_params;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
@@ -569,14 +570,4 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// `name=value` for each parameter (5 decimals), joined by `sep`.
-pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
-    let parts: Vec<String> = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| format!("{n}={v:.5}"))
-        .collect();
-    parts.join(sep)
 }
