@@ -14,7 +14,6 @@ use tokio::sync::watch;
 use crate::CoordinatorConfig;
 use crate::core::{Action, Coordinator, Write};
 use crate::spec::{RunSpec, open_run};
-use crate::waits;
 
 /// A proposal request on its way to the planner.
 type PlannerCall<'a> = std::pin::Pin<
@@ -280,7 +279,7 @@ impl<'a> Io<'a> {
         let waiting = if s.waiting.is_empty() {
             String::new()
         } else {
-            let waits = waits::describe(&s.waiting, s.stamp_ms);
+            let waits = graspopt_protocol::describe_waits(&s.waiting, s.stamp_ms);
             format!(" while waiting ({waits})")
         };
         // A run that issued no trial is started afresh by the same command (see `open_run`).

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use graspopt_protocol::{WaitReason, Waiting};
+use graspopt_protocol::{WaitReason, Waiting, describe_waits};
 
 /// A wait shows (status, monitor, log) once it has lasted this long: agents that join within
 /// a moment of the coordinator, as in every ordinary start, make no message.
@@ -60,26 +60,10 @@ impl Waits {
             Some((at, before)) if *before == reasons && now_ms - at < REPEAT_MS => None,
             _ => {
                 self.told = Some((now_ms, reasons));
-                Some(format!("is waiting: {}", describe(&shown, now_ms)))
+                Some(format!("is waiting: {}", describe_waits(&shown, now_ms)))
             }
         }
     }
-}
-
-/// `waits` for people, with how long each has lasted at `now_ms`: "no metric agent (12 s), no
-/// hand (3 s)".
-pub fn describe(waits: &[Waiting], now_ms: i64) -> String {
-    waits
-        .iter()
-        .map(|w| {
-            format!(
-                "{} ({:.0} s)",
-                w.reason.describe(),
-                (now_ms - w.since_ms).max(0) as f64 / 1000.0
-            )
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 #[cfg(test)]

@@ -533,6 +533,22 @@ pub struct Waiting {
     pub since_ms: i64,
 }
 
+/// `waits` for people, with how long each has lasted at `now_ms`: "no metric agent (12 s), no
+/// hand (3 s)" (the coordinator's log, the monitor).
+pub fn describe_waits(waits: &[Waiting], now_ms: i64) -> String {
+    waits
+        .iter()
+        .map(|w| {
+            format!(
+                "{} ({:.0} s)",
+                w.reason.describe(),
+                (now_ms - w.since_ms).max(0) as f64 / 1000.0
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// coordinator -> monitors: the state of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunStatus {

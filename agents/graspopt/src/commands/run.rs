@@ -20,6 +20,7 @@ use super::setup::SimArgs;
 use crate::out::outln;
 use graspopt_pictures::chart;
 use graspopt_runner::{Embedded, RunSettings, placeholder, run_embedded};
+use graspopt_watch::named_params;
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
@@ -276,14 +277,4 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// `name=value` for each parameter (5 decimals), joined by `sep`.
-pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
-    let parts: Vec<String> = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| format!("{n}={v:.5}"))
-        .collect();
-    parts.join(sep)
 }

@@ -1,0 +1,158 @@
+//! The monitor's loops: the bus (liveliness, states, statuses) and the keyboard.
+
+use std::future::Future;
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use graspopt_bus::Bus;
+use graspopt_protocol::keys::ROOT;
+use graspopt_protocol::{RunId, RunStatus};
+use tokio::sync::mpsc;
+
+use super::app::{Monitor, run_lines};
+use super::ui::draw;
+
+/// How long a new session waits for the liveliness tokens already on the bus.
+const SETTLE: Duration = Duration::from_millis(300);
+
+/// The runs whose coordinator is alive (`only`: this run, if it is).
+pub async fn live_runs(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
+    let run = only.map(RunId::as_str).unwrap_or("*");
+    let key = format!("{ROOT}/{run}/alive/coordinator/**");
+    let mut runs: Vec<String> = bus
+        .alive_now(&key)
+        .await
+        .unwrap_or_default()
+        .into_iter()
+        .map(|a| a.run.as_str().to_string())
+        .collect();
+    runs.sort();
+    runs.dedup();
+    runs
+}
+
+/// Asks each live run without a status for its coordinator's current state.
+pub async fn ask_states(bus: &Bus, m: &mut Monitor) {
+    for r in m.missing_states() {
+        let Ok(id) = RunId::new(&r) else { continue };
+        match bus
+            .get::<RunStatus>(&id.state_key(), Duration::from_secs(2))
+            .await
+        {
+            Ok(s) => m.on_status(s, Instant::now()),
+            Err(e) => tracing::warn!("monitor: state of run {r:?}: {e}"),
+        }
+    }
+}
+
+/// The runs' state as text, once: each run's [`run_lines`] and an empty line.
+pub async fn once(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
+    tokio::time::sleep(SETTLE).await;
+    let mut m = Monitor::default();
+    m.set_alive(&live_runs(bus, only).await);
+    ask_states(bus, &mut m).await;
+    if m.runs.is_empty() {
+        return vec!["no runs: no live coordinator (check --connect)".into()];
+    }
+    let now = Instant::now();
+    let mut out = Vec::new();
+    for (name, view) in &m.runs {
+        out.extend(run_lines(name, view, now));
+        out.push(String::new());
+    }
+    out
+}
+
+enum Key {
+    Quit,
+    Next,
+}
+
+/// Reads the keyboard on its own thread (crossterm's read blocks).
+fn read_keys() -> mpsc::UnboundedReceiver<Key> {
+    let (keys_tx, keys) = mpsc::unbounded_channel();
+    std::thread::spawn(move || {
+        use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
+        while let Ok(ev) = event::read() {
+            if let Event::Key(k) = ev
+                && k.kind == KeyEventKind::Press
+            {
+                let key = match k.code {
+                    KeyCode::Char('q') | KeyCode::Esc => Key::Quit,
+                    // Raw mode delivers Ctrl-C as a key, not a signal.
+                    KeyCode::Char('c') if k.modifiers.contains(KeyModifiers::CONTROL) => Key::Quit,
+                    KeyCode::Tab | KeyCode::Right | KeyCode::Down => Key::Next,
+                    _ => continue,
+                };
+                let quit = matches!(key, Key::Quit);
+                if keys_tx.send(key).is_err() || quit {
+                    break;
+                }
+            }
+        }
+    });
+    keys
+}
+
+/// The dashboard on this terminal, until `q`, Esc or `stop`.
+pub async fn dashboard(
+    bus: &Bus,
+    only: Option<&RunId>,
+    stop: impl Future<Output = ()>,
+) -> Result<()> {
+    let status_key = format!("{ROOT}/{}/status", only.map(RunId::as_str).unwrap_or("*"));
+    let statuses = bus.subscribe_ring::<RunStatus>(&status_key, 64).await?;
+    let alive = bus
+        .watch_alive(&format!(
+            "{ROOT}/{}/alive/coordinator/**",
+            only.map(RunId::as_str).unwrap_or("*")
+        ))
+        .await?;
+    let mut keys = read_keys();
+    let mut terminal = match ratatui::try_init() {
+        Ok(t) => t,
+        Err(e) => {
+            // Raw mode may be on already: give the shell its terminal back.
+            ratatui::restore();
+            return Err(anyhow::anyhow!(
+                "cannot use this terminal for the dashboard: {e} (try --once)"
+            ));
+        }
+    };
+    let mut m = Monitor::default();
+    let mut alive_runs: Vec<String> = Vec::new();
+    let mut redraw = tokio::time::interval(Duration::from_millis(250));
+    let mut ask = tokio::time::interval(Duration::from_secs(2));
+    tokio::pin!(stop);
+    let result = loop {
+        tokio::select! {
+            _ = redraw.tick() => {
+                let now = Instant::now();
+                if let Err(e) = terminal.draw(|f| draw(f, &m, now)) {
+                    break Err(e.into());
+                }
+            }
+            _ = ask.tick() => ask_states(bus, &mut m).await,
+            Some(s) = statuses.recv() => if let Ok(s) = s.message {
+                m.on_status(s, Instant::now());
+            },
+            Some(ev) = alive.recv() => {
+                let run = ev.agent.run.as_str().to_string();
+                if ev.alive {
+                    if !alive_runs.contains(&run) { alive_runs.push(run); }
+                } else {
+                    alive_runs.retain(|r| *r != run);
+                }
+                m.set_alive(&alive_runs);
+                ask_states(bus, &mut m).await;
+            }
+            Some(k) = keys.recv() => match k {
+                Key::Quit => break Ok(()),
+                Key::Next => m.next_run(),
+            },
+            _ = &mut stop => break Ok(()),
+        }
+    };
+    ratatui::restore();
+    result
+}

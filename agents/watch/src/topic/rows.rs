@@ -1,0 +1,154 @@
+//! The rows of `topic list`: what the live agents publish and answer.
+
+use std::collections::BTreeMap;
+
+use graspopt_protocol::keys::AliveKey;
+use graspopt_protocol::{AgentKind, RunId, Topic};
+use serde_json::{Value, json};
+
+/// One row of `topic list`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    pub run: String,
+    pub key: String,
+    pub message: &'static str,
+    /// `id@host` of each publisher.
+    pub publishers: Vec<String>,
+}
+
+/// The topics the live agents publish (and the queries they answer), by run then key.
+pub fn topic_rows(agents: &[AliveKey]) -> Vec<Row> {
+    let mut by_run: BTreeMap<String, Vec<&AliveKey>> = BTreeMap::new();
+    for a in agents {
+        by_run
+            .entry(a.run.as_str().to_string())
+            .or_default()
+            .push(a);
+    }
+    let mut rows = Vec::new();
+    for (run, agents) in by_run {
+        let Ok(id) = RunId::new(&run) else { continue };
+        let of = |kind: AgentKind| -> Vec<String> {
+            let mut v: Vec<String> = agents
+                .iter()
+                .filter(|a| a.kind == kind)
+                .map(|a| format!("{}@{}", a.id, a.host))
+                .collect();
+            v.sort();
+            v
+        };
+        let mut push = |key: String, message: &'static str, publishers: Vec<String>| {
+            if !publishers.is_empty() {
+                rows.push(Row {
+                    run: run.clone(),
+                    key,
+                    message,
+                    publishers,
+                });
+            }
+        };
+        for topic in Topic::ALL {
+            let publishers = of(topic.publisher());
+            match topic {
+                Topic::Command => {
+                    let mut hands: Vec<&str> = agents
+                        .iter()
+                        .filter(|a| a.kind == AgentKind::Hand)
+                        .map(|a| a.id.as_str())
+                        .collect();
+                    hands.sort();
+                    for h in hands {
+                        push(id.command_key(h), topic.message_type(), publishers.clone());
+                    }
+                }
+                Topic::Object => push(id.object_key(), topic.message_type(), publishers),
+                Topic::Clouds => push(id.clouds_key(), topic.message_type(), publishers),
+                Topic::Result => push(id.result_key(), topic.message_type(), publishers),
+                Topic::Status => push(id.status_key(), topic.message_type(), publishers),
+            }
+        }
+        push(
+            id.suggest_key(),
+            "query SuggestRequest -> SuggestReply",
+            of(AgentKind::Planner),
+        );
+        push(
+            id.state_key(),
+            "query -> RunStatus",
+            of(AgentKind::Coordinator),
+        );
+    }
+    rows.sort_by(|a, b| (&a.run, &a.key).cmp(&(&b.run, &b.key)));
+    rows
+}
+
+/// The rows as one JSON array.
+pub fn rows_json(rows: &[Row]) -> Value {
+    rows.iter()
+        .map(|r| json!({"run": r.run, "key": r.key, "type": r.message, "publishers": r.publishers}))
+        .collect()
+}
+
+/// The rows as a table (a header line, then one line per row).
+pub fn rows_table(rows: &[Row]) -> Vec<String> {
+    let w = rows.iter().map(|r| r.key.len()).max().unwrap_or(0);
+    let t = rows.iter().map(|r| r.message.len()).max().unwrap_or(0);
+    let mut out = vec![format!("{:w$}  {:t$}  PUBLISHERS", "TOPIC", "TYPE")];
+    for r in rows {
+        out.push(format!(
+            "{:w$}  {:t$}  {}",
+            r.key,
+            r.message,
+            r.publishers.join(", ")
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn list_rows_follow_the_live_agents() {
+        let run = RunId::new("r").unwrap();
+        let a = |kind, id: &str| AliveKey {
+            run: run.clone(),
+            kind,
+            host: "h".into(),
+            id: id.into(),
+            encoding: graspopt_protocol::Encoding::Bincode,
+        };
+        let rows = topic_rows(&[
+            a(AgentKind::Metric, "metric"),
+            a(AgentKind::Hand, "hand-2"),
+            a(AgentKind::Hand, "hand-1"),
+            a(AgentKind::Coordinator, "coordinator"),
+        ]);
+        let keys: Vec<&str> = rows.iter().map(|r| r.key.as_str()).collect();
+        assert_eq!(
+            keys,
+            [
+                "graspopt/r/clouds",
+                "graspopt/r/coordinator/state",
+                "graspopt/r/hand/hand-1/command",
+                "graspopt/r/hand/hand-2/command",
+                "graspopt/r/result",
+                "graspopt/r/status"
+            ]
+        );
+        let clouds = &rows[0];
+        assert_eq!(clouds.message, "ContactClouds");
+        assert_eq!(clouds.publishers, ["hand-1@h", "hand-2@h"]);
+        let table = rows_table(&rows[..2]);
+        assert_eq!(
+            table,
+            [
+                "TOPIC                         TYPE                PUBLISHERS",
+                "graspopt/r/clouds             ContactClouds       hand-1@h, hand-2@h",
+                "graspopt/r/coordinator/state  query -> RunStatus  coordinator@h",
+            ]
+        );
+        assert_eq!(rows_json(&rows)[1]["type"], "query -> RunStatus");
+    }
+}
