@@ -4,14 +4,36 @@
 
 use crate::support::{decode_png, graspopt, tempdir};
 
-/// The grey of grasps that touched nothing.
-const GREY: &str = "rgb(128,128,128)";
+/// The grey of grasps that touched nothing, as the charts write it.
+const GREY: &str = "#808080";
 
-/// The numbers written as the y axis's tick labels of an SVG chart.
-fn y_ticks(svg: &str) -> Vec<f64> {
-    svg.split(r#"text-anchor="end">"#)
+/// The SVG elements named `name` (`<name ...>`): their attributes and text.
+fn elements<'a>(svg: &'a str, name: &str) -> Vec<(&'a str, &'a str)> {
+    svg.split(&format!("<{name} "))
         .skip(1)
-        .filter_map(|s| s.split('<').next()?.parse().ok())
+        .filter_map(|s| {
+            let (attrs, rest) = s.split_once('>')?;
+            let text = rest.split_once(&format!("</{name}>")).map_or("", |t| t.0);
+            Some((attrs, text.trim()))
+        })
+        .collect()
+}
+
+/// The numbers written as the y axis's tick labels of an SVG chart (right-aligned text).
+fn y_ticks(svg: &str) -> Vec<f64> {
+    elements(svg, "text")
+        .into_iter()
+        .filter(|(attrs, _)| attrs.contains(r#"text-anchor="end""#))
+        .filter_map(|(_, text)| text.parse().ok())
+        .collect()
+}
+
+/// The filled dots of radius `r` in an SVG chart: their attributes.
+fn dots<'a>(svg: &'a str, r: &str) -> Vec<&'a str> {
+    elements(svg, "circle")
+        .into_iter()
+        .map(|(attrs, _)| attrs)
+        .filter(|a| a.contains(&format!(r#"r="{r}""#)) && !a.contains(r#"fill="none""#))
         .collect()
 }
 
@@ -58,30 +80,41 @@ fn run_pictures_show_the_best_grasp_and_keep_misses_off_the_scale() {
         .map(|r| r.0)
         .fold(f64::NEG_INFINITY, f64::max);
 
-    // best.svg: the score axis spans the grasps, the misses are grey ticks below it.
+    // best.svg: the score axis spans the grasps (its lowest and highest ticks within a tick
+    // step of them), the misses are grey ticks below it.
     let best = std::fs::read_to_string(out.join("best.svg")).unwrap();
-    let ticks = y_ticks(&best);
-    assert_eq!(ticks.len(), 5, "{best}");
-    let bottom = ticks.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut ticks = y_ticks(&best);
+    ticks.sort_by(f64::total_cmp);
+    assert!(ticks.len() >= 3, "{best}");
+    let step = ticks[1] - ticks[0];
+    let (bottom, top) = (ticks[0], ticks[ticks.len() - 1]);
+    let highest_hit = hits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     assert!(
         bottom > highest_miss,
         "axis from {bottom}: misses set the scale"
     );
     assert!(
-        bottom <= lowest_hit && lowest_hit - bottom < 0.1,
-        "{bottom} {lowest_hit}"
+        bottom - lowest_hit < step + 1e-12 && highest_hit - top < step + 1e-12,
+        "ticks {ticks:?} for grasps from {lowest_hit} to {highest_hit}"
     );
     assert_eq!(best.matches(&format!(r#"stroke="{GREY}""#)).count(), misses);
     assert!(best.contains("no contact"), "{best}");
 
-    // trials.svg: a dot per trial, grey for the misses, the best ringed, a legend.
+    // trials.svg: a dot per trial (and one in the legend), grey for the misses, the best
+    // ringed in red, a legend.
     let map = std::fs::read_to_string(out.join("trials.svg")).unwrap();
-    assert_eq!(map.matches(r#"r="4.5""#).count(), 12, "{map}");
-    assert_eq!(
-        map.matches(&format!(r#"r="4.5" fill="{GREY}""#)).count(),
-        misses
-    );
-    assert!(map.contains(r#"stroke="red""#) && map.contains("grey: no contact"));
+    let placed = dots(&map, "4");
+    assert_eq!(placed.len(), 12 + 1, "{map}");
+    let grey = placed
+        .iter()
+        .filter(|a| a.contains(&format!(r#"fill="{GREY}""#)));
+    assert_eq!(grey.count(), misses);
+    let rings = elements(&map, "circle")
+        .into_iter()
+        .filter(|(a, _)| a.contains(r#"r="9""#) && a.contains(r##"stroke="#FF0000""##))
+        .count();
+    assert_eq!(rings, 1, "{map}");
+    assert!(map.contains("grey: no contact"));
     assert!(map.contains("approach offset (m)") && map.contains("vertical offset (m)"));
 
     // best.png: the best grasp, titled, with its contacts.

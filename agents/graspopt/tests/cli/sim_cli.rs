@@ -189,11 +189,11 @@ fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
         let f: Vec<&str> = l.split(',').collect();
         assert_eq!(f[3..6], ["", "", ""], "{l}");
     }
-    // SVG: grey cells, one per miss, and a legend saying what grey means.
+    // SVG: grey cells, one per miss, the legend's grey square, and the legend's text.
     let svg = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.svg")).unwrap();
     assert_eq!(
-        svg.matches(r#"fill="rgb(128,128,128)"/>"#).count(),
-        misses.len(),
+        svg.matches(r##"fill="#808080" stroke="none"/>"##).count(),
+        misses.len() + 1,
         "{svg}"
     );
     assert!(svg.contains("grey: no contact"), "{svg}");
