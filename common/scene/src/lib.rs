@@ -1,14 +1,16 @@
 //! A grasp scene for 3D viewers: a grasp's object, hand links, contact points and contact
 //! normals as a Wavefront OBJ (with an MTL of one colour per group) or a glTF 2.0 JSON file
-//! with its buffer embedded (base64).
+//! built with `gltf-json`'s types, its buffer embedded as a base64 data URI.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use base64::prelude::{BASE64_STANDARD, Engine as _};
+use gltf_json as json;
 use graspopt_sim::ContactPoint;
 use graspopt_sim::scene::NamedMesh;
+use json::validation::Checked::Valid;
 use nalgebra::{Point3, Vector3};
 
 /// Vertices of one contact marker (an octahedron).
@@ -183,74 +185,204 @@ fn parts(meshes: &[NamedMesh], contacts: &[ContactPoint], normal_length: f64) ->
     out
 }
 
-/// Writes the same scene as [`write_obj`] as glTF 2.0 (JSON, buffer embedded as base64): one
-/// mesh and node per part (the meshes in order, `contacts` with the octahedral markers, and
-/// `normals` as a lines primitive), each with its own colour. The world's `z` (up) becomes
-/// glTF's `y` (up) through a rotation on the root node. Parts with nothing to draw (no
-/// contacts, an empty mesh) are left out. Errors name the path.
-pub fn write_gltf(
-    path: &Path,
-    meshes: &[NamedMesh],
-    contacts: &[ContactPoint],
-    normal_length: f64,
-) -> Result<()> {
-    use serde_json::{Value, json};
-    let mut buffer: Vec<u8> = Vec::new();
-    let mut views: Vec<Value> = Vec::new();
-    let mut accessors: Vec<Value> = Vec::new();
-    let mut gl_meshes: Vec<Value> = Vec::new();
-    let mut materials: Vec<Value> = Vec::new();
-    let mut nodes: Vec<Value> = vec![json!({
-        "name": "graspopt scene (world frame, z up)",
-        "rotation": [-std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f64::consts::FRAC_1_SQRT_2],
-        "children": [],
-    })];
-    // Appends positions (f32) as a buffer view and accessor; returns the accessor index.
-    let add_positions = |buffer: &mut Vec<u8>,
-                         views: &mut Vec<Value>,
-                         accessors: &mut Vec<Value>,
-                         points: &[Point3<f64>]| {
-        let offset = buffer.len();
+/// The glTF document being built: the JSON root, the bytes of its one buffer, and the root
+/// node the parts hang from.
+struct Gltf {
+    root: json::Root,
+    buffer: Vec<u8>,
+    top: json::Index<json::Node>,
+}
+
+impl Gltf {
+    fn new() -> Self {
+        let mut root = json::Root {
+            asset: json::Asset {
+                generator: Some("graspopt".into()),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        let top = root.push(json::Node {
+            name: Some("graspopt scene (world frame, z up)".into()),
+            rotation: Some(json::scene::UnitQuaternion([-h, 0.0, 0.0, h])),
+            children: Some(Vec::new()),
+            ..Default::default()
+        });
+        Self {
+            root,
+            buffer: Vec::new(),
+            top,
+        }
+    }
+
+    /// Appends `bytes` to the buffer as a view for `target`.
+    fn view(
+        &mut self,
+        bytes: &[u8],
+        target: json::buffer::Target,
+    ) -> json::Index<json::buffer::View> {
+        let offset = self.buffer.len();
+        self.buffer.extend_from_slice(bytes);
+        self.root.push(json::buffer::View {
+            buffer: json::Index::new(0),
+            byte_length: bytes.len().into(),
+            byte_offset: Some(offset.into()),
+            byte_stride: None,
+            name: None,
+            target: Some(Valid(target)),
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
+    /// An accessor of `count` elements of `kind` over `view`.
+    fn accessor(
+        &mut self,
+        view: json::Index<json::buffer::View>,
+        count: usize,
+        (component, kind): (json::accessor::ComponentType, json::accessor::Type),
+        bounds: Option<([f32; 3], [f32; 3])>,
+    ) -> json::Index<json::Accessor> {
+        self.root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: count.into(),
+            component_type: Valid(json::accessor::GenericComponentType(component)),
+            type_: Valid(kind),
+            min: bounds.map(|b| json::Value::from(b.0.to_vec())),
+            max: bounds.map(|b| json::Value::from(b.1.to_vec())),
+            name: None,
+            normalized: false,
+            sparse: None,
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
+    /// Positions as `f32` triples with their bounds (required by glTF for positions).
+    fn positions(&mut self, points: &[Point3<f64>]) -> json::Index<json::Accessor> {
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
+        let mut bytes = Vec::with_capacity(12 * points.len());
         for p in points {
             for k in 0..3 {
                 let x = p[k] as f32;
                 lo[k] = lo[k].min(x);
                 hi[k] = hi[k].max(x);
-                buffer.extend_from_slice(&x.to_le_bytes());
+                bytes.extend_from_slice(&x.to_le_bytes());
             }
         }
-        views.push(json!({
-            "buffer": 0, "byteOffset": offset, "byteLength": buffer.len() - offset,
-            "target": 34962,
-        }));
-        accessors.push(json!({
-            "bufferView": views.len() - 1, "componentType": 5126, "count": points.len(),
-            "type": "VEC3", "min": lo, "max": hi,
-        }));
-        accessors.len() - 1
-    };
-    let mut add_part = |name: &str, kd: [f64; 3], primitive: Value, nodes: &mut Vec<Value>| {
-        let mut primitive = primitive;
-        primitive["material"] = json!(materials.len());
-        materials.push(json!({
-            "name": name,
-            "pbrMetallicRoughness": {
-                "baseColorFactor": [kd[0], kd[1], kd[2], 1.0],
-                "metallicFactor": 0.0,
-                "roughnessFactor": 0.8,
+        let view = self.view(&bytes, json::buffer::Target::ArrayBuffer);
+        let kind = (
+            json::accessor::ComponentType::F32,
+            json::accessor::Type::Vec3,
+        );
+        self.accessor(view, points.len(), kind, Some((lo, hi)))
+    }
+
+    /// Triangle vertex indices as `u32`.
+    fn indices(&mut self, triangles: &[[u32; 3]]) -> json::Index<json::Accessor> {
+        let bytes: Vec<u8> = triangles
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, json::buffer::Target::ElementArrayBuffer);
+        let kind = (
+            json::accessor::ComponentType::U32,
+            json::accessor::Type::Scalar,
+        );
+        self.accessor(view, 3 * triangles.len(), kind, None)
+    }
+
+    /// A part: its material of colour `kd`, a mesh of one primitive, a node under the top one.
+    fn part(
+        &mut self,
+        name: &str,
+        kd: [f64; 3],
+        (positions, indices, mode): (
+            json::Index<json::Accessor>,
+            Option<json::Index<json::Accessor>>,
+            json::mesh::Mode,
+        ),
+    ) {
+        let material = self.root.push(json::Material {
+            name: Some(name.into()),
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                base_color_factor: json::material::PbrBaseColorFactor([
+                    kd[0] as f32,
+                    kd[1] as f32,
+                    kd[2] as f32,
+                    1.0,
+                ]),
+                metallic_factor: json::material::StrengthFactor(0.0),
+                roughness_factor: json::material::StrengthFactor(0.8),
+                ..Default::default()
             },
-            "doubleSided": true,
-        }));
-        gl_meshes.push(json!({"name": name, "primitives": [primitive]}));
-        nodes.push(json!({"name": name, "mesh": gl_meshes.len() - 1}));
-        let child = nodes.len() - 1;
-        nodes[0]["children"]
-            .as_array_mut()
-            .expect("children")
-            .push(json!(child));
-    };
+            double_sided: true,
+            ..Default::default()
+        });
+        let primitive = json::mesh::Primitive {
+            attributes: [(Valid(json::mesh::Semantic::Positions), positions)].into(),
+            indices,
+            material: Some(material),
+            mode: Valid(mode),
+            targets: None,
+            extensions: None,
+            extras: Default::default(),
+        };
+        let mesh = self.root.push(json::Mesh {
+            name: Some(name.into()),
+            primitives: vec![primitive],
+            weights: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let node = self.root.push(json::Node {
+            name: Some(name.into()),
+            mesh: Some(mesh),
+            ..Default::default()
+        });
+        let top = self.top.value();
+        self.root.nodes[top]
+            .children
+            .get_or_insert_with(Vec::new)
+            .push(node);
+    }
+
+    /// The finished document: the buffer as a base64 data URI, one scene of the top node.
+    fn finish(mut self) -> json::Root {
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            BASE64_STANDARD.encode(&self.buffer)
+        );
+        self.root.push(json::Buffer {
+            byte_length: self.buffer.len().into(),
+            uri: Some(uri),
+            name: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let scene = self.root.push(json::Scene {
+            name: Some("grasp".into()),
+            nodes: vec![self.top],
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.root.scene = Some(scene);
+        self.root
+    }
+}
+
+/// The scene of [`write_gltf`] as a glTF 2.0 document (see there), or what is wrong with the
+/// meshes.
+pub fn gltf_document(
+    meshes: &[NamedMesh],
+    contacts: &[ContactPoint],
+    normal_length: f64,
+) -> Result<json::Root> {
+    let mut doc = Gltf::new();
     for (name, kd, vertices, triangles) in parts(meshes, contacts, normal_length) {
         if vertices.is_empty() || triangles.is_empty() {
             continue;
@@ -260,240 +392,48 @@ pub fn write_gltf(
             .flatten()
             .find(|&&i| i as usize >= vertices.len())
         {
-            anyhow::bail!(
-                "cannot write the scene {}: mesh {name} has a vertex index {t} out of range",
-                path.display()
-            );
+            anyhow::bail!("mesh {name} has a vertex index {t} out of range");
         }
-        let position = add_positions(&mut buffer, &mut views, &mut accessors, &vertices);
-        let offset = buffer.len();
-        for i in triangles.iter().flatten() {
-            buffer.extend_from_slice(&i.to_le_bytes());
-        }
-        views.push(json!({
-            "buffer": 0, "byteOffset": offset, "byteLength": buffer.len() - offset,
-            "target": 34963,
-        }));
-        accessors.push(json!({
-            "bufferView": views.len() - 1, "componentType": 5125,
-            "count": triangles.len() * 3, "type": "SCALAR",
-        }));
-        let primitive = json!({
-            "attributes": {"POSITION": position},
-            "indices": accessors.len() - 1,
-            "mode": 4,
-        });
-        add_part(&name, kd, primitive, &mut nodes);
+        let positions = doc.positions(&vertices);
+        let indices = doc.indices(&triangles);
+        doc.part(
+            &name,
+            kd,
+            (positions, Some(indices), json::mesh::Mode::Triangles),
+        );
     }
     if !contacts.is_empty() {
         let ends: Vec<Point3<f64>> = contacts
             .iter()
             .flat_map(|c| [c.position, c.position - c.normal * normal_length])
             .collect();
-        let position = add_positions(&mut buffer, &mut views, &mut accessors, &ends);
-        let primitive = json!({"attributes": {"POSITION": position}, "mode": 1});
-        add_part("normals", NORMAL_KD, primitive, &mut nodes);
+        let positions = doc.positions(&ends);
+        doc.part(
+            "normals",
+            NORMAL_KD,
+            (positions, None, json::mesh::Mode::Lines),
+        );
     }
-    let doc = json!({
-        "asset": {"version": "2.0", "generator": "graspopt"},
-        "scene": 0,
-        "scenes": [{"name": "grasp", "nodes": [0]}],
-        "nodes": nodes,
-        "meshes": gl_meshes,
-        "materials": materials,
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{
-            "byteLength": buffer.len(),
-            "uri": format!(
-                "data:application/octet-stream;base64,{}",
-                BASE64_STANDARD.encode(&buffer)
-            ),
-        }],
-    });
-    let text = serde_json::to_string(&doc)?;
-    std::fs::write(path, text).with_context(|| format!("cannot write the scene {}", path.display()))
+    Ok(doc.finish())
+}
+
+/// Writes the same scene as [`write_obj`] as glTF 2.0 (JSON, buffer embedded as a base64 data
+/// URI), built with `gltf-json`'s types: one mesh, material and node per part (the meshes in
+/// order, `contacts` with the octahedral markers, and `normals` as a lines primitive), each
+/// with its own colour. The world's `z` (up) becomes glTF's `y` (up) through a rotation on
+/// the root node. Parts with nothing to draw (no contacts, an empty mesh) are left out.
+/// Errors name the path.
+pub fn write_gltf(
+    path: &Path,
+    meshes: &[NamedMesh],
+    contacts: &[ContactPoint],
+    normal_length: f64,
+) -> Result<()> {
+    let context = || format!("cannot write the scene {}", path.display());
+    let doc = gltf_document(meshes, contacts, normal_length).with_context(context)?;
+    let text = json::serialize::to_string(&doc).with_context(context)?;
+    std::fs::write(path, text).with_context(context)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use graspopt_sim::TriangleMesh;
-
-    fn tetra(offset: f64) -> TriangleMesh {
-        TriangleMesh::new(
-            vec![
-                Point3::new(offset, 0.0, 0.0),
-                Point3::new(offset + 1.0, 0.0, 0.0),
-                Point3::new(offset, 1.0, 0.0),
-                Point3::new(offset, 0.0, 1.0),
-            ],
-            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        )
-    }
-
-    #[test]
-    fn obj_groups_counts_and_normals() {
-        let dir = std::env::temp_dir().join(format!("graspopt-export-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("scene.obj");
-        let meshes = vec![
-            NamedMesh {
-                name: "sphere".into(),
-                mesh: tetra(0.0),
-            },
-            NamedMesh {
-                name: "finger 1".into(),
-                mesh: tetra(5.0),
-            },
-        ];
-        let contacts = vec![
-            ContactPoint {
-                position: Point3::new(1.0, 2.0, 3.0),
-                normal: Vector3::z(),
-                weight: 1.0,
-            },
-            ContactPoint {
-                position: Point3::new(0.0, 0.0, 0.0),
-                normal: -Vector3::x(),
-                weight: 1.0,
-            },
-        ];
-        write_obj(&path, &meshes, &contacts, 0.5).unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        let count = |p: &str| lines.iter().filter(|l| l.starts_with(p)).count();
-        assert_eq!(count("v "), 8 + 2 * MARKER_VERTICES + 2 * 2);
-        assert_eq!(count("f "), 8 + 2 * MARKER_TRIANGLES);
-        assert_eq!(count("l "), 2);
-        for g in ["g sphere", "g finger_1", "g contacts", "g normals"] {
-            assert!(lines.contains(&g), "{g}");
-        }
-        assert!(lines.contains(&"mtllib scene.mtl"));
-        // Every index refers to a vertex.
-        let vs: Vec<[f64; 3]> = lines
-            .iter()
-            .filter_map(|l| l.strip_prefix("v "))
-            .map(|l| {
-                let c: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
-                [c[0], c[1], c[2]]
-            })
-            .collect();
-        for l in lines
-            .iter()
-            .filter(|l| l.starts_with("f ") || l.starts_with("l "))
-        {
-            for i in l[2..].split(' ') {
-                let i: usize = i.parse().unwrap();
-                assert!(i >= 1 && i <= vs.len(), "{l}");
-            }
-        }
-        // The first normal line goes from the contact outward (against the normal).
-        let l: Vec<usize> = lines
-            .iter()
-            .find(|l| l.starts_with("l "))
-            .unwrap()
-            .split(' ')
-            .skip(1)
-            .map(|i| i.parse().unwrap())
-            .collect();
-        assert_eq!(vs[l[0] - 1], [1.0, 2.0, 3.0]);
-        assert_eq!(vs[l[1] - 1], [1.0, 2.0, 2.5]);
-        // The second mesh's faces are shifted past the first mesh's vertices.
-        assert!(lines.contains(&"f 5 7 6"));
-        let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
-        assert_eq!(mtl.matches("newmtl ").count(), 4);
-        for l in lines.iter().filter_map(|l| l.strip_prefix("usemtl ")) {
-            assert!(mtl.contains(&format!("newmtl {l}\n")), "{l}");
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    fn unbase64(s: &str) -> Vec<u8> {
-        BASE64_STANDARD.decode(s).unwrap()
-    }
-
-    #[test]
-    fn gltf_holds_every_part() {
-        let dir = std::env::temp_dir().join(format!("graspopt-gltf-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("scene.gltf");
-        let meshes = vec![
-            NamedMesh {
-                name: "sphere".into(),
-                mesh: tetra(0.0),
-            },
-            NamedMesh {
-                name: "palm".into(),
-                mesh: tetra(5.0),
-            },
-        ];
-        let contacts = vec![ContactPoint {
-            position: Point3::new(1.0, 2.0, 3.0),
-            normal: Vector3::z(),
-            weight: 1.0,
-        }];
-        write_gltf(&path, &meshes, &contacts, 0.5).unwrap();
-        let doc: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        assert_eq!(doc["asset"]["version"], "2.0");
-        let names: Vec<&str> = doc["meshes"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|m| m["name"].as_str().unwrap())
-            .collect();
-        assert_eq!(names, ["sphere", "palm", "contacts", "normals"]);
-        assert_eq!(doc["nodes"][0]["children"], serde_json::json!([1, 2, 3, 4]));
-        let uri = doc["buffers"][0]["uri"].as_str().unwrap();
-        let data = unbase64(
-            uri.strip_prefix("data:application/octet-stream;base64,")
-                .unwrap(),
-        );
-        assert_eq!(
-            data.len() as u64,
-            doc["buffers"][0]["byteLength"].as_u64().unwrap()
-        );
-        let acc = |i: &serde_json::Value| &doc["accessors"][i.as_u64().unwrap() as usize];
-        let mut total = 0;
-        for (m, (verts, indices, mode)) in doc["meshes"].as_array().unwrap().iter().zip([
-            (4, 12, 4),
-            (4, 12, 4),
-            (6, 24, 4),
-            (2, 0, 1),
-        ]) {
-            let p = &m["primitives"][0];
-            assert_eq!(p["mode"], mode);
-            let pos = acc(&p["attributes"]["POSITION"]);
-            assert_eq!(pos["count"], verts);
-            if indices > 0 {
-                assert_eq!(acc(&p["indices"])["count"], indices);
-            }
-            total += verts * 12 + indices * 4;
-        }
-        assert_eq!(data.len(), total);
-        // The normal segment: from the contact outward, against the normal.
-        let view =
-            &doc["bufferViews"]
-                [acc(&doc["meshes"][3]["primitives"][0]["attributes"]["POSITION"])["bufferView"]
-                    .as_u64()
-                    .unwrap() as usize];
-        let off = view["byteOffset"].as_u64().unwrap() as usize;
-        let floats: Vec<f32> = data[off..off + 24]
-            .chunks(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        assert_eq!(floats, [1.0, 2.0, 3.0, 1.0, 2.0, 2.5]);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn bad_path_is_named() {
-        let path = Path::new("/nonexistent-graspopt-dir/scene.obj");
-        let err = write_obj(path, &[], &[], 0.01).unwrap_err();
-        assert!(format!("{err:#}").contains("/nonexistent-graspopt-dir/scene.obj"));
-        let path = Path::new("/nonexistent-graspopt-dir/scene.gltf");
-        let err = write_gltf(path, &[], &[], 0.01).unwrap_err();
-        assert!(format!("{err:#}").contains("/nonexistent-graspopt-dir/scene.gltf"));
-    }
-}
+mod tests;

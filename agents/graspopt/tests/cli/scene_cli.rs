@@ -1,8 +1,11 @@
 //! `graspopt trial --scene FILE`: the exported OBJ and glTF hold the object, every hand link,
-//! a marker per modelled contact and a normal segment per contact.
+//! a marker per modelled contact and a normal segment per contact. The files are read back
+//! by other parsers: `tobj` for OBJ + MTL, the `gltf` crate (which validates the document)
+//! for glTF.
 
+use base64::prelude::{BASE64_STANDARD, Engine as _};
 use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::scene::scene_meshes;
+use graspopt_sim::scene::{NamedMesh, scene_meshes};
 use graspopt_sim::{ContactModel, Object, TrialOutcome};
 use serde_json::Value;
 
@@ -29,48 +32,53 @@ fn sphere_trial(extra: &[&str]) -> TrialOutcome {
     serde_json::from_value(e["outcome"].clone()).unwrap()
 }
 
-#[test]
-fn obj_scene_has_every_mesh_contact_and_normal() {
-    let dir = tempdir("obj");
-    let path = dir.join("grasp.obj");
-    let outcome = sphere_trial(&["--scene", path.to_str().unwrap()]);
+/// The meshes and the number of modelled contacts of a trial's outcome.
+fn expected(outcome: &TrialOutcome) -> (Vec<NamedMesh>, usize) {
     let object = Object::by_name("sphere").unwrap();
     let hand = hand_by_name("barrett").unwrap();
     let meshes = scene_meshes(&object, hand.as_ref(), &outcome.grasp).unwrap();
     let contacts = outcome.contacts(ContactModel::Surface, true).len();
     assert!(contacts >= 3, "{contacts}");
+    (meshes, contacts)
+}
 
-    let text = std::fs::read_to_string(&path).unwrap();
-    let count = |p: &str| text.lines().filter(|l| l.starts_with(p)).count();
-    let verts: usize = meshes.iter().map(|m| m.mesh.vertices.len()).sum();
-    let faces: usize = meshes.iter().map(|m| m.mesh.triangles.len()).sum();
-    // Octahedral markers (6 vertices, 8 faces) and two vertices per normal segment.
-    assert_eq!(count("v "), verts + 6 * contacts + 2 * contacts);
-    assert_eq!(count("f "), faces + 8 * contacts);
-    assert_eq!(count("l "), contacts);
-    assert_eq!(count("o "), meshes.len() + 2);
-    for m in &meshes {
-        assert!(
-            text.contains(&format!("\no {}\n", m.name.replace(' ', "_"))),
+#[test]
+fn obj_scene_has_every_mesh_contact_and_normal() {
+    let dir = tempdir("obj");
+    let path = dir.join("grasp.obj");
+    let outcome = sphere_trial(&["--scene", path.to_str().unwrap()]);
+    let (meshes, contacts) = expected(&outcome);
+
+    let options = tobj::LoadOptions {
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, materials) = tobj::load_obj(&path, &options).unwrap();
+    let materials = materials.expect("the MTL next to the OBJ loads");
+    assert_eq!(models.len(), meshes.len() + 2);
+    for (model, m) in models.iter().zip(&meshes) {
+        assert_eq!(model.name, m.name.replace(' ', "_"));
+        assert_eq!(
+            model.mesh.indices.len(),
+            3 * m.mesh.triangles.len(),
             "{}",
             m.name
         );
     }
-    assert!(text.contains("\no contacts\n") && text.contains("\no normals\n"));
-    // Every face and line index refers to an existing vertex (1-based).
-    let n = count("v ");
-    for l in text
-        .lines()
-        .filter(|l| l.starts_with("f ") || l.starts_with("l "))
-    {
-        for i in l.split_whitespace().skip(1) {
-            let i: usize = i.parse().unwrap();
-            assert!((1..=n).contains(&i), "{l}");
-        }
-    }
-    assert!(text.contains("mtllib grasp.mtl"));
-    let mtl = std::fs::read_to_string(dir.join("grasp.mtl")).unwrap();
-    assert_eq!(mtl.matches("newmtl ").count(), meshes.len() + 2);
+    // Octahedral markers (8 triangles each) and a two-point segment per contact.
+    let (markers, normals) = (&models[meshes.len()], &models[meshes.len() + 1]);
+    assert_eq!(
+        (markers.name.as_str(), normals.name.as_str()),
+        ("contacts", "normals")
+    );
+    assert_eq!(markers.mesh.indices.len(), 3 * 8 * contacts);
+    assert_eq!(markers.mesh.positions.len(), 3 * 6 * contacts);
+    assert_eq!(normals.mesh.face_arities, vec![2; contacts]);
+    // Every group has its own material, as named in the MTL.
+    assert_eq!(materials.len(), meshes.len() + 2);
+    let mut used: Vec<usize> = models.iter().map(|m| m.mesh.material_id.unwrap()).collect();
+    used.dedup();
+    assert_eq!(used.len(), models.len());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -79,32 +87,39 @@ fn gltf_scene_is_chosen_by_extension() {
     let dir = tempdir("gltf");
     let path = dir.join("grasp.gltf");
     let outcome = sphere_trial(&["--scene", path.to_str().unwrap()]);
-    let object = Object::by_name("sphere").unwrap();
-    let hand = hand_by_name("barrett").unwrap();
-    let meshes = scene_meshes(&object, hand.as_ref(), &outcome.grasp).unwrap();
-    let contacts = outcome.contacts(ContactModel::Surface, true).len();
-    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    assert_eq!(doc["asset"]["version"], "2.0");
-    let gl = doc["meshes"].as_array().unwrap();
+    let (meshes, contacts) = expected(&outcome);
+
+    let gltf = gltf::Gltf::from_slice(&std::fs::read(&path).unwrap()).expect("a valid glTF");
+    let buffer = gltf.buffers().next().unwrap();
+    let gltf::buffer::Source::Uri(uri) = buffer.source() else {
+        panic!("the buffer is not embedded");
+    };
+    let data = BASE64_STANDARD
+        .decode(
+            uri.strip_prefix("data:application/octet-stream;base64,")
+                .unwrap(),
+        )
+        .unwrap();
+    assert_eq!(data.len(), buffer.length());
+    let gl: Vec<gltf::Mesh> = gltf.meshes().collect();
     assert_eq!(gl.len(), meshes.len() + 2);
-    let accessor = |m: &Value| {
-        let i = m["primitives"][0]["attributes"]["POSITION"]
-            .as_u64()
-            .unwrap();
-        doc["accessors"][i as usize]["count"].as_u64().unwrap() as usize
+    let positions = |m: &gltf::Mesh| -> Vec<[f32; 3]> {
+        let p = m.primitives().next().unwrap();
+        p.reader(|_| Some(&data))
+            .read_positions()
+            .unwrap()
+            .collect()
     };
     for (g, m) in gl.iter().zip(&meshes) {
-        assert_eq!(accessor(g), m.mesh.vertices.len());
+        let read = positions(g);
+        assert_eq!(read.len(), m.mesh.vertices.len(), "{}", m.name);
+        let first = m.mesh.vertices[0].map(|v| v as f32);
+        assert_eq!(read[0], [first.x, first.y, first.z]);
     }
-    assert_eq!(accessor(&gl[meshes.len()]), 6 * contacts);
-    assert_eq!(accessor(&gl[meshes.len() + 1]), 2 * contacts);
-    assert_eq!(gl[meshes.len() + 1]["primitives"][0]["mode"], 1);
-    assert!(
-        doc["buffers"][0]["uri"]
-            .as_str()
-            .unwrap()
-            .starts_with("data:application/octet-stream;base64,")
-    );
+    assert_eq!(positions(&gl[meshes.len()]).len(), 6 * contacts);
+    let normals = gl[meshes.len() + 1].primitives().next().unwrap();
+    assert_eq!(normals.mode(), gltf::mesh::Mode::Lines);
+    assert_eq!(positions(&gl[meshes.len() + 1]).len(), 2 * contacts);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
