@@ -107,6 +107,12 @@ fn tick(v: &f64) -> String {
     }
 }
 
+/// `v` on an axis spanning `r`, with the rounding error of a tick at zero (say -2.8e-17,
+/// from `-0.15 + 3 * 0.05`) set to zero.
+fn snap(v: f64, r: (f64, f64)) -> f64 {
+    if v.abs() < 1e-9 * (r.1 - r.0) { 0.0 } else { v }
+}
+
 /// An axis tick label for counts (trials).
 fn whole(v: &f64) -> String {
     format!("{v:.0}")
@@ -195,15 +201,16 @@ fn axes<'a, 'b>(
         .x_label_area_size(if xlabel.is_empty() { 24 } else { 42 })
         .y_label_area_size(66)
         .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
-    let fmt: &dyn Fn(&f64) -> String = &fmt;
+    let fx = |v: &f64| fmt(&snap(*v, xr));
+    let fy = |v: &f64| tick(&snap(*v, yr));
     chart
         .configure_mesh()
         .x_desc(xlabel)
         .y_desc(ylabel)
         .x_labels(6)
         .y_labels(6)
-        .x_label_formatter(fmt)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
         .max_light_lines(0)
         .bold_line_style(BLACK.mix(0.08))
         .axis_desc_style((FONT, 15))
@@ -608,7 +615,7 @@ fn with_colour_bar<'b>(area: &Area<'b>, zr: (f64, f64)) -> Result<Area<'b>, Box<
         .disable_x_axis()
         .set_tick_mark_size(LabelAreaPosition::Right, 5)
         .y_labels(6)
-        .y_label_formatter(&tick)
+        .y_label_formatter(&|v: &f64| tick(&snap(*v, zr)))
         .label_style((FONT, 13))
         .draw()?;
     const STEPS: usize = 50;

@@ -603,3 +603,16 @@ fn extreme_values_never_panic() {
         ));
     }
 }
+
+#[test]
+fn a_tick_at_zero_reads_zero() {
+    // Ticks from -0.15 in steps of 0.05 reach zero with a rounding error (-2.8e-17).
+    let xs: Vec<f64> = (0..=18).map(|k| -0.16 + 0.01 * f64::from(k)).collect();
+    let els = parse(&line_plot("z", "x", "y", &xs, &xs));
+    let labels: Vec<String> = texts(&els)
+        .into_iter()
+        .filter(|t| t.parse::<f64>().is_ok())
+        .collect();
+    assert!(labels.iter().any(|t| t == "0.000"), "{labels:?}");
+    assert!(labels.iter().all(|t| !t.contains('e')), "{labels:?}");
+}
