@@ -81,6 +81,7 @@ impl Bus {
                 .unwrap_or_else(|| graspopt_shm::PREFIX_BASE.to_string());
             let config = graspopt_shm::ShmConfig {
                 prefix,
+                probe_service: graspopt_protocol::keys::shm_probe_service(),
                 ..graspopt_shm::ShmConfig::default()
             };
             // Resources of processes that died under this prefix (a killed worker).

@@ -372,6 +372,12 @@ pub fn shm_clouds_service(run: &RunId) -> String {
     CLOUDS.entry.key_expr(Runs::One(run))
 }
 
+/// The name of the throwaway shared-memory services that check, at start-up, that shared
+/// memory works on a host: `graspopt/shm-probe`.
+pub fn shm_probe_service() -> String {
+    format!("{ROOT}/shm-probe")
+}
+
 /// The published topics, for tools that list and decode them: the topic rows of [`TABLE`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Topic {

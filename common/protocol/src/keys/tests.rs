@@ -209,6 +209,7 @@ fn the_table_builds_every_documented_key() {
     );
     assert_eq!(all_key(one), "graspopt/r1/**");
     assert_eq!(shm_clouds_service(&run), "graspopt/r1/clouds");
+    assert_eq!(shm_probe_service(), "graspopt/shm-probe");
     // The topics are the table's topic rows, by name.
     for t in Topic::ALL {
         assert_eq!(Topic::named(t.entry().name), Some(t));
