@@ -6,6 +6,7 @@ use std::time::Duration;
 use anyhow::Context;
 use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Server, Subscription, now_ms};
 use graspopt_journal::{Journal, ResultOutcome, RunLifecycle};
+use graspopt_protocol::keys::{COMMAND, OBJECT, RESULT, STATE, STATUS, SUGGEST, alive_key};
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, TrialResult,
 };
@@ -82,15 +83,15 @@ struct Inputs {
     hands: AliveWatch,
     metrics: AliveWatch,
     planners: AliveWatch,
-    state_server: Server<RunStatus>,
+    state_server: Server<()>,
 }
 
 impl Inputs {
     async fn open(bus: &Bus, run: &RunId) -> anyhow::Result<Inputs> {
-        let alive = |kind| run.alive_kind_key(kind);
+        let alive = |kind| alive_key(run.into(), Some(kind));
         Ok(Inputs {
-            results: bus.subscribe(&run.result_key()).await?,
-            objects: bus.subscribe(&run.object_key()).await?,
+            results: bus.subscribe(&RESULT.key(run.into())).await?,
+            objects: bus.subscribe(&OBJECT.key(run.into())).await?,
             hands: bus.watch_alive(&alive(AgentKind::Hand)).await?,
             // Trials wait for a metric agent: clouds published before one listens would be
             // lost.
@@ -98,7 +99,7 @@ impl Inputs {
             // A planner (re)appearing answers at once: a question in flight when the
             // network was cut would otherwise wait for its timeout.
             planners: bus.watch_alive(&alive(AgentKind::Planner)).await?,
-            state_server: bus.serve(&run.state_key()).await?,
+            state_server: bus.serve(&STATE.key(run)).await?,
         })
     }
 }
@@ -198,11 +199,11 @@ impl<'a> Io<'a> {
                     encoding,
                     command,
                 } => {
-                    let key = self.run.command_key(&worker);
+                    let key = COMMAND.worker_key(self.run.into(), &worker);
                     self.bus.put(&key, &command, encoding).await?;
                 }
                 Action::Ask(request) => {
-                    let (bus, key) = (self.bus, self.run.suggest_key());
+                    let (bus, key) = (self.bus, SUGGEST.key(self.run));
                     let timeout = self.planner_timeout;
                     *planning = Some(Box::pin(
                         async move { bus.query(&key, &request, timeout).await },
@@ -210,7 +211,7 @@ impl<'a> Io<'a> {
                 }
                 Action::CancelAsk => *planning = None,
                 Action::Publish(s) => {
-                    let key = self.run.status_key();
+                    let key = STATUS.key(self.run.into());
                     let _ = self.bus.put_droppable(&key, &s, Encoding::Bincode).await;
                 }
                 Action::Progress(s) => {
@@ -262,7 +263,7 @@ impl<'a> Io<'a> {
         let s = core.status_at(RunPhase::Finished, now_ms());
         let _ = self
             .bus
-            .put(&self.run.status_key(), &s, Encoding::Bincode)
+            .put(&STATUS.key(self.run.into()), &s, Encoding::Bincode)
             .await;
         if let Some(p) = &self.progress {
             let _ = p.send(s.clone());

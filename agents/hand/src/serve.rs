@@ -4,6 +4,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudSender, Inbox, Subscription, now_ms};
+use graspopt_protocol::keys::{COMMAND, OBJECT};
 use graspopt_protocol::{AgentKind, ContactClouds, ObjectEstimate, RunId, TrialCommand};
 
 use crate::driver::{HandDriver, HandError, HandReading};
@@ -30,8 +31,8 @@ pub async fn serve(
     let _place = bus
         .wait_until_unique(run, AgentKind::Hand, Some(id), UNIQUE_WAIT)
         .await?;
-    let commands = bus.subscribe::<TrialCommand>(&run.command_key(id)).await?;
-    let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
+    let commands = bus.subscribe(&COMMAND.worker_key(run.into(), id)).await?;
+    let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
     let sender = CloudSender::open(bus, run);
     // Declared last: the coordinator sends commands once it sees the token.
     let _token = bus.declare_alive(run, AgentKind::Hand, id).await?;
@@ -147,6 +148,7 @@ mod tests {
     use std::sync::{Arc, Mutex};
 
     use graspopt_bus::{BusArgs, CloudReceiver, CongestionControl, free_loopback_port};
+    use graspopt_protocol::keys::alive_key;
     use graspopt_protocol::{CloudPoint, Encoding, FingerCloud, Pose};
 
     use super::*;
@@ -258,7 +260,7 @@ mod tests {
             let (hand_bus, bus) = sessions().await;
             let mut clouds = CloudReceiver::open(&bus, &run).await.unwrap();
             let hands = bus
-                .watch_alive(&run.alive_kind_key(AgentKind::Hand))
+                .watch_alive(&alive_key((&run).into(), Some(AgentKind::Hand)))
                 .await
                 .unwrap();
             let seen = Arc::new(Mutex::new(Vec::new()));
@@ -272,7 +274,7 @@ mod tests {
             let alive = hands.recv().await.unwrap();
             assert!(alive.alive && alive.agent.id == "w1");
 
-            let key = run.command_key("w1");
+            let key = COMMAND.worker_key((&run).into(), "w1");
             let put = |c: TrialCommand| {
                 let (bus, key) = (bus.clone(), key.clone());
                 async move { bus.put(&key, &c, Encoding::Bincode).await.unwrap() }
@@ -280,7 +282,7 @@ mod tests {
             let sent_ms = now_ms();
             // Before any estimate: the command waits for one; another run's is ignored.
             put(command(&run, 1, "w1", "barrett")).await;
-            let object_key = run.object_key();
+            let object_key = OBJECT.key((&run).into());
             bus.put(&object_key, &estimate(&other, "mug"), Encoding::Json)
                 .await
                 .unwrap();
@@ -291,7 +293,7 @@ mod tests {
             put(command(&run, 7, "w2", "barrett")).await;
             put(command(&other, 8, "w1", "barrett")).await;
             bus.put_bytes(
-                &key,
+                key.as_str(),
                 vec![1, 2, 3],
                 Encoding::Bincode,
                 CongestionControl::Block,

@@ -14,8 +14,9 @@ use std::sync::Arc;
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudReceiver};
 use graspopt_convert::{measured_from_clouds, metric_values, object_from_estimate};
+use graspopt_protocol::keys::{OBJECT, RESULT};
 use graspopt_protocol::{
-    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, ObjectEstimate, RunId, TrialResult,
+    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, RunId, TrialResult,
 };
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
@@ -107,7 +108,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
         .validate()
         .context("metric agent settings")?;
     let mut clouds = CloudReceiver::open(bus, run).await?;
-    let objects = bus.subscribe::<ObjectEstimate>(&run.object_key()).await?;
+    let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
     let _token = bus
         .declare_alive(run, AgentKind::Metric, &config.id)
         .await?;
@@ -115,7 +116,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
     let mut object: Option<(u64, String, Arc<Object>)> = None;
     let mut waiting: VecDeque<(ContactClouds, &'static str)> = VecDeque::new();
     let mut bad = 0u64;
-    let key = run.result_key();
+    let key = RESULT.key(run.into());
     loop {
         tokio::select! {
             Some(r) = objects.recv() => match r.message {

@@ -12,6 +12,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use graspopt_bus::{Bus, now_ms};
+use graspopt_protocol::keys::OBJECT;
 use graspopt_protocol::{AgentKind, Encoding, ObjectEstimate, RunId};
 use graspopt_sim::Object;
 use graspopt_sim::noise::gaussian;
@@ -115,7 +116,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PerceptionConfig) -> anyhow::R
     let _token = bus
         .declare_alive(run, AgentKind::Perception, &config.id)
         .await?;
-    let key = run.object_key();
+    let key = OBJECT.key(run.into());
     let period = Duration::from_millis(config.period_ms.max(10));
     loop {
         estimate.stamp_ms = now_ms();

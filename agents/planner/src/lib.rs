@@ -26,6 +26,7 @@ use graspopt_bayesopt::baseline::{AskTell, RandomSearch};
 use graspopt_bayesopt::error::BoError;
 use graspopt_bayesopt::optimizer::Optimizer;
 use graspopt_bus::Bus;
+use graspopt_protocol::keys::SUGGEST;
 use graspopt_protocol::{AgentKind, PlannerMethod, RunId, SuggestReply, SuggestRequest};
 use serde::{Deserialize, Serialize};
 
@@ -244,7 +245,7 @@ impl Planner {
 
 /// Answers proposal requests until the task is cancelled.
 pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Result<()> {
-    let server = bus.serve::<SuggestRequest>(&run.suggest_key()).await?;
+    let server = bus.serve(&SUGGEST.key(run)).await?;
     let _token = bus
         .declare_alive(run, AgentKind::Planner, &config.id)
         .await?;

@@ -2,7 +2,10 @@
 //! coordinator and tools watch them. A token vanishes when its process dies or loses the
 //! network, which is how a killed hand worker is noticed.
 
-use graspopt_protocol::keys::{AliveKey, Claim as ClaimKey, parse_alive_key, parse_claim_key};
+use graspopt_protocol::keys::{
+    AliveKey, Claim as ClaimKey, alive_key, alive_token, claim_slot_key, claim_token,
+    parse_alive_key, parse_claim_key,
+};
 use graspopt_protocol::{AgentKind, RunId};
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
@@ -89,7 +92,7 @@ impl Bus {
         id: &str,
     ) -> Result<LivelinessToken, BusError> {
         graspopt_protocol::keys::check_agent_id(id).map_err(|e| BusError::Config(e.to_string()))?;
-        let key = run.alive_key(kind, self.host(), id);
+        let key = alive_token(run, kind, self.host(), id);
         self.session()
             .liveliness()
             .declare_token(key.clone())
@@ -97,7 +100,7 @@ impl Bus {
             .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
     }
 
-    /// Watches the tokens under `key` (e.g. [`RunId::alive_kind_key`]), starting with those
+    /// Watches the tokens under `key` (e.g. [`alive_key`]), starting with those
     /// already declared.
     pub async fn watch_alive(&self, key: &str) -> Result<AliveWatch, BusError> {
         let sub = self
@@ -144,7 +147,7 @@ impl Bus {
         let slot = id.unwrap_or("any");
         let nonce = claim_nonce();
         let declare = |held: bool| {
-            let key = run.claim_key(kind, slot, ClaimKey { nonce, held });
+            let key = claim_token(run, kind, slot, ClaimKey { nonce, held });
             async move {
                 self.session()
                     .liveliness()
@@ -154,7 +157,7 @@ impl Bus {
             }
         };
         let _starting = declare(false).await?;
-        let claims_key = run.claim_slot_key(kind, slot);
+        let claims_key = claim_slot_key(run, kind, slot);
         loop {
             // Looks until another claimant is seen; none: hold the place, and look once
             // more in case another claimant held it at the same moment (the smaller nonce
@@ -243,7 +246,7 @@ impl Bus {
         let mut free = 0;
         loop {
             let holders: Vec<AliveKey> = self
-                .alive_now(&run.alive_kind_key(kind))
+                .alive_now(&alive_key(run.into(), Some(kind)))
                 .await?
                 .into_iter()
                 .filter(|a| a.run == *run && id.is_none_or(|id| a.id == id))

@@ -6,6 +6,7 @@
 //! followed. A metric agent listens on both paths at once. Both carry the same bincode
 //! payload.
 
+use graspopt_protocol::keys::{CLOUDS, Key, shm_clouds_service};
 use graspopt_protocol::{ContactClouds, DecodeError, Encoding, RunId, decode, encode};
 use graspopt_shm::{ShmPublisher, ShmSubscriber};
 use tokio::sync::mpsc;
@@ -31,7 +32,7 @@ impl CloudPath {
 /// Sends contact clouds.
 pub struct CloudSender {
     bus: Bus,
-    key: String,
+    key: Key<ContactClouds>,
     shm: Option<ShmPublisher>,
 }
 
@@ -41,7 +42,7 @@ impl CloudSender {
     pub fn open(bus: &Bus, run: &RunId) -> CloudSender {
         let shm =
             bus.shm().and_then(
-                |cfg| match ShmPublisher::open(cfg, &run.shm_clouds_service()) {
+                |cfg| match ShmPublisher::open(cfg, &shm_clouds_service(run)) {
                     Ok(p) => Some(p),
                     Err(e) => {
                         tracing::warn!("shared memory unavailable, clouds go over Zenoh: {e}");
@@ -51,7 +52,7 @@ impl CloudSender {
             );
         CloudSender {
             bus: bus.clone(),
-            key: run.clouds_key(),
+            key: CLOUDS.key(run.into()),
             shm,
         }
     }
@@ -109,7 +110,7 @@ impl CloudReceiver {
                     // The receiver gone means the agent is stopping: nothing to do.
                     let _ = tx.blocking_send(received);
                 };
-                match ShmSubscriber::open(cfg, &run.shm_clouds_service(), on_message) {
+                match ShmSubscriber::open(cfg, &shm_clouds_service(run), on_message) {
                     Ok(s) => Some(s),
                     Err(e) => {
                         tracing::warn!("shared memory unavailable, clouds come over Zenoh: {e}");
@@ -119,7 +120,7 @@ impl CloudReceiver {
             }
             None => None,
         };
-        let sub = bus.subscribe::<ContactClouds>(&run.clouds_key()).await?;
+        let sub = bus.subscribe(&CLOUDS.key(run.into())).await?;
         let task = tokio::spawn(async move {
             while let Some(r) = sub.recv().await {
                 let received = ReceivedClouds {

@@ -3,7 +3,8 @@
 use std::marker::PhantomData;
 use std::time::Duration;
 
-use graspopt_protocol::{Encoding, Message, decode, encode};
+use graspopt_protocol::keys::{KeyFor, QueryFor, Serves};
+use graspopt_protocol::{Encoding, Message, Request, decode, encode};
 use zenoh::Session;
 use zenoh::bytes::Encoding as ZEncoding;
 use zenoh::handlers::{FifoChannel, FifoChannelHandler, RingChannel, RingChannelHandler};
@@ -80,6 +81,7 @@ impl Bus {
                 .unwrap_or_else(|| graspopt_shm::PREFIX_BASE.to_string());
             let config = graspopt_shm::ShmConfig {
                 prefix,
+                probe_service: graspopt_protocol::keys::shm_probe_service(),
                 ..graspopt_shm::ShmConfig::default()
             };
             // Resources of processes that died under this prefix (a killed worker).
@@ -119,27 +121,28 @@ impl Bus {
     }
 
     /// Puts a message reliably: blocks under congestion rather than dropping (trial
-    /// commands, clouds, results).
+    /// commands, clouds, results). `key`: a [`Key<T>`](graspopt_protocol::Key) of the key
+    /// table, so that only a `T` can go there (or a plain key expression).
     pub async fn put<T: Message>(
         &self,
-        key: &str,
+        key: &(impl KeyFor<T> + ?Sized),
         msg: &T,
         encoding: Encoding,
     ) -> Result<(), BusError> {
         let bytes = encode(msg, encoding)?;
-        self.put_bytes(key, bytes, encoding, CongestionControl::Block)
+        self.put_bytes(key.key_expr(), bytes, encoding, CongestionControl::Block)
             .await
     }
 
     /// Puts a message that a newer one soon replaces (status): dropped under congestion.
     pub async fn put_droppable<T: Message>(
         &self,
-        key: &str,
+        key: &(impl KeyFor<T> + ?Sized),
         msg: &T,
         encoding: Encoding,
     ) -> Result<(), BusError> {
         let bytes = encode(msg, encoding)?;
-        self.put_bytes(key, bytes, encoding, CongestionControl::Drop)
+        self.put_bytes(key.key_expr(), bytes, encoding, CongestionControl::Drop)
             .await
     }
 
@@ -160,8 +163,13 @@ impl Bus {
     }
 
     /// Subscribes to `key` with a bounded queue (back-pressure on the sender's side when the
-    /// queue is full: for agents that keep up).
-    pub async fn subscribe<T: Message>(&self, key: &str) -> Result<Subscription<T>, BusError> {
+    /// queue is full: for agents that keep up). The messages are `T`s: the type of the
+    /// [`Key<T>`](graspopt_protocol::Key).
+    pub async fn subscribe<T: Message>(
+        &self,
+        key: &(impl KeyFor<T> + ?Sized),
+    ) -> Result<Subscription<T>, BusError> {
+        let key = key.key_expr();
         let sub = self
             .session
             .declare_subscriber(key)
@@ -178,11 +186,11 @@ impl Bus {
     /// the oldest samples and never slows the publishers (monitors, terminals).
     pub async fn subscribe_ring<T: Message>(
         &self,
-        key: &str,
+        key: &(impl KeyFor<T> + ?Sized),
         capacity: usize,
     ) -> Result<Subscription<T>, BusError> {
         Ok(Subscription {
-            inner: Inner::Ring(self.ring_subscriber(key, capacity).await?),
+            inner: Inner::Ring(self.ring_subscriber(key.key_expr(), capacity).await?),
             _t: PhantomData,
         })
     }
@@ -215,10 +223,11 @@ impl Bus {
     /// Sends a query and decodes the first reply.
     pub async fn query<Q: Message, R: Message>(
         &self,
-        key: &str,
+        key: &(impl QueryFor<Q, R> + ?Sized),
         request: &Q,
         timeout: Duration,
     ) -> Result<R, BusError> {
+        let key = key.key_expr();
         let bytes = encode(request, Encoding::Bincode)?;
         let started = std::time::Instant::now();
         let replies = self
@@ -238,7 +247,12 @@ impl Bus {
 
     /// Sends a query without a payload (the coordinator's state, say) and decodes the first
     /// reply.
-    pub async fn get<R: Message>(&self, key: &str, timeout: Duration) -> Result<R, BusError> {
+    pub async fn get<R: Message>(
+        &self,
+        key: &(impl QueryFor<(), R> + ?Sized),
+        timeout: Duration,
+    ) -> Result<R, BusError> {
+        let key = key.key_expr();
         let started = std::time::Instant::now();
         let replies = self
             .session
@@ -250,8 +264,12 @@ impl Bus {
         first_reply(key, &replies, timeout, started).await
     }
 
-    /// Answers queries on `key`.
-    pub async fn serve<Q: Message>(&self, key: &str) -> Result<Server<Q>, BusError> {
+    /// Answers queries on `key`, whose requests are `Q`s.
+    pub async fn serve<Q: Request>(
+        &self,
+        key: &(impl Serves<Q> + ?Sized),
+    ) -> Result<Server<Q>, BusError> {
+        let key = key.key_expr();
         let queryable = self
             .session
             .declare_queryable(key)
@@ -462,22 +480,16 @@ pub struct Incoming<Q> {
     pub request: Result<Q, graspopt_protocol::DecodeError>,
 }
 
-impl<Q: Message> Server<Q> {
+impl<Q: Request> Server<Q> {
     /// The next query; `None` when the session closed.
     pub async fn recv(&self) -> Option<Incoming<Q>> {
         let query = self.queryable.recv_async().await.ok()?;
-        let request = match query.payload() {
-            Some(p) => {
-                let enc = query
-                    .encoding()
-                    .map(protocol_encoding)
-                    .unwrap_or(Encoding::Bincode);
-                decode::<Q>(&p.to_bytes(), enc)
-            }
-            None => Err(graspopt_protocol::DecodeError::Empty {
-                message_type: Q::TYPE,
-            }),
-        };
+        let enc = query
+            .encoding()
+            .map(protocol_encoding)
+            .unwrap_or(Encoding::Bincode);
+        let payload = query.payload().map(|p| p.to_bytes().into_owned());
+        let request = Q::from_payload(payload.as_deref(), enc);
         Some(Incoming { query, request })
     }
 }

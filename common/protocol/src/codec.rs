@@ -209,6 +209,29 @@ pub fn decode<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<T, DecodeE
     Ok(msg)
 }
 
+/// What a query carries: a message, or nothing (`()`, the coordinator's state query).
+pub trait Request: Sized {
+    /// The request in a query's payload (`None`: the query had none).
+    fn from_payload(payload: Option<&[u8]>, encoding: Encoding) -> Result<Self, DecodeError>;
+}
+
+impl<M: Message> Request for M {
+    fn from_payload(payload: Option<&[u8]>, encoding: Encoding) -> Result<Self, DecodeError> {
+        match payload {
+            Some(bytes) => decode(bytes, encoding),
+            None => Err(DecodeError::Empty {
+                message_type: M::TYPE,
+            }),
+        }
+    }
+}
+
+impl Request for () {
+    fn from_payload(_: Option<&[u8]>, _: Encoding) -> Result<Self, DecodeError> {
+        Ok(())
+    }
+}
+
 /// Decodes (and validates) the message a topic carries, as JSON for display: what
 /// `graspopt topic echo` prints. The JSON is the message's fields, without the wire version.
 pub fn decode_topic(

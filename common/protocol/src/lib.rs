@@ -2,8 +2,8 @@
 //!
 //! - [`messages`]: every message as a serde type. Each carries the run id and, where it concerns
 //!   a trial, the trial id and attempt, so results are idempotent by trial id.
-//! - [`keys`]: the key-expression scheme, in one place. Every key starts with
-//!   `graspopt/<run>/`.
+//! - [`keys`]: the key-expression scheme, in one place: one table binds each key to the
+//!   type of its messages ([`keys::TABLE`], [`Key`]). Every key starts with `graspopt/<run>/`.
 //! - [`codec`]: bincode 2 (the default) and JSON (for agents written in other languages), each
 //!   payload prefixed by the [`WIRE_VERSION`].
 //!
@@ -15,8 +15,8 @@ pub mod codec;
 pub mod keys;
 pub mod messages;
 
-pub use codec::{DecodeError, Encoding, decode, decode_topic, encode};
-pub use keys::{AgentKind, RunId, Topic};
+pub use codec::{DecodeError, Encoding, Request, decode, decode_topic, encode};
+pub use keys::{AgentKind, Key, QueryKey, RunId, Runs, Topic};
 pub use messages::*;
 
 /// The wire version every payload carries. Bumped on any incompatible change of a message.

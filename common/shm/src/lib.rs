@@ -209,6 +209,9 @@ pub struct ShmConfig {
     /// [`ShmPublisher::open`] waits for the existing subscribers to connect
     /// (default 1 s).
     pub delivery_timeout: Duration,
+    /// The name under which [`available`] opens its throwaway services (`<name>/<pid>/<n>`):
+    /// the user of this crate names it (graspopt: `graspopt/shm-probe`).
+    pub probe_service: String,
 }
 
 impl Default for ShmConfig {
@@ -220,6 +223,7 @@ impl Default for ShmConfig {
             subscriber_buffer: 64,
             initial_payload: 64 * 1024,
             delivery_timeout: Duration::from_secs(1),
+            probe_service: "shm-probe".to_owned(),
         }
     }
 }

@@ -15,7 +15,8 @@ pub fn available(config: &ShmConfig) -> bool {
 pub(super) fn probe(config: &ShmConfig) -> Result<()> {
     static PROBES: AtomicU64 = AtomicU64::new(0);
     let service = format!(
-        "graspopt/shm-probe/{}/{}",
+        "{}/{}/{}",
+        config.probe_service,
         std::process::id(),
         PROBES.fetch_add(1, Ordering::Relaxed)
     );

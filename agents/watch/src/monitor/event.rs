@@ -5,8 +5,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use graspopt_bus::Bus;
-use graspopt_protocol::keys::ROOT;
-use graspopt_protocol::{RunId, RunStatus};
+use graspopt_protocol::keys::{STATE, STATUS, alive_key};
+use graspopt_protocol::{AgentKind, RunId, Runs};
 use tokio::sync::mpsc;
 
 use super::app::{Monitor, run_lines};
@@ -15,12 +15,20 @@ use super::ui::draw;
 /// How long a new session waits for the liveliness tokens already on the bus.
 const SETTLE: Duration = Duration::from_millis(300);
 
+/// `only` this run, or every run.
+fn runs(only: Option<&RunId>) -> Runs<'_> {
+    only.map_or(Runs::All, Runs::One)
+}
+
+/// The liveliness key of the coordinators of `only` (or of every run).
+fn coordinators(only: Option<&RunId>) -> String {
+    alive_key(runs(only), Some(AgentKind::Coordinator))
+}
+
 /// The runs whose coordinator is alive (`only`: this run, if it is).
 pub async fn live_runs(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
-    let run = only.map(RunId::as_str).unwrap_or("*");
-    let key = format!("{ROOT}/{run}/alive/coordinator/**");
     let mut runs: Vec<String> = bus
-        .alive_now(&key)
+        .alive_now(&coordinators(only))
         .await
         .unwrap_or_default()
         .into_iter()
@@ -35,10 +43,7 @@ pub async fn live_runs(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
 pub async fn ask_states(bus: &Bus, m: &mut Monitor) {
     for r in m.missing_states() {
         let Ok(id) = RunId::new(&r) else { continue };
-        match bus
-            .get::<RunStatus>(&id.state_key(), Duration::from_secs(2))
-            .await
-        {
+        match bus.get(&STATE.key(&id), Duration::from_secs(2)).await {
             Ok(s) => m.on_status(s, Instant::now()),
             Err(e) => tracing::warn!("monitor: state of run {r:?}: {e}"),
         }
@@ -100,14 +105,8 @@ pub async fn dashboard(
     only: Option<&RunId>,
     stop: impl Future<Output = ()>,
 ) -> Result<()> {
-    let status_key = format!("{ROOT}/{}/status", only.map(RunId::as_str).unwrap_or("*"));
-    let statuses = bus.subscribe_ring::<RunStatus>(&status_key, 64).await?;
-    let alive = bus
-        .watch_alive(&format!(
-            "{ROOT}/{}/alive/coordinator/**",
-            only.map(RunId::as_str).unwrap_or("*")
-        ))
-        .await?;
+    let statuses = bus.subscribe_ring(&STATUS.key(runs(only)), 64).await?;
+    let alive = bus.watch_alive(&coordinators(only)).await?;
     let mut keys = read_keys();
     let mut terminal = match ratatui::try_init() {
         Ok(t) => t,

@@ -6,8 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use graspopt_bus::Bus;
-use graspopt_protocol::RunId;
-use graspopt_protocol::keys::ROOT;
+use graspopt_protocol::keys::alive_key;
+use graspopt_protocol::{RunId, Runs};
 
 use super::Format;
 use super::rows::{Row, topic_rows};
@@ -79,9 +79,9 @@ async fn until(duration: Option<Duration>, stop: impl Future<Output = ()>) {
 
 /// The topics of the live agents of `run` (every run if `None`).
 pub async fn list(bus: &Bus, run: Option<&RunId>) -> Result<Vec<Row>> {
-    let run = run.map(RunId::as_str).unwrap_or("*");
+    let runs = run.map_or(Runs::All, Runs::One);
     tokio::time::sleep(SETTLE).await;
-    let agents = bus.alive_now(&format!("{ROOT}/{run}/alive/**")).await?;
+    let agents = bus.alive_now(&alive_key(runs, None)).await?;
     Ok(topic_rows(&agents))
 }
 

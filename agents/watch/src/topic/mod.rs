@@ -18,8 +18,7 @@ pub mod text;
 pub mod window;
 
 use anyhow::{Result, bail};
-use graspopt_protocol::RunId;
-use graspopt_protocol::keys::ROOT;
+use graspopt_protocol::{RunId, Runs, Topic};
 
 pub use event::{EchoSettings, Measure, RateSettings, check_duration, echo, list, rate};
 pub use rows::{Row, rows_json, rows_table, topic_rows};
@@ -35,16 +34,8 @@ pub enum Format {
     Json,
 }
 
-const TOPIC_NAMES: [(&str, &str); 5] = [
-    ("object", "object"),
-    ("command", "hand/*/command"),
-    ("clouds", "clouds"),
-    ("result", "result"),
-    ("status", "status"),
-];
-
-/// The key expression a `KEY` argument means: a key expression as it is, or a topic name in
-/// `run` (every run if `None`).
+/// The key expression a `KEY` argument means: a key expression as it is, or a topic name of
+/// the key table in `run` (every run if `None`).
 pub fn resolve_key(key: &str, run: Option<&str>) -> Result<String> {
     if key.contains('/') {
         if run.is_some() {
@@ -52,15 +43,13 @@ pub fn resolve_key(key: &str, run: Option<&str>) -> Result<String> {
         }
         return Ok(key.to_string());
     }
-    let run = match run {
-        Some(r) => RunId::new(r)?.as_str().to_string(),
-        None => "*".to_string(),
-    };
-    match TOPIC_NAMES.iter().find(|(name, _)| *name == key) {
-        Some((_, rest)) => Ok(format!("{ROOT}/{run}/{rest}")),
+    let run = run.map(RunId::new).transpose()?;
+    let runs = run.as_ref().map_or(Runs::All, Runs::One);
+    match Topic::named(key) {
+        Some(topic) => Ok(topic.entry().key_expr(runs)),
         None => bail!(
             "unknown topic {key:?}: give a key expression (graspopt/<run>/result) or one of {}",
-            TOPIC_NAMES.map(|(n, _)| n).join(", ")
+            Topic::ALL.map(|t| t.entry().name).join(", ")
         ),
     }
 }

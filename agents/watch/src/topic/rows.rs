@@ -3,7 +3,8 @@
 use std::collections::BTreeMap;
 
 use graspopt_protocol::keys::AliveKey;
-use graspopt_protocol::{AgentKind, RunId, Topic};
+use graspopt_protocol::keys::{COMMAND, TABLE};
+use graspopt_protocol::{AgentKind, RunId, Runs};
 use serde_json::{Value, json};
 
 /// One row of `topic list`.
@@ -11,7 +12,8 @@ use serde_json::{Value, json};
 pub struct Row {
     pub run: String,
     pub key: String,
-    pub message: &'static str,
+    /// What travels on it ([`graspopt_protocol::keys::Entry::describe`]).
+    pub message: String,
     /// `id@host` of each publisher.
     pub publishers: Vec<String>,
 }
@@ -37,46 +39,35 @@ pub fn topic_rows(agents: &[AliveKey]) -> Vec<Row> {
             v.sort();
             v
         };
-        let mut push = |key: String, message: &'static str, publishers: Vec<String>| {
-            if !publishers.is_empty() {
+        let mut hands: Vec<&str> = agents
+            .iter()
+            .filter(|a| a.kind == AgentKind::Hand)
+            .map(|a| a.id.as_str())
+            .collect();
+        hands.sort();
+        for entry in TABLE {
+            let publishers = of(entry.by);
+            if publishers.is_empty() {
+                continue;
+            }
+            // A worker's topic has one key per live hand.
+            let keys: Vec<String> = if entry == COMMAND.entry() {
+                hands
+                    .iter()
+                    .map(|h| COMMAND.worker_key(Runs::One(&id), h).to_string())
+                    .collect()
+            } else {
+                vec![entry.key_expr(Runs::One(&id))]
+            };
+            for key in keys {
                 rows.push(Row {
                     run: run.clone(),
                     key,
-                    message,
-                    publishers,
+                    message: entry.describe(),
+                    publishers: publishers.clone(),
                 });
             }
-        };
-        for topic in Topic::ALL {
-            let publishers = of(topic.publisher());
-            match topic {
-                Topic::Command => {
-                    let mut hands: Vec<&str> = agents
-                        .iter()
-                        .filter(|a| a.kind == AgentKind::Hand)
-                        .map(|a| a.id.as_str())
-                        .collect();
-                    hands.sort();
-                    for h in hands {
-                        push(id.command_key(h), topic.message_type(), publishers.clone());
-                    }
-                }
-                Topic::Object => push(id.object_key(), topic.message_type(), publishers),
-                Topic::Clouds => push(id.clouds_key(), topic.message_type(), publishers),
-                Topic::Result => push(id.result_key(), topic.message_type(), publishers),
-                Topic::Status => push(id.status_key(), topic.message_type(), publishers),
-            }
         }
-        push(
-            id.suggest_key(),
-            "query SuggestRequest -> SuggestReply",
-            of(AgentKind::Planner),
-        );
-        push(
-            id.state_key(),
-            "query -> RunStatus",
-            of(AgentKind::Coordinator),
-        );
     }
     rows.sort_by(|a, b| (&a.run, &a.key).cmp(&(&b.run, &b.key)));
     rows

@@ -11,6 +11,11 @@
 //! | `graspopt/<run>/coordinator/state`    | [`RunStatus`] (query) | coordinator answers |
 //! | `graspopt/<run>/alive/<kind>/<host>/<id>[/json]` | liveliness token (`/json`: send me JSON) | every agent |
 //!
+//! One table ([`TABLE`], in `table.rs`) binds each key to the type of its messages: a
+//! [`Key<M>`] comes only from its row ([`RESULT`]`.key(run)`), and the bus sends and awaits
+//! only `M`s on it. The liveliness and claim keys are built beside it. Nothing else writes a
+//! key chunk.
+//!
 //! Run ids, hosts and agent ids are single key chunks: ASCII letters, digits, `-`, `_` and `.`.
 //!
 //! [`ObjectEstimate`]: crate::ObjectEstimate
@@ -26,6 +31,9 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::codec::Encoding;
+
+mod table;
+pub use table::*;
 
 /// The first chunk of every key.
 pub const ROOT: &str = "graspopt";
@@ -99,87 +107,74 @@ impl RunId {
         &self.0
     }
 
-    fn prefix(&self) -> String {
-        format!("{ROOT}/{}", self.0)
-    }
-
     /// `graspopt/<run>/object`
     pub fn object_key(&self) -> String {
-        format!("{}/object", self.prefix())
+        OBJECT.key(self.into()).to_string()
     }
 
     /// `graspopt/<run>/hand/<worker>/command`
     pub fn command_key(&self, worker: &str) -> String {
-        format!("{}/hand/{worker}/command", self.prefix())
+        COMMAND.worker_key(self.into(), worker).to_string()
     }
 
     /// `graspopt/<run>/clouds`
     pub fn clouds_key(&self) -> String {
-        format!("{}/clouds", self.prefix())
+        CLOUDS.key(self.into()).to_string()
     }
 
     /// `graspopt/<run>/result`
     pub fn result_key(&self) -> String {
-        format!("{}/result", self.prefix())
+        RESULT.key(self.into()).to_string()
     }
 
     /// `graspopt/<run>/status`
     pub fn status_key(&self) -> String {
-        format!("{}/status", self.prefix())
+        STATUS.key(self.into()).to_string()
     }
 
     /// `graspopt/<run>/planner/suggest`
     pub fn suggest_key(&self) -> String {
-        format!("{}/planner/suggest", self.prefix())
+        SUGGEST.key(self).to_string()
     }
 
     /// `graspopt/<run>/coordinator/state`
     pub fn state_key(&self) -> String {
-        format!("{}/coordinator/state", self.prefix())
+        STATE.key(self).to_string()
     }
 
     /// `graspopt/<run>/alive/<kind>/<host>/<id>`
     pub fn alive_key(&self, kind: AgentKind, host: &str, id: &str) -> String {
-        format!("{}/alive/{}/{host}/{id}", self.prefix(), kind.as_str())
+        alive_token(self, kind, host, id)
     }
 
     /// `graspopt/<run>/alive/<kind>/**`
     pub fn alive_kind_key(&self, kind: AgentKind) -> String {
-        format!("{}/alive/{}/**", self.prefix(), kind.as_str())
+        alive_key(self.into(), Some(kind))
     }
 
     /// `graspopt/<run>/alive/**`
     pub fn alive_all_key(&self) -> String {
-        format!("{}/alive/**", self.prefix())
+        alive_key(self.into(), None)
     }
 
-    /// `graspopt/<run>/claim/<kind>/<slot>/<nonce>/<phase>`: a liveliness token an agent
-    /// holds while it makes sure it is alone in its place (`slot`: its id, or `any` for the
-    /// run's one coordinator). `nonce` is 16 hex digits, random per agent; `phase` is
-    /// `starting`, then `held` once the agent has its place (see [`Claim`]).
+    /// See [`claim_token`].
     pub fn claim_key(&self, kind: AgentKind, slot: &str, claim: Claim) -> String {
-        let phase = if claim.held { "held" } else { "starting" };
-        format!(
-            "{}/claim/{}/{slot}/{:016x}/{phase}",
-            self.prefix(),
-            kind.as_str(),
-            claim.nonce
-        )
+        claim_token(self, kind, slot, claim)
     }
 
     /// `graspopt/<run>/claim/<kind>/<slot>/**`
     pub fn claim_slot_key(&self, kind: AgentKind, slot: &str) -> String {
-        format!("{}/claim/{}/{slot}/**", self.prefix(), kind.as_str())
+        claim_slot_key(self, kind, slot)
     }
 
     /// Everything of this run: `graspopt/<run>/**`.
     pub fn all_key(&self) -> String {
-        format!("{}/**", self.prefix())
+        all_key(self.into())
     }
 
     /// The name of the shared-memory service that carries this run's contact clouds on a host.
     pub fn shm_clouds_service(&self) -> String {
-        format!("{}/clouds", self.prefix())
+        shm_clouds_service(self)
     }
 }
 
@@ -209,7 +204,7 @@ impl From<RunId> for String {
     }
 }
 
-/// A claim token's nonce and phase (see [`RunId::claim_key`]).
+/// A claim token's nonce and phase (see [`claim_token`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Claim {
     pub nonce: u64,
@@ -322,167 +317,5 @@ pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
     })
 }
 
-/// The published topics, for tools that list and decode them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Topic {
-    Object,
-    Command,
-    Clouds,
-    Result,
-    Status,
-}
-
-impl Topic {
-    pub const ALL: [Topic; 5] = [
-        Topic::Object,
-        Topic::Command,
-        Topic::Clouds,
-        Topic::Result,
-        Topic::Status,
-    ];
-
-    /// The message type carried.
-    pub fn message_type(self) -> &'static str {
-        match self {
-            Topic::Object => "ObjectEstimate",
-            Topic::Command => "TrialCommand",
-            Topic::Clouds => "ContactClouds",
-            Topic::Result => "TrialResult",
-            Topic::Status => "RunStatus",
-        }
-    }
-
-    /// Who publishes it.
-    pub fn publisher(self) -> AgentKind {
-        match self {
-            Topic::Object => AgentKind::Perception,
-            Topic::Command => AgentKind::Coordinator,
-            Topic::Clouds => AgentKind::Hand,
-            Topic::Result => AgentKind::Metric,
-            Topic::Status => AgentKind::Coordinator,
-        }
-    }
-
-    /// Which topic a concrete key belongs to, with its run.
-    pub fn classify(key: &str) -> Option<(RunId, Topic)> {
-        let parts: Vec<&str> = key.split('/').collect();
-        let (root, run, rest) = match parts.as_slice() {
-            [root, run, rest @ ..] => (*root, *run, rest),
-            _ => return None,
-        };
-        if root != ROOT {
-            return None;
-        }
-        let run = RunId::new(run).ok()?;
-        let topic = match rest {
-            ["object"] => Topic::Object,
-            ["hand", _, "command"] => Topic::Command,
-            ["clouds"] => Topic::Clouds,
-            ["result"] => Topic::Result,
-            ["status"] => Topic::Status,
-            _ => return None,
-        };
-        Some((run, topic))
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn run_ids_are_single_chunks() {
-        assert!(RunId::new("mug-2026_11.22").is_ok());
-        for bad in ["", "a/b", "a*", "$x", "a b", ".hidden", &"x".repeat(65)] {
-            let e = RunId::new(bad).unwrap_err();
-            assert_eq!(e.value, bad);
-        }
-        assert!(serde_json::from_str::<RunId>("\"a/b\"").is_err());
-    }
-
-    #[test]
-    fn claim_keys_parse_back_and_nothing_else_does() {
-        let run = RunId::new("r1").unwrap();
-        for claim in [
-            Claim {
-                nonce: 0x00ab_cdef_0123_4567,
-                held: false,
-            },
-            Claim {
-                nonce: u64::MAX,
-                held: true,
-            },
-        ] {
-            let key = run.claim_key(AgentKind::Hand, "hand-1", claim);
-            assert_eq!(parse_claim_key(&key), Some(claim), "{key}");
-        }
-        assert_eq!(
-            run.claim_key(
-                AgentKind::Coordinator,
-                "any",
-                Claim {
-                    nonce: 1,
-                    held: true
-                }
-            ),
-            "graspopt/r1/claim/coordinator/any/0000000000000001/held"
-        );
-        for bad in [
-            "graspopt/r1/claim/hand/h/+000000000000000/held",
-            "graspopt/r1/claim/hand/h/00000000000000001/held",
-            "graspopt/r1/claim/hand/h/0000000000000001/taken",
-            "graspopt/r1/alive/hand/h/0000000000000001/held",
-            "graspopt/r1/claim/hand/0000000000000001/held",
-        ] {
-            assert_eq!(parse_claim_key(bad), None, "{bad}");
-        }
-    }
-
-    #[test]
-    fn keys_classify_back_to_their_topic() {
-        let run = RunId::new("r1").unwrap();
-        let cases = [
-            (run.object_key(), Topic::Object),
-            (run.command_key("w-1"), Topic::Command),
-            (run.clouds_key(), Topic::Clouds),
-            (run.result_key(), Topic::Result),
-            (run.status_key(), Topic::Status),
-        ];
-        for (key, topic) in cases {
-            assert_eq!(Topic::classify(&key), Some((run.clone(), topic)), "{key}");
-        }
-        assert_eq!(Topic::classify("graspopt/r1/unknown"), None);
-        assert_eq!(Topic::classify("other/r1/result"), None);
-    }
-
-    #[test]
-    fn alive_keys_parse() {
-        let run = RunId::new("r1").unwrap();
-        let key = run.alive_key(AgentKind::Hand, "host-a", "hand-1");
-        assert_eq!(key, "graspopt/r1/alive/hand/host-a/hand-1");
-        let parsed = parse_alive_key(&key).unwrap();
-        assert_eq!(parsed.kind, AgentKind::Hand);
-        assert_eq!(parsed.host, "host-a");
-        assert_eq!(parsed.id, "hand-1");
-        assert_eq!(parsed.encoding, Encoding::Bincode);
-        assert!(parse_alive_key("graspopt/r1/alive/robot/h/i").is_none());
-        // A JSON-speaking agent's token.
-        let parsed = parse_alive_key(&format!("{key}/json")).unwrap();
-        assert_eq!(
-            (parsed.id.as_str(), parsed.encoding),
-            ("hand-1", Encoding::Json)
-        );
-        assert!(parse_alive_key(&format!("{key}/xml")).is_none());
-        assert!(parse_alive_key("graspopt/r/alive/hand/h/*").is_none());
-        assert!(parse_alive_key("graspopt/r/alive/hand/**/h1").is_none());
-    }
-
-    #[test]
-    fn sanitize_makes_valid_chunks() {
-        for text in ["my host.local", "", ".x", "a/b*c"] {
-            let s = sanitize_chunk(text);
-            assert!(check_agent_id(&s).is_ok(), "{text:?} -> {s:?}");
-        }
-        assert_eq!(sanitize_chunk("a b/c"), "a_b_c");
-    }
-}
+mod tests;
