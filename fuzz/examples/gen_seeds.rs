@@ -7,8 +7,9 @@
 use std::path::{Path, PathBuf};
 
 use graspopt_protocol::keys::AgentKind;
+use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, alive_token};
 use graspopt_protocol::{
-    BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, Message, MeshData,
+    BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, MeshData, Message,
     MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
     SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
     WorkerStatus, decode, encode,
@@ -32,9 +33,16 @@ impl Out {
                 panic!("the {target} seed {name} ({encoding:?}) does not decode: {e}");
             }
             let tag = if bit == 0 { "bincode" } else { "json" };
-            self.write(target, &format!("{name}-{tag}"), &[&[bit][..], &payload].concat());
+            self.write(
+                target,
+                &format!("{name}-{tag}"),
+                &[&[bit][..], &payload].concat(),
+            );
             if let Some(topic) = topic {
-                let index = Topic::ALL.iter().position(|t| *t == topic).expect("a topic") as u8;
+                let index = Topic::ALL
+                    .iter()
+                    .position(|t| *t == topic)
+                    .expect("a topic") as u8;
                 let selector = (index << 1) | bit;
                 self.write(
                     "decode_topic",
@@ -47,7 +55,9 @@ impl Out {
 }
 
 fn main() {
-    let root = std::env::args_os().nth(1).unwrap_or_else(|| "corpus".into());
+    let root = std::env::args_os()
+        .nth(1)
+        .unwrap_or_else(|| "corpus".into());
     let out = Out(Path::new(&root).to_path_buf());
     let run = RunId::new("run-1").expect("a run id");
     let pose = Pose {
@@ -208,16 +218,22 @@ fn main() {
     reply.error = Some("no planner".into());
     out.message("decode_suggest_reply", "error", &reply, None);
 
-    let alive = run.alive_key(AgentKind::Hand, "host-a", "hand-1");
+    let alive = alive_token(&run, AgentKind::Hand, "host-a", "hand-1");
     let keys = [
         ("alive", alive.clone()),
         ("alive-json", format!("{alive}/json")),
-        ("alive-coordinator", run.alive_key(AgentKind::Coordinator, "h", "c-1")),
-        ("object", run.object_key()),
-        ("command", run.command_key("hand-1")),
-        ("clouds", run.clouds_key()),
-        ("result", run.result_key()),
-        ("status", run.status_key()),
+        (
+            "alive-coordinator",
+            alive_token(&run, AgentKind::Coordinator, "h", "c-1"),
+        ),
+        ("object", OBJECT.key(Runs::One(&run)).to_string()),
+        (
+            "command",
+            COMMAND.worker_key(Runs::One(&run), "hand-1").to_string(),
+        ),
+        ("clouds", CLOUDS.key(Runs::One(&run)).to_string()),
+        ("result", RESULT.key(Runs::One(&run)).to_string()),
+        ("status", STATUS.key(Runs::One(&run)).to_string()),
     ];
     for (name, key) in keys {
         out.write("parse_alive_key", name, key.as_bytes());

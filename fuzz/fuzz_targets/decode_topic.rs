@@ -6,13 +6,17 @@
 #![no_main]
 
 use graspopt_protocol::{
-    ContactClouds, DecodeError, Encoding, Message, ObjectEstimate, RunStatus, Topic,
-    TrialCommand, TrialResult, decode, decode_topic,
+    ContactClouds, DecodeError, Encoding, Message, ObjectEstimate, RunStatus, Topic, TrialCommand,
+    TrialResult, decode, decode_topic,
 };
 use libfuzzer_sys::fuzz_target;
 use serde_json::Value;
 
-fn typed<T: Message>(topic: Topic, payload: &[u8], encoding: Encoding) -> Result<Value, DecodeError> {
+fn typed<T: Message>(
+    topic: Topic,
+    payload: &[u8],
+    encoding: Encoding,
+) -> Result<Value, DecodeError> {
     assert_eq!(topic.message_type(), T::TYPE, "{topic:?}");
     decode::<T>(payload, encoding)
         .map(|msg| serde_json::to_value(&msg).expect("a decoded message converts to JSON"))
@@ -39,6 +43,9 @@ fuzz_target!(|data: &[u8]| {
     assert_eq!(shown, expected, "{topic:?} {encoding:?}");
     if let Ok(value) = shown {
         let object = value.as_object().expect("a message shows as a JSON object");
-        assert!(!object.contains_key("wire"), "{topic:?} shows the wire version");
+        assert!(
+            !object.contains_key("wire"),
+            "{topic:?} shows the wire version"
+        );
     }
 });

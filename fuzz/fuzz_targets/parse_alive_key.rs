@@ -7,6 +7,7 @@
 //! valid key chunk.
 #![no_main]
 
+use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, alive_token};
 use graspopt_protocol::keys::{check_agent_id, parse_alive_key, sanitize_chunk};
 use graspopt_protocol::{Encoding, RunId, Topic};
 use libfuzzer_sys::fuzz_target;
@@ -16,7 +17,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     if let Some(alive) = parse_alive_key(key) {
-        let mut rebuilt = alive.run.alive_key(alive.kind, &alive.host, &alive.id);
+        let mut rebuilt = alive_token(&alive.run, alive.kind, &alive.host, &alive.id);
         if alive.encoding == Encoding::Json {
             rebuilt.push_str("/json");
         }
@@ -24,16 +25,21 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Some((run, topic)) = Topic::classify(key) {
         let rebuilt = match topic {
-            Topic::Object => run.object_key(),
-            Topic::Command => run.command_key(key.split('/').nth(3).unwrap_or_default()),
-            Topic::Clouds => run.clouds_key(),
-            Topic::Result => run.result_key(),
-            Topic::Status => run.status_key(),
+            Topic::Object => OBJECT.key(Runs::One(&run)).to_string(),
+            Topic::Command => COMMAND
+                .worker_key(Runs::One(&run), key.split('/').nth(3).unwrap_or_default())
+                .to_string(),
+            Topic::Clouds => CLOUDS.key(Runs::One(&run)).to_string(),
+            Topic::Result => RESULT.key(Runs::One(&run)).to_string(),
+            Topic::Status => STATUS.key(Runs::One(&run)).to_string(),
         };
         assert_eq!(rebuilt, key, "{topic:?}");
     }
     let chunk = sanitize_chunk(key);
-    assert!(check_agent_id(&chunk).is_ok(), "{key:?} sanitized to {chunk:?}");
+    assert!(
+        check_agent_id(&chunk).is_ok(),
+        "{key:?} sanitized to {chunk:?}"
+    );
     assert!(RunId::new(&chunk).is_ok(), "{key:?} sanitized to {chunk:?}");
     let _ = Encoding::from_mime(key);
 });

@@ -8,6 +8,7 @@ use crate::support::{
 };
 use graspopt_bus::{Bus, CongestionControl};
 use graspopt_journal::{Journal, TrialState};
+use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Pose, RunId, TrialResult, encode,
 };
@@ -165,7 +166,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     let first: TrialResult = runtime.block_on(async {
         let bus = Bus::open(&c.client_args(None)).await.unwrap();
         let results = bus
-            .subscribe::<TrialResult>(&run.result_key())
+            .subscribe::<TrialResult>(&RESULT.key(Runs::One(&run)).to_string())
             .await
             .unwrap();
         let first = tokio::time::timeout(Duration::from_secs(60), results.recv())
@@ -193,31 +194,54 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         };
         // Results: three undecodable (garbage, wrong version, NaN), one unknown trial, one
         // duplicate with a better score than any real trial.
-        put_raw(run.result_key(), garbage.clone(), Encoding::Bincode).await;
-        put_raw(run.result_key(), wrong_version, Encoding::Bincode).await;
         put_raw(
-            run.result_key(),
+            RESULT.key(Runs::One(&run)).to_string(),
+            garbage.clone(),
+            Encoding::Bincode,
+        )
+        .await;
+        put_raw(
+            RESULT.key(Runs::One(&run)).to_string(),
+            wrong_version,
+            Encoding::Bincode,
+        )
+        .await;
+        put_raw(
+            RESULT.key(Runs::One(&run)).to_string(),
             encode(&nan_score, Encoding::Bincode).unwrap(),
             Encoding::Bincode,
         )
         .await;
-        bus.put(&run.result_key(), &unknown, Encoding::Bincode)
-            .await
-            .unwrap();
-        bus.put(&run.result_key(), &duplicate, Encoding::Json)
-            .await
-            .unwrap();
+        bus.put(
+            &RESULT.key(Runs::One(&run)).to_string(),
+            &unknown,
+            Encoding::Bincode,
+        )
+        .await
+        .unwrap();
+        bus.put(
+            &RESULT.key(Runs::One(&run)).to_string(),
+            &duplicate,
+            Encoding::Json,
+        )
+        .await
+        .unwrap();
         // Object estimate (coordinator, metric and hands listen), clouds (metric), a command
         // (hand-1), each garbage or NaN.
-        put_raw(run.object_key(), garbage.clone(), Encoding::Bincode).await;
         put_raw(
-            run.clouds_key(),
+            OBJECT.key(Runs::One(&run)).to_string(),
+            garbage.clone(),
+            Encoding::Bincode,
+        )
+        .await;
+        put_raw(
+            CLOUDS.key(Runs::One(&run)).to_string(),
             encode(&nan_clouds(&run), Encoding::Bincode).unwrap(),
             Encoding::Bincode,
         )
         .await;
         put_raw(
-            run.command_key("hand-1"),
+            COMMAND.worker_key(Runs::One(&run), "hand-1").to_string(),
             b"{\"wire\": 3}".to_vec(),
             Encoding::Json,
         )

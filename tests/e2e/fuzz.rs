@@ -13,6 +13,7 @@ use std::time::Duration;
 use crate::support::{Cluster, check_journal, report, wait_until};
 use graspopt_bus::{Bus, CongestionControl, zenoh_encoding};
 use graspopt_journal::TrialRow;
+use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, SUGGEST};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Message, MetricValues, ObjectEstimate,
     PlannerMethod, Pose, RunId, SuggestRequest, TrialCommand, TrialResult, decode, encode,
@@ -254,7 +255,7 @@ fn send_noise(c: &Cluster) -> Sent {
         let bus = Bus::open(&c.client_args(None)).await.unwrap();
         // Start once the run is under way (the first trial has been issued).
         let results = bus
-            .subscribe::<TrialResult>(&run.result_key())
+            .subscribe::<TrialResult>(&RESULT.key(Runs::One(&run)).to_string())
             .await
             .unwrap();
         tokio::time::timeout(Duration::from_secs(60), results.recv())
@@ -265,22 +266,22 @@ fn send_noise(c: &Cluster) -> Sent {
         let mut sent = Sent::default();
         let mut streams: Vec<(String, Payloads, &str)> = vec![
             (
-                run.result_key(),
+                RESULT.key(Runs::One(&run)).to_string(),
                 mutants(&mut rng, &result, PER_STREAM),
                 "results",
             ),
             (
-                run.object_key(),
+                OBJECT.key(Runs::One(&run)).to_string(),
                 mutants(&mut rng, &object, PER_STREAM),
                 "objects",
             ),
             (
-                run.clouds_key(),
+                CLOUDS.key(Runs::One(&run)).to_string(),
                 mutants(&mut rng, &clouds, PER_STREAM),
                 "clouds",
             ),
             (
-                run.command_key("hand-1"),
+                COMMAND.worker_key(Runs::One(&run), "hand-1").to_string(),
                 mutants(&mut rng, &command, PER_STREAM),
                 "commands",
             ),
@@ -302,7 +303,11 @@ fn send_noise(c: &Cluster) -> Sent {
             };
             strangers.push((encode(&r, e).unwrap(), e));
         }
-        streams.push((run.result_key(), strangers, "results"));
+        streams.push((
+            RESULT.key(Runs::One(&run)).to_string(),
+            strangers,
+            "results",
+        ));
         // Interleave the streams message by message.
         for i in 0..PER_STREAM {
             for (key, msgs, what) in &streams {
@@ -322,7 +327,7 @@ fn send_noise(c: &Cluster) -> Sent {
         for (bytes, encoding) in mutants(&mut rng, &suggest, PER_STREAM) {
             let replies = bus
                 .session()
-                .get(run.suggest_key())
+                .get(SUGGEST.key(&run).to_string())
                 .payload(bytes)
                 .encoding(zenoh_encoding(encoding))
                 .timeout(Duration::from_secs(10))

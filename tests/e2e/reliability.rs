@@ -12,6 +12,7 @@ use crate::support::{
 };
 use graspopt_bus::Bus;
 use graspopt_journal::{Journal, TrialRow, TrialState};
+use graspopt_protocol::keys::{CLOUDS, COMMAND, Runs};
 use graspopt_protocol::{
     AgentKind, CloudPoint, ContactClouds, Encoding, FingerCloud, RunId, TrialCommand,
 };
@@ -371,7 +372,7 @@ fn degenerate_contacts_never_leave_a_trial_stuck() {
     let (expected, _hand) = runtime.block_on(async {
         let bus = Bus::open(&c.client_args(None)).await.unwrap();
         let commands = bus
-            .subscribe::<TrialCommand>(&run.command_key("hand-x"))
+            .subscribe::<TrialCommand>(&COMMAND.worker_key(Runs::One(&run), "hand-x").to_string())
             .await
             .unwrap();
         let token = bus
@@ -387,9 +388,13 @@ fn degenerate_contacts_never_leave_a_trial_stuck() {
                 .message
                 .unwrap();
             let (clouds, complete, what) = degenerate(i, &cmd);
-            bus.put(&run.clouds_key(), &clouds, Encoding::Bincode)
-                .await
-                .unwrap();
+            bus.put(
+                &CLOUDS.key(Runs::One(&run)).to_string(),
+                &clouds,
+                Encoding::Bincode,
+            )
+            .await
+            .unwrap();
             expected.push((cmd.trial_id, complete, what));
         }
         (expected, (bus, token))

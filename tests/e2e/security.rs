@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use crate::support::{Cluster, check_journal, cloud_transport, repo_root, report};
 use graspopt_bus::Bus;
+use graspopt_protocol::keys::{RESULT, Runs, alive_key};
 use graspopt_protocol::{AgentKind, Encoding, RunId, TrialResult};
 use serde_json::json;
 
@@ -102,7 +103,7 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
             .unwrap();
         let hand = Bus::open(&c.client_args(Some(role("hand")))).await.unwrap();
         let results = watcher
-            .subscribe::<TrialResult>(&run.result_key())
+            .subscribe::<TrialResult>(&RESULT.key(Runs::One(&run)).to_string())
             .await
             .unwrap();
         // A hand posing as a metric agent (the coordinator would issue trials to nobody).
@@ -115,9 +116,13 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
         while observed < TRIALS {
             for id in 1..=TRIALS {
                 for bus in [&observer, &hand] {
-                    bus.put(&run.result_key(), &forged(id), Encoding::Bincode)
-                        .await
-                        .unwrap();
+                    bus.put(
+                        &RESULT.key(Runs::One(&run)).to_string(),
+                        &forged(id),
+                        Encoding::Bincode,
+                    )
+                    .await
+                    .unwrap();
                     sent += 1;
                 }
             }
@@ -132,7 +137,7 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
             assert!(sent < 200_000, "the run does not progress");
         }
         let metrics: Vec<String> = watcher
-            .alive_now(&run.alive_kind_key(AgentKind::Metric))
+            .alive_now(&alive_key(Runs::One(&run), Some(AgentKind::Metric)))
             .await
             .unwrap()
             .into_iter()

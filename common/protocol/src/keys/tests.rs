@@ -24,11 +24,12 @@ fn claim_keys_parse_back_and_nothing_else_does() {
             held: true,
         },
     ] {
-        let key = run.claim_key(AgentKind::Hand, "hand-1", claim);
+        let key = claim_token(&run, AgentKind::Hand, "hand-1", claim);
         assert_eq!(parse_claim_key(&key), Some(claim), "{key}");
     }
     assert_eq!(
-        run.claim_key(
+        claim_token(
+            &run,
             AgentKind::Coordinator,
             "any",
             Claim {
@@ -53,11 +54,14 @@ fn claim_keys_parse_back_and_nothing_else_does() {
 fn keys_classify_back_to_their_topic() {
     let run = RunId::new("r1").unwrap();
     let cases = [
-        (run.object_key(), Topic::Object),
-        (run.command_key("w-1"), Topic::Command),
-        (run.clouds_key(), Topic::Clouds),
-        (run.result_key(), Topic::Result),
-        (run.status_key(), Topic::Status),
+        (OBJECT.key(Runs::One(&run)).to_string(), Topic::Object),
+        (
+            COMMAND.worker_key(Runs::One(&run), "w-1").to_string(),
+            Topic::Command,
+        ),
+        (CLOUDS.key(Runs::One(&run)).to_string(), Topic::Clouds),
+        (RESULT.key(Runs::One(&run)).to_string(), Topic::Result),
+        (STATUS.key(Runs::One(&run)).to_string(), Topic::Status),
     ];
     for (key, topic) in cases {
         assert_eq!(Topic::classify(&key), Some((run.clone(), topic)), "{key}");
@@ -69,7 +73,7 @@ fn keys_classify_back_to_their_topic() {
 #[test]
 fn alive_keys_parse() {
     let run = RunId::new("r1").unwrap();
-    let key = run.alive_key(AgentKind::Hand, "host-a", "hand-1");
+    let key = alive_token(&run, AgentKind::Hand, "host-a", "hand-1");
     assert_eq!(key, "graspopt/r1/alive/hand/host-a/hand-1");
     let parsed = parse_alive_key(&key).unwrap();
     assert_eq!(parsed.kind, AgentKind::Hand);
