@@ -52,6 +52,24 @@ impl ParamKind {
             ParamKind::RotZ => "rz",
         }
     }
+
+    /// A parameter as users type it: the thesis's x (approach) and y (vertical), the names
+    /// of [`ParamKind::name`], and the long forms; surrounding spaces ignored.
+    pub fn parse(name: &str) -> Result<Self> {
+        Ok(match name.trim() {
+            "x" | "approach" => ParamKind::Approach,
+            "lateral" | "z" => ParamKind::Lateral,
+            "y" | "vertical" => ParamKind::Vertical,
+            "rx" | "roll" => ParamKind::RotX,
+            "ry" | "pitch" => ParamKind::RotY,
+            "rz" | "yaw" => ParamKind::RotZ,
+            other => {
+                return Err(SimError::UnknownParam {
+                    name: other.to_string(),
+                });
+            }
+        })
+    }
 }
 
 impl std::fmt::Display for ParamKind {
@@ -129,6 +147,23 @@ impl TrialSpace {
             reference: reference_pose(object),
             params: default_bounds(object).to_vec(),
         }
+    }
+
+    /// The object's default trial space restricted to `kinds`, in that order (each with its
+    /// full default bounds).
+    pub fn with_params(object: &Object, kinds: &[ParamKind]) -> Result<Self> {
+        let full = Self::full_6d(object);
+        let params: Vec<ParamSpec> = kinds
+            .iter()
+            .map(|k| {
+                full.params
+                    .iter()
+                    .find(|p| p.kind == *k)
+                    .copied()
+                    .ok_or_else(|| SimError::InvalidInput(format!("no bounds for {}", k.name())))
+            })
+            .collect::<Result<_>>()?;
+        Self::new(full.reference, params)
     }
 
     /// Number of parameters.
@@ -236,6 +271,42 @@ pub fn default_bounds(object: &Object) -> [ParamSpec; 6] {
 mod tests {
     use super::*;
     use nalgebra::Point3;
+
+    #[test]
+    fn parameter_names_users_type_parse_to_their_kinds() {
+        for (names, kind) in [
+            (["x", "approach", " x "], ParamKind::Approach),
+            (["y", "vertical", "vertical"], ParamKind::Vertical),
+            (["z", "lateral", "lateral"], ParamKind::Lateral),
+            (["rx", "roll", "rx"], ParamKind::RotX),
+            (["ry", "pitch", "ry"], ParamKind::RotY),
+            (["rz", "yaw", "rz"], ParamKind::RotZ),
+        ] {
+            for name in names {
+                assert_eq!(ParamKind::parse(name).unwrap(), kind, "{name}");
+            }
+            // The name it is shown by parses back.
+            assert_eq!(ParamKind::parse(kind.name()).unwrap(), kind);
+        }
+        let e = ParamKind::parse("rot_x").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "unknown trial parameter \"rot_x\": expected x (approach), y (vertical), lateral, rx, ry or rz"
+        );
+    }
+
+    #[test]
+    fn a_space_with_chosen_parameters_keeps_their_order_and_default_bounds() {
+        let o = Object::by_name("mug").unwrap();
+        let full = TrialSpace::full_6d(&o);
+        let s = TrialSpace::with_params(&o, &[ParamKind::RotZ, ParamKind::Approach]).unwrap();
+        assert_eq!(s.reference, full.reference);
+        let kinds: Vec<ParamKind> = s.params.iter().map(|p| p.kind).collect();
+        assert_eq!(kinds, [ParamKind::RotZ, ParamKind::Approach]);
+        let bounds = full.bounds();
+        assert_eq!(s.bounds(), vec![bounds[5], bounds[0]]);
+        assert_eq!(TrialSpace::with_params(&o, &[]).unwrap().dim(), 0);
+    }
 
     #[test]
     fn reference_frame_looks_along_world_x() {

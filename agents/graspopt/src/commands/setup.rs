@@ -3,11 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
-use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec, TrialSpace};
-use graspopt_trial::{Evaluator, Metric, ReferenceFrame};
+use graspopt_sim::{ContactModel, Object, ParamKind};
+use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
 pub struct SimArgs {
@@ -63,65 +62,41 @@ pub enum Frame {
 }
 
 impl SimArgs {
+    /// The trial settings the flags name.
+    pub fn settings(&self) -> Result<TrialSettings> {
+        Ok(TrialSettings {
+            object: self.object.clone(),
+            mesh: self.mesh.clone(),
+            mesh_scale: self.mesh_scale,
+            hand: self.hand.clone(),
+            contacts: self.contacts.into(),
+            metric: Metric::parse(&self.metric)?,
+            frame: match self.frame {
+                Frame::Object => ReferenceFrame::Object,
+                Frame::World => ReferenceFrame::World,
+                Frame::Palm => ReferenceFrame::Palm,
+            },
+            torque_scale: self.torque_scale,
+        })
+    }
+
     /// The object named by the flags.
     pub fn object(&self) -> Result<Object> {
-        match &self.mesh {
-            Some(path) => Object::from_file_scaled(path, self.mesh_scale)
-                .with_context(|| format!("cannot load the mesh {}", path.display())),
-            None => Ok(Object::by_name(&self.object)?),
-        }
+        Ok(graspopt_trial::settings::load_object(
+            &self.object,
+            self.mesh.as_deref(),
+            self.mesh_scale,
+        )?)
     }
 
     /// An evaluator over the trial space with the given parameters (full default bounds).
     pub fn evaluator(&self, kinds: &[ParamKind]) -> Result<Evaluator> {
-        let object = self.object()?;
-        let space = space_for(&object, kinds)?;
-        let hand = hand_by_name(&self.hand)?;
-        let mut ev = Evaluator::new(object, hand, space);
-        ev.score.contacts = self.contacts.into();
-        ev.score.metric = Metric::parse(&self.metric)?;
-        ev.score.frame = match self.frame {
-            Frame::Object => ReferenceFrame::Object,
-            Frame::World => ReferenceFrame::World,
-            Frame::Palm => ReferenceFrame::Palm,
-        };
-        if let Some(rho) = self.torque_scale {
-            if !(rho.is_finite() && rho > 0.0) {
-                bail!("--torque-scale must be a positive length in metres, got {rho}");
-            }
-            ev.score.torque_scale = Some(rho);
-        }
-        Ok(ev)
+        Ok(Evaluator::from_settings(&self.settings()?, kinds)?)
     }
 }
 
-/// Parameter names users type: the thesis's x (approach) and y (vertical), plus the rest.
+/// Parameter names users type (see [`ParamKind::parse`]); for the callers that still use
+/// anyhow's `Result`.
 pub fn param_kind(name: &str) -> Result<ParamKind> {
-    Ok(match name.trim() {
-        "x" | "approach" => ParamKind::Approach,
-        "lateral" | "z" => ParamKind::Lateral,
-        "y" | "vertical" => ParamKind::Vertical,
-        "rx" | "roll" => ParamKind::RotX,
-        "ry" | "pitch" => ParamKind::RotY,
-        "rz" | "yaw" => ParamKind::RotZ,
-        other => bail!(
-            "unknown trial parameter {other:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
-        ),
-    })
-}
-
-/// The object's default trial space restricted to `kinds`, in that order.
-pub fn space_for(object: &Object, kinds: &[ParamKind]) -> Result<TrialSpace> {
-    let full = TrialSpace::full_6d(object);
-    let params: Vec<ParamSpec> = kinds
-        .iter()
-        .map(|k| {
-            full.params
-                .iter()
-                .find(|p| p.kind == *k)
-                .copied()
-                .with_context(|| format!("no bounds for {}", k.name()))
-        })
-        .collect::<Result<_>>()?;
-    Ok(TrialSpace::new(full.reference, params)?)
+    Ok(ParamKind::parse(name)?)
 }
