@@ -69,14 +69,9 @@ impl Part {
     /// Every part, in the order they run.
     pub const ALL: [Part; 3] = [Part::OneD, Part::TwoD, Part::SixD];
 
-    /// The part named `name` (one of [`Part::name`]).
-    pub fn from_name(name: &str) -> Result<Part, ExperimentError> {
-        Part::ALL
-            .into_iter()
-            .find(|p| p.name() == name)
-            .ok_or_else(|| {
-                ExperimentError::Settings(format!("unknown part {name:?}: expected 1d, 2d or 6d"))
-            })
+    /// The part named `name` (one of [`Part::name`]), if any.
+    pub fn from_name(name: &str) -> Option<Part> {
+        Part::ALL.into_iter().find(|p| p.name() == name)
     }
 
     /// `1d`, `2d` or `6d`.

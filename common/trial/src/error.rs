@@ -11,7 +11,7 @@ pub enum TrialError {
     #[error("cannot load the mesh {}", path.display())]
     Mesh {
         path: std::path::PathBuf,
-        source: graspopt_sim::SimError,
+        source: Box<graspopt_sim::SimError>,
     },
     #[error("{0}")]
     Settings(String),

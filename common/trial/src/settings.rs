@@ -42,7 +42,7 @@ pub fn load_object(name: &str, mesh: Option<&Path>, scale: f64) -> Result<Object
     match mesh {
         Some(path) => Object::from_file_scaled(path, scale).map_err(|source| TrialError::Mesh {
             path: path.to_path_buf(),
-            source,
+            source: Box::new(source),
         }),
         None => Ok(Object::by_name(name)?),
     }

@@ -67,7 +67,8 @@ pub struct BoArgs {
 
 /// `--parts`: each one of [`Part::ALL`], parsed by [`Part::from_name`].
 fn part_parser() -> impl TypedValueParser<Value = Part> {
-    PossibleValuesParser::new(Part::ALL.map(|p| p.name())).try_map(|name| Part::from_name(&name))
+    PossibleValuesParser::new(Part::ALL.map(|p| p.name()))
+        .try_map(|name| Part::from_name(&name).ok_or("unknown part: expected 1d, 2d or 6d"))
 }
 
 /// `--engine`: one of the presets, parsed by [`Preset::from_name`].
