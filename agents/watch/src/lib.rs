@@ -13,25 +13,3 @@
 
 pub mod monitor;
 pub mod topic;
-
-/// `name=value` for each parameter (5 decimals), joined by `sep`.
-pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
-    let parts: Vec<String> = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| format!("{n}={v:.5}"))
-        .collect();
-    parts.join(sep)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn named_params_pairs_names_and_values() {
-        let names = ["a".to_string(), "b".to_string()];
-        assert_eq!(
-            super::named_params(&names, &[0.5, -1.0], ","),
-            "a=0.50000,b=-1.00000"
-        );
-    }
-}

@@ -8,37 +8,13 @@ use crate::acquisition::XiRule;
 use crate::baseline::{AskTell, RandomSearch};
 use crate::error::{BoError, Result};
 use crate::optimizer::{BatchStrategy, Optimizer, OutputTransform, RestartRule, Settings};
+pub use crate::preset::{Method, Preset};
 use crate::testfunctions::TestFunction;
 
 /// Regret levels reported: 5%, 1%, 0.1%.
 pub const REGRET_LEVELS: [f64; 3] = [0.05, 0.01, 0.001];
 
-/// Which method to run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Method {
-    /// The engine with [`recommended_settings`].
-    Bo,
-    /// The engine with the thesis settings as written (xi = sigma_f^2 / 100).
-    BoThesis,
-    /// Uniform random search.
-    Random,
-}
-
-impl Method {
-    /// Parse `bo`, `bo-thesis` or `random`.
-    pub fn from_name(name: &str) -> Result<Self> {
-        match name.to_ascii_lowercase().as_str() {
-            "bo" => Ok(Method::Bo),
-            "bo-thesis" | "thesis" => Ok(Method::BoThesis),
-            "random" => Ok(Method::Random),
-            other => Err(BoError::InvalidSetting(format!(
-                "unknown method '{other}' (known: bo, bo-thesis, random)"
-            ))),
-        }
-    }
-}
-
-/// Settings used by [`Method::Bo`] on the benchmarks: the defaults (Matern 3/2, log-EI,
+/// Settings of [`Preset::Benchmark`], used by `bo` on the benchmarks: the defaults (Matern 3/2, log-EI,
 /// DIRECT + polish, MAP fit) with `xi = 0` instead of the thesis's `sigma_f^2 / 100` (which
 /// stalls Branin near 3e-4 regret with the plain pipeline), the log tail warp of the outputs,
 /// a pessimistic GP prior mean (the worst transformed observation) and a diversification
@@ -118,12 +94,8 @@ pub fn run_seed(
     method: Method,
 ) -> Result<Vec<f64>> {
     match method {
-        Method::Bo | Method::BoThesis => {
-            let mut s = if method == Method::Bo {
-                recommended_settings()
-            } else {
-                Settings::default()
-            };
+        Method::Bo(preset) => {
+            let mut s = preset.settings();
             s.n_init = Some(n_init);
             run_seed_with(function, seed, budget, batch_q, s)
         }
@@ -179,6 +151,67 @@ pub fn summarize(function: TestFunction, seed: u64, trace: &[f64], q: usize) -> 
         rounds_to: evals_to.map(|e| e.map(|e| rounds_for(e, q))),
         final_best,
         final_regret: function.regret(final_best),
+    }
+}
+
+/// One method on one test function over seeds `0..seeds` (the `optimize-function` command).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Benchmark {
+    pub function: TestFunction,
+    pub method: Method,
+    /// Seeds run: `0..seeds`.
+    pub seeds: u64,
+    /// Evaluations per seed.
+    pub budget: usize,
+    /// Random initial points (part of the budget).
+    pub n_init: usize,
+    /// Points proposed per round.
+    pub batch: usize,
+}
+
+impl Benchmark {
+    /// The default budget for `function`: 50 evaluations in 2D, 100 otherwise.
+    pub fn default_budget(function: TestFunction) -> usize {
+        if function.dim() <= 2 { 50 } else { 100 }
+    }
+
+    /// The default initial design for `function`: 5 points in 2D, 10 in 6D, otherwise twice
+    /// the dimension, never more than `budget`.
+    pub fn default_n_init(function: TestFunction, budget: usize) -> usize {
+        match function.dim() {
+            2 => 5,
+            6 => 10,
+            d => 2 * d,
+        }
+        .min(budget)
+    }
+
+    /// Runs every seed in order, calling `each(seed, best_after_each_evaluation, summary)`
+    /// after each, and returns the summary over the seeds per regret level. A seed's failure
+    /// stops the run ([`BoError::Seed`]); so does an error of `each`.
+    pub fn run<E: From<BoError>>(
+        &self,
+        mut each: impl FnMut(u64, &[f64], &SeedSummary) -> std::result::Result<(), E>,
+    ) -> std::result::Result<Vec<LevelSummary>, E> {
+        let mut summaries = Vec::new();
+        for seed in 0..self.seeds {
+            let trace = run_seed(
+                self.function,
+                seed,
+                self.budget,
+                self.n_init,
+                self.batch,
+                self.method,
+            )
+            .map_err(|e| BoError::Seed {
+                seed,
+                error: Box::new(e),
+            })?;
+            let s = summarize(self.function, seed, &trace, self.batch);
+            each(seed, &trace, &s)?;
+            summaries.push(s);
+        }
+        Ok(aggregate(&summaries, self.budget, self.batch))
     }
 }
 
@@ -271,6 +304,51 @@ mod tests {
         assert_eq!(t.len(), 30);
         assert!(t.windows(2).all(|w| w[1] <= w[0]));
         assert!(run_seed(TestFunction::Branin, 3, 0, 5, 1, Method::Random).is_err());
-        assert!(run_seed(TestFunction::Branin, 3, 10, 5, 0, Method::Bo).is_err());
+        assert!(
+            run_seed(
+                TestFunction::Branin,
+                3,
+                10,
+                5,
+                0,
+                Method::Bo(Preset::Benchmark)
+            )
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn a_benchmark_runs_every_seed_in_order_and_summarises_them() {
+        let b = Benchmark {
+            function: TestFunction::Branin,
+            method: Method::Random,
+            seeds: 3,
+            budget: 12,
+            n_init: 5,
+            batch: 2,
+        };
+        let mut seen = Vec::new();
+        let levels = b
+            .run(|seed, trace, s| {
+                let again = run_seed(TestFunction::Branin, seed, 12, 5, 2, Method::Random)?;
+                assert_eq!(trace, &again[..]);
+                assert_eq!(s, &summarize(TestFunction::Branin, seed, trace, 2));
+                seen.push(seed);
+                Ok::<(), BoError>(())
+            })
+            .unwrap();
+        assert_eq!(seen, [0, 1, 2]);
+        assert_eq!(levels.len(), REGRET_LEVELS.len());
+        assert!(levels.iter().all(|l| l.seeds == 3));
+        let broken = Benchmark { batch: 0, ..b };
+        let e = broken.run(|_, _, _| Ok::<(), BoError>(())).unwrap_err();
+        assert!(matches!(e, BoError::Seed { seed: 0, .. }), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "seed 0: invalid setting: budget and batch_q must be >= 1"
+        );
+        assert_eq!(Benchmark::default_budget(TestFunction::Hartmann6), 100);
+        assert_eq!(Benchmark::default_n_init(TestFunction::Hartmann6, 100), 10);
+        assert_eq!(Benchmark::default_n_init(TestFunction::Branin, 3), 3);
     }
 }

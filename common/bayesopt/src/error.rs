@@ -49,6 +49,14 @@ pub enum BoError {
     /// A setting is outside its valid range.
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
+    /// One seed of a benchmark failed.
+    #[error("seed {seed}: {error}")]
+    Seed {
+        /// The seed.
+        seed: u64,
+        /// What went wrong.
+        error: Box<BoError>,
+    },
     /// Not enough data for the requested operation (e.g. a GP with no observation).
     #[error("not enough data: {0}")]
     NotEnoughData(String),

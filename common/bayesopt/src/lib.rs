@@ -18,6 +18,7 @@ pub mod kernel;
 pub mod lbfgs;
 pub mod linalg;
 pub mod optimizer;
+pub mod preset;
 pub mod qei;
 pub mod rng;
 pub mod special;
@@ -25,7 +26,7 @@ pub mod testfunctions;
 
 pub use acquisition::{AcquisitionKind, XiRule};
 pub use baseline::{AskTell, GridSearch, RandomSearch};
-pub use benchmark::{Method, run_seed};
+pub use benchmark::run_seed;
 pub use error::{BoError, Result};
 pub use fit::{FitSettings, Hyperparameters};
 pub use gp::Gp;
@@ -34,4 +35,5 @@ pub use optimizer::{
     BatchStrategy, InitialDesign, MAX_QEI_SAMPLES, ModelPoint, Optimizer, OutputTransform,
     RestartRule, RoundInfo, Settings, StopReason, StopRule,
 };
+pub use preset::{Method, Preset};
 pub use testfunctions::TestFunction;

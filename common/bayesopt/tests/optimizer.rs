@@ -398,7 +398,7 @@ fn branin_quick_run_finds_the_basin() {
         25,
         5,
         1,
-        graspopt_bayesopt::Method::Bo,
+        graspopt_bayesopt::Method::Bo(graspopt_bayesopt::Preset::Benchmark),
     )
     .unwrap();
     let best = trace.last().copied().unwrap();

@@ -18,8 +18,8 @@ use graspopt_bayesopt::benchmark::recommended_settings;
 use std::time::Instant;
 
 use graspopt_bayesopt::{
-    AcquisitionKind, BatchStrategy, InitialDesign, KernelKind, Method, OutputTransform, Settings,
-    XiRule,
+    AcquisitionKind, BatchStrategy, InitialDesign, KernelKind, Method, OutputTransform, Preset,
+    Settings, XiRule,
 };
 use graspopt_experiment::{SearchSettings, compare};
 use graspopt_sim::hand::hand_by_name;
@@ -109,7 +109,7 @@ fn main() {
         let method = if name == "random" {
             Method::Random
         } else {
-            Method::Bo
+            Method::Bo(Preset::Benchmark)
         };
         let template = SearchSettings {
             method,

@@ -17,6 +17,18 @@ pub enum ExperimentError {
     /// A trial scored a value that is not finite.
     #[error("trial at {params:?} scored {score}, not a finite number")]
     NonFinite { params: Vec<f64>, score: f64 },
+    /// A grid scan failed (its error names the point).
+    #[error(transparent)]
+    Scan(#[from] graspopt_trial::TrialError),
+    /// An object or a trial space could not be built.
+    #[error(transparent)]
+    Sim(#[from] graspopt_sim::SimError),
+    /// The hand could not be loaded.
+    #[error("cannot load the hand {name:?}")]
+    Hand {
+        name: String,
+        source: graspopt_sim::SimError,
+    },
     /// The experiment's own settings are wrong.
     #[error("{0}")]
     Settings(String),

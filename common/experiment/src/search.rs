@@ -4,7 +4,6 @@
 
 use std::collections::VecDeque;
 
-use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::{AskTell, Method, Optimizer, RandomSearch, Settings, StopReason};
 use graspopt_trial::Evaluator;
 use serde::{Deserialize, Serialize};
@@ -15,7 +14,7 @@ use crate::error::ExperimentError;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SearchSettings {
     /// Which method: [`Method::Random`] or an engine run (the engine settings come from
-    /// `engine`, or from the method: `Bo` the benchmark settings, `BoThesis` the thesis's).
+    /// `engine`, or from the method's preset).
     pub method: Method,
     /// Trials at most.
     pub budget: usize,
@@ -25,8 +24,8 @@ pub struct SearchSettings {
     /// (thesis 3.4); otherwise the run goes on and [`Trace::ei_stop_at`] records when the
     /// engine would have stopped. Random search always uses the whole budget.
     pub stop_on_small_ei: bool,
-    /// The engine's settings, replacing the method's (`Bo`: [`Engine::Benchmark`],
-    /// `BoThesis`: [`Engine::Thesis`]); ignored by random search; `minimize` is forced off.
+    /// The engine's settings, replacing the method's preset; ignored by random search;
+    /// `minimize` is forced off.
     #[serde(default)]
     pub engine: Option<Settings>,
     /// Trials in flight (>= 1): W workers run asynchronously. Each proposal is made while
@@ -38,42 +37,6 @@ pub struct SearchSettings {
 
 fn one_worker() -> usize {
     1
-}
-
-/// Which engine settings a BO run uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Engine {
-    /// The thesis's method (Matern 3/2, EI with `xi = sigma_f^2 / 100`, DIRECT, stop when EI
-    /// vanishes) with the bad tail of the scores compressed logarithmically
-    /// (`Settings::for_grasps`). The best measured on the seven objects (docs/benchmarks.md).
-    Grasp,
-    /// The settings tuned on the Branin and Hartmann6 test functions
-    /// (`benchmark::recommended_settings`).
-    Benchmark,
-    /// The thesis's settings as written.
-    Thesis,
-}
-
-impl Engine {
-    /// The settings, maximising.
-    pub fn settings(self) -> Settings {
-        let mut s = match self {
-            Engine::Grasp => Settings::for_grasps(),
-            Engine::Benchmark => recommended_settings(),
-            Engine::Thesis => Settings::default(),
-        };
-        s.minimize = false;
-        s
-    }
-
-    /// `grasp`, `benchmark` or `thesis`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Engine::Grasp => "grasp",
-            Engine::Benchmark => "benchmark",
-            Engine::Thesis => "thesis",
-        }
-    }
 }
 
 /// The trials of one run, in order.
@@ -177,8 +140,10 @@ pub(crate) fn run_observed(
             minimize: false,
             ..custom.clone()
         }),
-        (None, Method::Bo) => Some(Engine::Benchmark.settings()),
-        (None, Method::BoThesis) => Some(Engine::Thesis.settings()),
+        (None, Method::Bo(preset)) => Some(Settings {
+            minimize: false,
+            ..preset.settings()
+        }),
     };
     let mut searcher = match engine {
         Some(mut s) => {

@@ -2,8 +2,8 @@
 //! in 2D with a grid reference, determinism, and a 1D run that finds the scan's maximum and
 //! stops on its own (thesis figure 4.16).
 
-use graspopt_bayesopt::Method;
-use graspopt_experiment::{Engine, SearchSettings, compare, run, run_with_snapshots};
+use graspopt_bayesopt::{Method, Preset};
+use graspopt_experiment::{SearchSettings, compare, run, run_with_snapshots};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, ParamKind, TrialSpace, reference_pose};
 use graspopt_trial::Evaluator;
@@ -45,7 +45,7 @@ fn settings(method: Method, budget: usize) -> SearchSettings {
         budget,
         n_init: None,
         stop_on_small_ei: false,
-        engine: Some(Engine::Grasp.settings()),
+        engine: Some(Preset::Grasp.settings()),
         workers: 1,
     }
 }
@@ -61,15 +61,18 @@ fn bo_gets_within_five_percent_of_the_grid_maximum_sooner_than_random_search() {
     let seeds: Vec<u64> = (0..5).collect();
     let cmp = compare(
         &ev,
-        &[Method::Bo, Method::Random],
+        &[Method::Bo(Preset::Grasp), Method::Random],
         &seeds,
-        &settings(Method::Bo, 30),
+        &settings(Method::Bo(Preset::Grasp), 30),
         Some(reference),
         0,
     )
     .unwrap();
     let (bo, random) = (&cmp.methods[0], &cmp.methods[1]);
-    assert_eq!((bo.method, random.method), (Method::Bo, Method::Random));
+    assert_eq!(
+        (bo.method, random.method),
+        (Method::Bo(Preset::Grasp), Method::Random)
+    );
     assert_eq!(bo.traces.len(), 5);
     assert!(bo.traces.iter().all(|t| t.scores.len() == 30));
     // Most BO seeds get within 5% in the 30 trials, and the median beats random search's
@@ -99,7 +102,7 @@ fn bo_gets_within_five_percent_of_the_grid_maximum_sooner_than_random_search() {
 #[test]
 fn the_same_seed_gives_the_same_trials_and_another_seed_others() {
     let ev = sphere(true);
-    let s = settings(Method::Bo, 8);
+    let s = settings(Method::Bo(Preset::Grasp), 8);
     let a = run(&ev, &s, 3).unwrap();
     let b = run(&ev, &s, 3).unwrap();
     let c = run(&ev, &s, 4).unwrap();
@@ -108,7 +111,7 @@ fn the_same_seed_gives_the_same_trials_and_another_seed_others() {
     let r = run(&ev, &settings(Method::Random, 8), 3).unwrap();
     assert_eq!(r.scores.len(), 8);
     assert_eq!(r.ei_stop_at, None, "random search has no stopping rule");
-    let zero = run(&ev, &settings(Method::Bo, 0), 3);
+    let zero = run(&ev, &settings(Method::Bo(Preset::Grasp), 0), 3);
     assert!(zero.unwrap_err().to_string().contains("budget"));
 }
 
@@ -126,7 +129,7 @@ fn a_1d_run_finds_the_scan_maximum_and_stops_when_ei_vanishes() {
     let s = SearchSettings {
         n_init: Some(2),
         stop_on_small_ei: true,
-        ..settings(Method::Bo, 40)
+        ..settings(Method::Bo(Preset::Grasp), 40)
     };
     let (trace, snaps) = run_with_snapshots(&ev, &s, 0, 101).unwrap();
     let stopped = trace.ei_stop_at.expect("the engine stops on its own");
@@ -179,12 +182,12 @@ fn a_1d_run_finds_the_scan_maximum_and_stops_when_ei_vanishes() {
 #[test]
 fn asynchronous_workers_propose_with_trials_pending() {
     let ev = sphere(true);
-    let one = run(&ev, &settings(Method::Bo, 12), 3).unwrap();
+    let one = run(&ev, &settings(Method::Bo(Preset::Grasp), 12), 3).unwrap();
     let four = run(
         &ev,
         &SearchSettings {
             workers: 4,
-            ..settings(Method::Bo, 12)
+            ..settings(Method::Bo(Preset::Grasp), 12)
         },
         3,
     )
@@ -196,7 +199,7 @@ fn asynchronous_workers_propose_with_trials_pending() {
     assert_ne!(one.params[5..], four.params[5..]);
     let none = SearchSettings {
         workers: 0,
-        ..settings(Method::Bo, 12)
+        ..settings(Method::Bo(Preset::Grasp), 12)
     };
     let err = run(&ev, &none, 3).unwrap_err().to_string();
     assert!(err.contains("worker"), "{err}");

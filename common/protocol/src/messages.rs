@@ -457,6 +457,17 @@ pub enum RunPhase {
     Finished,
 }
 
+/// `name=value` for each parameter of a trial (5 decimals), joined by `sep`: how the
+/// tools print a trial's parameters with [`RunStatus::param_names`].
+pub fn named_params(names: &[String], values: &[f64], sep: &str) -> String {
+    let parts: Vec<String> = names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| format!("{n}={v:.5}"))
+        .collect();
+    parts.join(sep)
+}
+
 /// The best trial so far.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BestTrial {
@@ -618,5 +629,22 @@ impl Message for RunStatus {
             waiting: Vec::new(),
         };
         Some((status, read))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn named_params_pairs_names_and_values() {
+        let names = ["a".to_string(), "b".to_string()];
+        assert_eq!(
+            super::named_params(&names, &[0.5, -1.0], ","),
+            "a=0.50000,b=-1.00000"
+        );
+        // Extra values (or names) are left out, not paired with nothing.
+        assert_eq!(
+            super::named_params(&names[..1], &[0.5, -1.0], ","),
+            "a=0.50000"
+        );
     }
 }

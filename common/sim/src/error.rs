@@ -102,6 +102,11 @@ pub enum SimError {
     /// A parameter vector of the wrong length or outside its bounds, or an invalid setting.
     #[error("invalid input: {0}")]
     InvalidInput(String),
+    /// A trial parameter name that is none of those [`crate::ParamKind::parse`] accepts.
+    #[error(
+        "unknown trial parameter {name:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
+    )]
+    UnknownParam { name: String },
     /// A collision query that parry does not support for the shapes involved.
     #[error("unsupported collision query between {0}")]
     UnsupportedQuery(String),

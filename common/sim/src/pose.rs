@@ -63,9 +63,9 @@ impl ParamKind {
             "ry" | "rot_y" | "pitch" => ParamKind::RotY,
             "rz" | "rot_z" | "yaw" => ParamKind::RotZ,
             other => {
-                return Err(SimError::InvalidInput(format!(
-                    "unknown trial parameter {other:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
-                )));
+                return Err(SimError::UnknownParam {
+                    name: other.to_string(),
+                });
             }
         })
     }

@@ -8,6 +8,11 @@ pub enum TrialError {
     Sim(#[from] graspopt_sim::SimError),
     #[error(transparent)]
     Quality(#[from] graspopt_quality::QualityError),
+    #[error("cannot load the mesh {}", path.display())]
+    Mesh {
+        path: std::path::PathBuf,
+        source: Box<graspopt_sim::SimError>,
+    },
     #[error("{0}")]
     Settings(String),
 }

@@ -18,6 +18,86 @@ pub struct ScanPoint {
     pub score: TrialScore,
 }
 
+/// The most points a grid (steps multiplied over the axes) may hold.
+pub const MAX_GRID_POINTS: usize = 10_000_000;
+
+/// A grid of trials: the evaluator, the parameters, points per axis and the axes' values.
+pub struct Grid {
+    pub ev: Evaluator,
+    pub kinds: Vec<graspopt_sim::ParamKind>,
+    pub steps: Vec<usize>,
+    pub axes: Vec<Vec<f64>>,
+}
+
+impl Grid {
+    /// The grid over the whole of `ev`'s trial space with `steps[k]` points on axis `k`
+    /// (`kinds` names the space's parameters, in order).
+    pub fn new(ev: Evaluator, kinds: Vec<graspopt_sim::ParamKind>, steps: Vec<usize>) -> Grid {
+        let axes = grid_axes(&ev.space.bounds(), &steps);
+        Grid {
+            ev,
+            kinds,
+            steps,
+            axes,
+        }
+    }
+
+    /// Points in the grid.
+    pub fn points(&self) -> usize {
+        self.steps.iter().product()
+    }
+}
+
+/// Points per axis from the text of `--steps` (comma separated whole numbers >= 1; one value
+/// applies to every one of the `axes` axes), checked against [`MAX_GRID_POINTS`].
+pub fn grid_steps(text: &str, axes: usize) -> Result<Vec<usize>, TrialError> {
+    let steps: Vec<usize> = text
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n >= 1)
+                .ok_or_else(|| {
+                    TrialError::Settings(format!("--steps: expected whole numbers >= 1, got {s:?}"))
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    let steps = match steps.len() {
+        1 => vec![steps[0]; axes],
+        n if n == axes => steps,
+        n => {
+            return Err(TrialError::Settings(format!(
+                "--steps has {n} values for {axes} axes"
+            )));
+        }
+    };
+    let total = grid_points(&steps)?;
+    if total > MAX_GRID_POINTS {
+        return Err(TrialError::Settings(format!(
+            "--steps {}: a grid of {total} points is more than the {MAX_GRID_POINTS} allowed; \
+             use fewer steps or axes",
+            text.trim()
+        )));
+    }
+    Ok(steps)
+}
+
+/// Points of a grid with `steps[k]` points on axis `k`; errors (naming `--steps`) when the
+/// product does not fit in a `usize`.
+pub fn grid_points(steps: &[usize]) -> Result<usize, TrialError> {
+    steps
+        .iter()
+        .try_fold(1usize, |acc, &n| acc.checked_mul(n))
+        .ok_or_else(|| {
+            let list: Vec<String> = steps.iter().map(usize::to_string).collect();
+            TrialError::Settings(format!(
+                "--steps {}: the grid has more points than can be counted (at most {MAX_GRID_POINTS} allowed)",
+                list.join(",")
+            ))
+        })
+}
+
 /// Evenly spaced values from `lower` to `upper` inclusive (`n >= 2`; one value, the
 /// midpoint, for `n == 1`).
 pub fn linspace(lower: f64, upper: f64, n: usize) -> Vec<f64> {

@@ -3,11 +3,9 @@
 //! and the evaluations (and rounds, for batches) needed to reach normalised regret 5%, 1% and
 //! 0.1%, then medians over the seeds.
 
-use anyhow::Context;
-use graspopt_bayesopt::TestFunction;
-use graspopt_bayesopt::benchmark::{
-    Method, REGRET_LEVELS, SeedSummary, aggregate, run_seed, summarize,
-};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use graspopt_bayesopt::benchmark::{Benchmark, REGRET_LEVELS};
+use graspopt_bayesopt::{Method, TestFunction};
 use serde_json::json;
 
 use crate::out::outln;
@@ -17,15 +15,12 @@ pub const MAX_SEEDS: u64 = 1000;
 /// The most evaluations per seed.
 pub const MAX_BUDGET: usize = 100_000;
 
-/// Method to run.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodArg {
-    /// The engine with its recommended settings.
-    Bo,
-    /// The engine with the thesis settings as written (EI xi = sigma_f^2 / 100).
-    BoThesis,
-    /// Uniform random search.
-    Random,
+/// `--method`: one of [`Method::NAMED`], parsed by [`Method::from_name`].
+pub fn method_parser() -> impl TypedValueParser<Value = Method> {
+    PossibleValuesParser::new(
+        Method::NAMED.map(|m| PossibleValue::new(m.name()).help(m.description())),
+    )
+    .try_map(|name| Method::from_name(&name))
 }
 
 /// Output format.
@@ -56,8 +51,8 @@ pub struct OptimizeFunctionArgs {
     #[arg(long, default_value_t = 1)]
     pub batch: usize,
     /// Method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Bo)]
-    pub method: MethodArg,
+    #[arg(long, default_value = "bo", value_parser = method_parser())]
+    pub method: Method,
     /// Output format.
     #[arg(long, value_enum, default_value_t = FormatArg::Text)]
     pub format: FormatArg,
@@ -74,8 +69,9 @@ fn fmt_med(v: Option<f64>) -> String {
 /// Run the command.
 pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
     let function = TestFunction::from_name(&args.function)?;
-    let d = function.dim();
-    let budget = args.budget.unwrap_or(if d <= 2 { 50 } else { 100 });
+    let budget = args
+        .budget
+        .unwrap_or_else(|| Benchmark::default_budget(function));
     anyhow::ensure!(
         (1..=MAX_SEEDS).contains(&args.seeds),
         "--seeds must be between 1 and {MAX_SEEDS}, got {}",
@@ -95,29 +91,24 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
             n
         }
         // The default design never exceeds a small explicit budget.
-        None => match d {
-            2 => 5,
-            6 => 10,
-            _ => 2 * d,
-        }
-        .min(budget),
+        None => Benchmark::default_n_init(function, budget),
     };
-    let method = match args.method {
-        MethodArg::Bo => Method::Bo,
-        MethodArg::BoThesis => Method::BoThesis,
-        MethodArg::Random => Method::Random,
-    };
+    let method = args.method;
     let q = args.batch;
-    let mut summaries: Vec<SeedSummary> = Vec::new();
-    for seed in 0..args.seeds {
-        let trace = run_seed(function, seed, budget, n_init, q, method)
-            .with_context(|| format!("seed {seed}"))?;
-        let s = summarize(function, seed, &trace, q);
+    let benchmark = Benchmark {
+        function,
+        method,
+        seeds: args.seeds,
+        budget,
+        n_init,
+        batch: q,
+    };
+    let agg = benchmark.run(|seed, trace, s| -> anyhow::Result<()> {
         match args.format {
             FormatArg::Json => {
                 let line = json!({
                     "function": function.name(),
-                    "method": method_name(args.method),
+                    "method": method.name(),
                     "seed": seed,
                     "budget": budget,
                     "init": n_init,
@@ -155,9 +146,8 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                 )?;
             }
         }
-        summaries.push(s);
-    }
-    let agg = aggregate(&summaries, budget, q);
+        Ok(())
+    })?;
     match args.format {
         FormatArg::Json => {
             let levels: Vec<serde_json::Value> = agg
@@ -178,7 +168,7 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
                 json!({
                     "summary": {
                         "function": function.name(),
-                        "method": method_name(args.method),
+                        "method": method.name(),
                         "seeds": args.seeds,
                         "budget": budget,
                         "init": n_init,
@@ -205,15 +195,10 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
             outln!(
                 "summary {} ({}, budget {budget}, initial {n_init}, batch {q}): {}",
                 function.name(),
-                method_name(args.method),
+                method.name(),
                 parts.join("; ")
             )?;
         }
     }
     Ok(())
-}
-
-/// The method's name as typed (`bo`, `bo-thesis`, `random`).
-fn method_name(m: MethodArg) -> String {
-    clap::ValueEnum::to_possible_value(&m).map_or_else(String::new, |v| v.get_name().to_string())
 }

@@ -33,7 +33,7 @@ pub struct RecordArgs {
 }
 
 pub fn run(args: &RecordArgs) -> Result<ExitCode> {
-    let super::scan::Grid { ev, axes, .. } = grid(&args.sim, &args.axes, &args.steps)?;
+    let graspopt_trial::scan::Grid { ev, axes, .. } = grid(&args.sim, &args.axes, &args.steps)?;
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use graspopt_bus::BusArgs;
@@ -18,9 +18,8 @@ use tokio::sync::watch;
 
 use super::setup::SimArgs;
 use crate::out::outln;
-use graspopt_pictures::chart;
+use graspopt_protocol::named_params;
 use graspopt_runner::{Embedded, RunSettings, placeholder, run_embedded};
-use graspopt_watch::named_params;
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
@@ -116,85 +115,17 @@ impl RunArgs {
     }
 }
 
-/// Writes `trials.csv`, `trials.json` and the pictures ([`write_pictures`]) from the journal.
+/// Writes the run's results folder from its journal
+/// ([`graspopt_report::run::write_results`]).
 pub fn write_results(e: &Embedded, status: &RunStatus) -> Result<()> {
-    let journal = graspopt_journal::Journal::open(&e.coordinator.journal)?;
-    let csv = e.out.join("trials.csv");
-    let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
-    graspopt_journal::export::write_csv(&journal, e.run.as_str(), &mut f)?;
-    let json = e.out.join("trials.json");
-    let mut f = std::io::BufWriter::new(std::fs::File::create(&json)?);
-    graspopt_journal::export::write_json(&journal, e.run.as_str(), &mut f)?;
-    write_pictures(e, &status.object, &journal.export(e.run.as_str())?.trials)
-}
-
-/// The pictures of a run, from its trials: `best.png`, the best grasp drawn as `graspopt
-/// trial --preview` draws it (simulated again at its parameters, on the object's true pose);
-/// `trials.svg`, every trial on the parameter space (the first two parameters); `best.svg`,
-/// each trial's score and the best so far, in the order the trials completed. Trials that
-/// touched nothing are grey and never set a scale.
-fn write_pictures(e: &Embedded, object: &str, trials: &[graspopt_journal::TrialRow]) -> Result<()> {
-    let mut done: Vec<&graspopt_journal::TrialRow> =
-        trials.iter().filter(|t| t.score.is_some()).collect();
-    done.sort_by_key(|t| (t.completed_ms, t.trial_id));
-    // A trial that touched nothing scores below every grasp: `None` on the pictures.
-    let hit = |t: &graspopt_journal::TrialRow| t.score.filter(|_| t.contacts > 0);
-    let scores: Vec<Option<f64>> = done.iter().map(|t| hit(t)).collect();
-    let plot = chart::progress_plot(&format!("{object}: score by trial, best so far"), &scores);
-    std::fs::write(e.out.join("best.svg"), plot)?;
-
-    let names: Vec<String> = e
-        .spec
-        .params
-        .iter()
-        .map(|k| match k {
-            ParamKind::RotX | ParamKind::RotY | ParamKind::RotZ => format!("{} (rad)", k.name()),
-            _ => format!("{} offset (m)", k.name()),
-        })
-        .collect();
-    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
-    let shown = if names.len() > 2 {
-        format!(" (the first two of {} parameters)", names.len())
-    } else {
-        String::new()
+    let folder = graspopt_report::run::RunFolder {
+        out: &e.out,
+        journal: &e.coordinator.journal,
+        run: e.run.as_str(),
+        params: &e.spec.params,
+        evaluator: &e.evaluator,
     };
-    let points: Vec<(Vec<f64>, Option<f64>)> =
-        done.iter().map(|t| (t.params.clone(), hit(t))).collect();
-    let map = chart::trials_map(
-        &format!(
-            "{object}: {} trials on the parameter space{shown}",
-            done.len()
-        ),
-        &labels,
-        &e.evaluator.space.bounds(),
-        &points,
-    );
-    std::fs::write(e.out.join("trials.svg"), map)?;
-
-    let Some(best) = done.iter().max_by(|a, b| {
-        a.score
-            .unwrap_or(f64::NAN)
-            .total_cmp(&b.score.unwrap_or(f64::NAN))
-    }) else {
-        return Ok(());
-    };
-    let grasp = e
-        .evaluator
-        .evaluate(&best.params)
-        .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
-    let words = match (&best.metrics, best.score) {
-        (Some(m), Some(s)) if m.force_closure => format!("score {s:.4}, force closure"),
-        (Some(_), Some(s)) => format!("score {s:.4}"),
-        _ => "no contact".to_string(),
-    };
-    let short: Vec<String> = e.spec.params.iter().map(|k| k.name().to_string()).collect();
-    let title = format!(
-        "run {}, best trial {} at {}: {words}",
-        e.run,
-        best.trial_id,
-        named_params(&short, &best.params, ",")
-    );
-    super::trial::preview_image(&e.evaluator, &grasp, &title)?.save_png(&e.out.join("best.png"))
+    graspopt_report::run::write_results(&folder, &status.object)
 }
 
 /// `graspopt run`; `explicit(name)` says whether `--name` was given on the command line.

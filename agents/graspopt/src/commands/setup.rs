@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use clap::{Args, ValueEnum};
-use graspopt_sim::{ContactModel, Object, ParamKind, TrialSpace};
+use graspopt_sim::{ContactModel, Object, ParamKind};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
@@ -60,24 +60,6 @@ fn frame() -> impl TypedValueParser<Value = ReferenceFrame> {
         .try_map(|s| ReferenceFrame::parse(&s))
 }
 
-/// The clap copy of [`ContactModel`] that `experiment bo` still uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Contacts {
-    Surface,
-    Patch,
-    Mean,
-}
-
-impl From<Contacts> for ContactModel {
-    fn from(c: Contacts) -> Self {
-        match c {
-            Contacts::Surface => ContactModel::Surface,
-            Contacts::Patch => ContactModel::CircularPatch,
-            Contacts::Mean => ContactModel::MeanPoint,
-        }
-    }
-}
-
 impl SimArgs {
     /// The settings the flags name.
     pub fn settings(&self) -> TrialSettings {
@@ -102,14 +84,4 @@ impl SimArgs {
     pub fn evaluator(&self, kinds: &[ParamKind]) -> Result<Evaluator> {
         Ok(Evaluator::from_settings(&self.settings(), kinds)?)
     }
-}
-
-/// Parameter names users type (see [`ParamKind::parse`]).
-pub fn param_kind(name: &str) -> Result<ParamKind> {
-    Ok(ParamKind::parse(name)?)
-}
-
-/// The object's default trial space restricted to `kinds`, in that order.
-pub fn space_for(object: &Object, kinds: &[ParamKind]) -> Result<TrialSpace> {
-    Ok(TrialSpace::with_params(object, kinds)?)
 }

@@ -1,26 +1,16 @@
 //! `graspopt trial --object mug --hand barrett --at x=-0.08,y=0.01`: run one simulated
 //! trial and print its contacts and metrics (`--format json` for everything).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use graspopt_sim::{LinkShape, TriangleMesh};
-use graspopt_trial::{Evaluation, Evaluator};
-use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use graspopt_report::trial::{self as trial_report, has_extension};
+use graspopt_trial::Evaluation;
 use serde::Serialize;
 
-use super::setup::{SimArgs, param_kind};
+use super::setup::SimArgs;
 use crate::out::outln;
-use graspopt_pictures::preview;
-use graspopt_scene as scene;
-
-/// Size of `--preview` pictures (two views side by side).
-pub const PREVIEW_WIDTH: u32 = 1200;
-pub const PREVIEW_HEIGHT: u32 = 560;
-/// Colours of the object and of the hand's links (alternating) in previews.
-const OBJECT_COLOUR: [u8; 3] = [90, 140, 220];
-const LINK_COLOURS: [[u8; 3]; 2] = [[230, 150, 60], [200, 120, 40]];
 
 #[derive(Args, Debug)]
 pub struct TrialArgs {
@@ -141,7 +131,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         let (name, value) = part
             .split_once('=')
             .with_context(|| format!("--at: expected NAME=VALUE, got {part:?}"))?;
-        let kind = param_kind(name)?;
+        let kind = graspopt_sim::ParamKind::parse(name)?;
         if kinds.contains(&kind) {
             bail!("--at: {} given twice", kind.name());
         }
@@ -196,9 +186,15 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         } else {
             at.join(",")
         },
-        score_words(&e.score)
+        trial_report::score_words(&e.score)
     );
-    let written = write_pictures(args, &ev, &e, &title)?;
+    let written = trial_report::write_pictures(
+        args.scene.as_deref(),
+        args.preview.as_deref(),
+        &ev,
+        &e,
+        &title,
+    )?;
     match args.format {
         TrialFormat::Json => outln!("{}", serde_json::to_string_pretty(&TrialJson::of(&e))?)?,
         TrialFormat::Text => {
@@ -269,135 +265,6 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         }
     }
     Ok(std::process::ExitCode::SUCCESS)
-}
-
-/// A trial's score in words for a picture's title: `score 0.2412, force closure`, or
-/// `no contact`.
-pub fn score_words(s: &graspopt_trial::TrialScore) -> String {
-    match s.metrics {
-        None => "no contact".to_string(),
-        Some(m) if m.force_closure => format!("score {:.4}, force closure", s.score),
-        Some(_) => format!("score {:.4}", s.score),
-    }
-}
-
-/// The `--preview` picture of the evaluated trial `e` under `title`: the object (blue) and
-/// the hand's links (orange), two views (see [`preview::render`]).
-pub fn preview_image(ev: &Evaluator, e: &Evaluation, title: &str) -> Result<preview::Image> {
-    let meshes = graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
-    let contacts = e.outcome.contacts(ev.score.contacts, true);
-    let posts = knuckles(ev.hand.as_ref(), &e.outcome.grasp);
-    let mut coloured: Vec<_> = meshes
-        .iter()
-        .enumerate()
-        .map(|(k, m)| {
-            let c = if k == 0 {
-                OBJECT_COLOUR
-            } else {
-                LINK_COLOURS[k % 2]
-            };
-            (&m.mesh, c)
-        })
-        .collect();
-    // The posts in the palm's colour.
-    coloured.extend(posts.iter().map(|m| (m, LINK_COLOURS[1])));
-    Ok(preview::render(
-        &coloured,
-        &contacts,
-        (PREVIEW_WIDTH, PREVIEW_HEIGHT),
-        title,
-    ))
-}
-
-/// Posts between the palm and each finger's first joint where the hand's model leaves a gap
-/// (the Barrett's knuckle housings are not simulated), so that pictures show one hand: for
-/// each finger, a cylinder as wide as its first link, from that link's joint end (the
-/// middle of its lowest face, in its own frame) straight down to the palm's top face.
-fn knuckles(hand: &dyn graspopt_sim::Hand, grasp: &graspopt_sim::Grasp) -> Vec<TriangleMesh> {
-    let links = hand.links();
-    let Some(palm) = links.iter().position(|l| l.finger.is_none()) else {
-        return Vec::new();
-    };
-    let Some(palm_pose) = grasp.link_poses.get(palm) else {
-        return Vec::new();
-    };
-    let top = links[palm]
-        .shape
-        .mesh()
-        .vertices
-        .iter()
-        .map(|v| v.z)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let up = palm_pose.rotation * Vector3::z();
-    let top_centre = palm_pose * Point3::new(0.0, 0.0, top);
-    let mut posts = Vec::new();
-    let mut seen = Vec::new();
-    for (link, pose) in links.iter().zip(&grasp.link_poses) {
-        let Some(finger) = link.finger else { continue };
-        if seen.contains(&finger) {
-            continue;
-        }
-        seen.push(finger);
-        let mesh = link.shape.mesh();
-        let (mut lo, mut hi) = (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        );
-        for v in &mesh.vertices {
-            lo = lo.inf(&v.coords);
-            hi = hi.sup(&v.coords);
-        }
-        let joint = pose * Point3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, lo.z);
-        let gap = (joint - top_centre).dot(&up);
-        let radius = (hi.x - lo.x).min(hi.y - lo.y) / 2.0;
-        if !(gap > 1e-4 && radius.is_finite() && radius > 0.0) {
-            continue;
-        }
-        let centre = joint - up * (gap / 2.0);
-        let post = LinkShape::Cylinder {
-            radius,
-            half_height: gap / 2.0,
-        };
-        let at = Isometry3::from_parts(Translation3::from(centre.coords), palm_pose.rotation);
-        posts.push(post.mesh().transformed(&at));
-    }
-    posts
-}
-
-/// Writes `--scene` and `--preview` (if asked for); returns the paths written.
-fn write_pictures(
-    args: &TrialArgs,
-    ev: &Evaluator,
-    e: &Evaluation,
-    title: &str,
-) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    if let Some(path) = &args.scene {
-        let meshes =
-            graspopt_sim::scene::scene_meshes(&ev.object, ev.hand.as_ref(), &e.outcome.grasp)?;
-        let contacts = e.outcome.contacts(ev.score.contacts, true);
-        let (lo, hi) = ev.object.aabb();
-        let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
-        if has_extension(path, "gltf") {
-            scene::write_gltf(path, &meshes, &contacts, normal_length)?;
-            written.push(path.clone());
-        } else {
-            // `.obj`, checked by `check_outputs`.
-            scene::write_obj(path, &meshes, &contacts, normal_length)?;
-            written.push(path.clone());
-            written.push(scene::mtl_path(path));
-        }
-    }
-    if let Some(path) = &args.preview {
-        preview_image(ev, e, title)?.save_png(path)?;
-        written.push(path.clone());
-    }
-    Ok(written)
-}
-
-fn has_extension(path: &Path, ext: &str) -> bool {
-    path.extension()
-        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case(ext))
 }
 
 #[cfg(test)]

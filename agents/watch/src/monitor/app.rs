@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use graspopt_protocol::{RunPhase, RunStatus, describe_waits};
 
-use crate::named_params;
+use graspopt_protocol::named_params;
 
 /// What the monitor knows of one run.
 #[derive(Debug, Clone, Default)]

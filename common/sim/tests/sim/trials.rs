@@ -568,6 +568,43 @@ fn scene_meshes_and_json() {
 }
 
 #[test]
+fn knuckle_posts_join_the_barrett_palm_to_each_finger() {
+    let mug = Object::by_name("mug").unwrap();
+    let hand = BarrettHand::default();
+    let out = trial(&mug, &hand, &reference_pose(&mug));
+    let posts = scene::knuckle_posts(&hand, &out.grasp);
+    // One post per finger, each a closed cylinder standing on the palm's top face.
+    assert_eq!(posts.len(), 3);
+    let palm = hand
+        .links()
+        .iter()
+        .position(|l| l.finger.is_none())
+        .unwrap();
+    let palm_pose = out.grasp.link_poses[palm];
+    let top = hand.links()[palm]
+        .shape
+        .mesh()
+        .vertices
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    for (k, post) in posts.iter().enumerate() {
+        post.validate_closed(&format!("post {k}")).unwrap();
+        // In the palm's frame, the post's lowest point is on the palm's top face.
+        let lowest = post
+            .vertices
+            .iter()
+            .map(|v| (palm_pose.inverse() * v).z)
+            .fold(f64::INFINITY, f64::min);
+        assert!((lowest - top).abs() < 1e-9, "post {k}: {lowest} vs {top}");
+    }
+    // A grasp whose link poses do not match the hand has no palm pose: no posts.
+    let mut bare = out.grasp.clone();
+    bare.link_poses.clear();
+    assert!(scene::knuckle_posts(&hand, &bare).is_empty());
+}
+
+#[test]
 fn two_dimensional_space_covers_touching_and_empty_trials() {
     let sphere = Object::by_name("sphere").unwrap();
     let hand = BarrettHand::default();

@@ -2,6 +2,7 @@
 //! instead of one per file). A new file here needs a `mod` line below.
 
 mod contacts;
+mod grid;
 mod qualitative;
 mod scoring;
 mod settings;

@@ -1,0 +1,35 @@
+//! What a graspopt command leaves in its output folder: the CSV and images of a scan, the
+//! files of a run (trials.csv/json from the journal, best.png, trials.svg, best.svg), a
+//! trial's preview and scene, and the experiment reports (CSV, markdown, figures).
+//!
+//! This crate lays out what others compute: the trial crate (scans, evaluations), the
+//! experiment crate (the thesis studies as data) and the journal (a run's trials). Figures are
+//! drawn by `graspopt-pictures`, scenes written by `graspopt-scene`. It computes nothing of its
+//! own and knows nothing of the bus.
+//!
+//! - [`scan`]: `graspopt scan`'s CSV, SVG and PNG.
+//! - [`trial`]: `graspopt trial --preview/--scene`, and the preview picture of a trial.
+//! - [`run`]: the results folder of `graspopt run`.
+//! - [`experiment`]: the folders of `graspopt experiment metrics` and `experiment bo`.
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod experiment;
+pub mod run;
+pub mod scan;
+pub mod trial;
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+/// Writes `text` to `dir/name`; returns `name` (for a report's list of files).
+pub(crate) fn write(dir: &Path, name: &str, text: &str) -> Result<String> {
+    let path = dir.join(name);
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(name.to_string())
+}
+
+/// Creates `dir` and its parents.
+pub(crate) fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}

@@ -1,0 +1,106 @@
+//! The results folder of a run, from its journal: `trials.csv`, `trials.json`, and the
+//! pictures `best.png`, `trials.svg` and `best.svg`.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use graspopt_journal::{Journal, TrialRow};
+use graspopt_pictures::chart;
+use graspopt_protocol::named_params;
+use graspopt_sim::ParamKind;
+use graspopt_trial::Evaluator;
+
+/// What the results of a run are written from.
+pub struct RunFolder<'a> {
+    /// The folder written to.
+    pub out: &'a Path,
+    /// The run's journal (SQLite).
+    pub journal: &'a Path,
+    /// The run's id.
+    pub run: &'a str,
+    /// The run's trial parameters, in order.
+    pub params: &'a [ParamKind],
+    /// The trials as simulated here (to draw the best one).
+    pub evaluator: &'a Evaluator,
+}
+
+/// Writes `trials.csv`, `trials.json` and the pictures ([`write_pictures`]) of the run on
+/// `object` from its journal.
+pub fn write_results(folder: &RunFolder, object: &str) -> Result<()> {
+    let journal = Journal::open(folder.journal)?;
+    let csv = folder.out.join("trials.csv");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
+    graspopt_journal::export::write_csv(&journal, folder.run, &mut f)?;
+    let json = folder.out.join("trials.json");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&json)?);
+    graspopt_journal::export::write_json(&journal, folder.run, &mut f)?;
+    write_pictures(folder, object, &journal.export(folder.run)?.trials)
+}
+
+/// The pictures of a run, from its trials: `best.png`, the best grasp drawn as `graspopt
+/// trial --preview` draws it (simulated again at its parameters, on the object's true pose);
+/// `trials.svg`, every trial on the parameter space (the first two parameters); `best.svg`,
+/// each trial's score and the best so far, in the order the trials completed. Trials that
+/// touched nothing are grey and never set a scale.
+pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> Result<()> {
+    let mut done: Vec<&TrialRow> = trials.iter().filter(|t| t.score.is_some()).collect();
+    done.sort_by_key(|t| (t.completed_ms, t.trial_id));
+    // A trial that touched nothing scores below every grasp: `None` on the pictures.
+    let hit = |t: &TrialRow| t.score.filter(|_| t.contacts > 0);
+    let scores: Vec<Option<f64>> = done.iter().map(|t| hit(t)).collect();
+    let plot = chart::progress_plot(&format!("{object}: score by trial, best so far"), &scores);
+    std::fs::write(folder.out.join("best.svg"), plot)?;
+
+    let names: Vec<String> = folder
+        .params
+        .iter()
+        .map(|k| match k {
+            ParamKind::RotX | ParamKind::RotY | ParamKind::RotZ => format!("{} (rad)", k.name()),
+            _ => format!("{} offset (m)", k.name()),
+        })
+        .collect();
+    let labels: Vec<&str> = names.iter().map(String::as_str).collect();
+    let shown = if names.len() > 2 {
+        format!(" (the first two of {} parameters)", names.len())
+    } else {
+        String::new()
+    };
+    let points: Vec<(Vec<f64>, Option<f64>)> =
+        done.iter().map(|t| (t.params.clone(), hit(t))).collect();
+    let map = chart::trials_map(
+        &format!(
+            "{object}: {} trials on the parameter space{shown}",
+            done.len()
+        ),
+        &labels,
+        &folder.evaluator.space.bounds(),
+        &points,
+    );
+    std::fs::write(folder.out.join("trials.svg"), map)?;
+
+    let Some(best) = done.iter().max_by(|a, b| {
+        a.score
+            .unwrap_or(f64::NAN)
+            .total_cmp(&b.score.unwrap_or(f64::NAN))
+    }) else {
+        return Ok(());
+    };
+    let grasp = folder
+        .evaluator
+        .evaluate(&best.params)
+        .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
+    let words = match (&best.metrics, best.score) {
+        (Some(m), Some(s)) if m.force_closure => format!("score {s:.4}, force closure"),
+        (Some(_), Some(s)) => format!("score {s:.4}"),
+        _ => "no contact".to_string(),
+    };
+    let short: Vec<String> = folder.params.iter().map(|k| k.name().to_string()).collect();
+    let title = format!(
+        "run {}, best trial {} at {}: {words}",
+        folder.run,
+        best.trial_id,
+        named_params(&short, &best.params, ",")
+    );
+    crate::trial::preview_image(folder.evaluator, &grasp, &title)?
+        .save_png(&folder.out.join("best.png"))
+}

@@ -1,0 +1,92 @@
+//! The settings of a simulated trial as a user states them: which object (built-in or a mesh
+//! file), hand, contact model, metric, reference frame and torque scale. The CLI builds them
+//! from its flags; [`Evaluator::from_settings`] turns them into an evaluator.
+
+use std::path::{Path, PathBuf};
+
+use graspopt_sim::hand::hand_by_name;
+use graspopt_sim::{ContactModel, Object, ParamKind, TrialSpace};
+use serde::{Deserialize, Serialize};
+
+use crate::error::TrialError;
+use crate::evaluator::Evaluator;
+use crate::score::{Metric, ReferenceFrame};
+
+/// Which object, hand and scoring choices a trial uses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialSettings {
+    /// A built-in object's name (used when `mesh` is None).
+    pub object: String,
+    /// A closed mesh (OBJ or STL) instead of a built-in object.
+    pub mesh: Option<PathBuf>,
+    /// Factor from the mesh file's units to metres.
+    pub mesh_scale: f64,
+    /// A built-in hand's name or a URDF file.
+    pub hand: String,
+    pub contacts: ContactModel,
+    pub metric: Metric,
+    pub frame: ReferenceFrame,
+    /// Torque scale in metres (None: the object's bounding radius).
+    pub torque_scale: Option<f64>,
+}
+
+impl Default for TrialSettings {
+    /// The mug, the Barrett hand and the default scoring (surface contacts, BW, object frame).
+    fn default() -> Self {
+        let score = crate::score::ScoreSettings::default();
+        Self {
+            object: "mug".into(),
+            mesh: None,
+            mesh_scale: 1.0,
+            hand: "barrett".into(),
+            contacts: score.contacts,
+            metric: score.metric,
+            frame: score.frame,
+            torque_scale: None,
+        }
+    }
+}
+
+impl TrialSettings {
+    /// The object named by the settings.
+    pub fn object(&self) -> Result<Object, TrialError> {
+        load_object(&self.object, self.mesh.as_deref(), self.mesh_scale)
+    }
+}
+
+/// The built-in object `name`, or the mesh file `mesh` (scaled by `scale` to metres) if given.
+pub fn load_object(name: &str, mesh: Option<&Path>, scale: f64) -> Result<Object, TrialError> {
+    match mesh {
+        Some(path) => Object::from_file_scaled(path, scale).map_err(|source| TrialError::Mesh {
+            path: path.to_path_buf(),
+            source: Box::new(source),
+        }),
+        None => Ok(Object::by_name(name)?),
+    }
+}
+
+impl Evaluator {
+    /// The evaluator of `settings` over the parameters `kinds` (each with its full default
+    /// bounds, in that order).
+    pub fn from_settings(
+        settings: &TrialSettings,
+        kinds: &[ParamKind],
+    ) -> Result<Self, TrialError> {
+        let object = settings.object()?;
+        let space = TrialSpace::with_params(&object, kinds)?;
+        let hand = hand_by_name(&settings.hand)?;
+        let mut ev = Evaluator::new(object, hand, space);
+        ev.score.contacts = settings.contacts;
+        ev.score.metric = settings.metric;
+        ev.score.frame = settings.frame;
+        if let Some(rho) = settings.torque_scale {
+            if !(rho.is_finite() && rho > 0.0) {
+                return Err(TrialError::Settings(format!(
+                    "the torque scale must be a positive length in metres, got {rho}"
+                )));
+            }
+            ev.score.torque_scale = Some(rho);
+        }
+        Ok(ev)
+    }
+}
