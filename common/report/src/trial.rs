@@ -58,6 +58,38 @@ pub fn has_extension(path: &Path, ext: &str) -> bool {
         .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case(ext))
 }
 
+/// Extensions a scene is written in (glTF 2.0 JSON, Wavefront OBJ).
+pub const SCENE_EXTENSIONS: [&str; 2] = ["gltf", "obj"];
+
+/// Refuses, before any work, a `scene` file whose extension is not one of
+/// [`SCENE_EXTENSIONS`] and a `preview` that is not a `.png`.
+pub fn check_outputs(scene: Option<&Path>, preview: Option<&Path>) -> Result<()> {
+    if let Some(path) = scene
+        && !SCENE_EXTENSIONS.iter().any(|e| has_extension(path, e))
+    {
+        let note = if has_extension(path, "glb") {
+            " (binary glTF is not supported)"
+        } else {
+            ""
+        };
+        anyhow::bail!(
+            "--scene {}: unsupported file type{note}; the supported extensions are .gltf (glTF 2.0) \
+             and .obj (Wavefront OBJ with an MTL)",
+            path.display()
+        );
+    }
+    if let Some(path) = preview
+        && !has_extension(path, "png")
+    {
+        anyhow::bail!(
+            "--preview {}: unsupported file type; previews are PNG pictures, the supported \
+             extension is .png",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Writes the scene of the trial `e` to `scene` (glTF 2.0 if it ends in `.gltf`, else OBJ with
 /// its MTL beside it) and its preview under `title` to `preview` (PNG), each if given; returns
 /// the paths written.

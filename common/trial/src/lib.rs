@@ -9,6 +9,7 @@
 //! - [`score`]: settings and scoring of one trial outcome.
 //! - [`evaluator`]: an object, a hand and a trial space: parameters in, score out.
 //! - [`measured`]: scoring clouds a hand measured (the metric agent's side).
+//! - [`point`]: a trial point as users write it (`x=-0.08,y=0.01`), checked against a space.
 //! - [`scan`]: 1D/2D (any-D) grid scans over the trial space, in parallel, and their grids.
 //! - [`settings`]: a trial's settings as a user states them ([`Evaluator::from_settings`]).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -16,12 +17,14 @@
 pub mod error;
 pub mod evaluator;
 pub mod measured;
+pub mod point;
 pub mod scan;
 pub mod score;
 pub mod settings;
 
 pub use error::TrialError;
 pub use evaluator::{Evaluation, Evaluator};
+pub use point::NamedPoint;
 pub use scan::{ScanPoint, scan_grid};
 pub use score::{Metric, ReferenceFrame, ScoreSettings, TrialScore, score_outcome};
 pub use settings::TrialSettings;

@@ -84,6 +84,17 @@ pub fn grid_steps(text: &str, axes: usize) -> Result<Vec<usize>, TrialError> {
 }
 
 /// Points of a grid with `steps[k]` points on axis `k`; errors (naming `--steps`) when the
+/// The grid point of flat index `index` (the first axis varies slowest), as [`scan_grid`]
+/// visits them. `index` must be below the product of the axes' lengths.
+pub fn grid_point(axes: &[Vec<f64>], mut index: usize) -> Vec<f64> {
+    let mut params = vec![0.0; axes.len()];
+    for (k, axis) in axes.iter().enumerate().rev() {
+        params[k] = axis[index % axis.len()];
+        index /= axis.len();
+    }
+    params
+}
+
 /// product does not fit in a `usize`.
 pub fn grid_points(steps: &[usize]) -> Result<usize, TrialError> {
     steps
@@ -153,14 +164,7 @@ pub fn scan_grid(
         )));
     }
     let total: usize = axes.iter().map(Vec::len).product();
-    let point = |mut index: usize| -> Vec<f64> {
-        let mut params = vec![0.0; axes.len()];
-        for (k, axis) in axes.iter().enumerate().rev() {
-            params[k] = axis[index % axis.len()];
-            index /= axis.len();
-        }
-        params
-    };
+    let point = |index: usize| grid_point(axes, index);
     let threads = worker_count(threads, total);
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);

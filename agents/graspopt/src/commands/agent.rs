@@ -155,9 +155,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             seed,
         } => {
             let mut c: graspopt_perception::PerceptionConfig = load(common.config.as_deref())?;
-            if let Some(v) = &common.id {
-                c.id = v.clone();
-            }
+            common.set_id(&mut c.id);
             if let Some(v) = object {
                 c.object = v.clone();
             }
@@ -179,9 +177,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             replay,
         } => {
             let mut c: graspopt_hand::HandConfig = load(common.config.as_deref())?;
-            if let Some(v) = &common.id {
-                c.id = v.clone();
-            }
+            common.set_id(&mut c.id);
             if let Some(v) = hand {
                 c.hand = v.clone();
             }
@@ -195,18 +191,14 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
         }
         Kind::Metric { common } => {
             let mut c: graspopt_metric::MetricConfig = load(common.config.as_deref())?;
-            if let Some(v) = &common.id {
-                c.id = v.clone();
-            }
+            common.set_id(&mut c.id);
             let (bus, run) = join(common).await?;
             until_signal(graspopt_metric::run(&bus, &run, &c)).await?;
             Ok(ExitCode::SUCCESS)
         }
         Kind::Planner { common } => {
             let mut c: graspopt_planner::PlannerConfig = load(common.config.as_deref())?;
-            if let Some(v) = &common.id {
-                c.id = v.clone();
-            }
+            common.set_id(&mut c.id);
             let (bus, run) = join(common).await?;
             until_signal(graspopt_planner::run(&bus, &run, &c)).await?;
             Ok(ExitCode::SUCCESS)
@@ -224,9 +216,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             resume,
         } => {
             let mut c: CoordinatorConfig = load(common.config.as_deref())?;
-            if let Some(v) = &common.id {
-                c.id = v.clone();
-            }
+            common.set_id(&mut c.id);
             if let Some(v) = journal {
                 c.journal = v.clone();
             }
@@ -262,6 +252,15 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             } else {
                 ExitCode::from(130)
             })
+        }
+    }
+}
+
+impl Common {
+    /// `--id`, when given, over the settings file's id.
+    fn set_id(&self, id: &mut String) {
+        if let Some(v) = &self.id {
+            id.clone_from(v);
         }
     }
 }

@@ -65,13 +65,11 @@ fn describe(hand: &dyn Hand) -> String {
         let finger = l
             .finger
             .map_or("palm".to_string(), |f| format!("finger {}", f + 1));
-        let shape = match &l.shape {
-            graspopt_sim::LinkShape::Box { .. } => "box",
-            graspopt_sim::LinkShape::Cylinder { .. } => "cylinder",
-            graspopt_sim::LinkShape::Sphere { .. } => "sphere",
-            graspopt_sim::LinkShape::Mesh { .. } => "mesh",
-        };
-        out.push_str(&format!("  {:<16} {finger:<9} {shape}\n", l.name));
+        out.push_str(&format!(
+            "  {:<16} {finger:<9} {}\n",
+            l.name,
+            l.shape.kind()
+        ));
     }
     out
 }

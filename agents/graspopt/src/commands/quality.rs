@@ -129,15 +129,11 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
 
 type Row = std::result::Result<(Metrics, Option<f64>), String>;
 
-/// One JSON output row, keys in the documented order.
+/// One JSON output row: the metrics in their documented order, then `micros`.
 #[derive(Serialize)]
 struct JsonRow {
-    rank: usize,
-    force_closure: bool,
-    epsilon: f64,
-    volume: Option<f64>,
-    distance: f64,
-    bw: f64,
+    #[serde(flatten)]
+    metrics: Metrics,
     #[serde(skip_serializing_if = "Option::is_none")]
     micros: Option<f64>,
 }
@@ -170,12 +166,7 @@ fn printable(m: Metrics) -> Result<Metrics> {
 fn json_row(row: &Row) -> String {
     match row {
         Ok((m, micros)) => serde_json::to_string(&JsonRow {
-            rank: m.rank,
-            force_closure: m.force_closure,
-            epsilon: m.epsilon,
-            volume: m.volume,
-            distance: m.distance,
-            bw: m.bw,
+            metrics: *m,
             micros: *micros,
         })
         .unwrap_or_else(|e| json!({ "error": e.to_string() }).to_string()),

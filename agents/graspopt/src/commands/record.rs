@@ -49,12 +49,7 @@ pub fn run(args: &RecordArgs) -> Result<ExitCode> {
     // Every grid point, the first axis varying slowest.
     let total: usize = axes.iter().map(Vec::len).product();
     for flat in 0..total {
-        let mut rest = flat;
-        let mut params = vec![0.0; axes.len()];
-        for (i, axis) in axes.iter().enumerate().rev() {
-            params[i] = axis[rest % axis.len()];
-            rest /= axis.len();
-        }
+        let params = graspopt_trial::scan::grid_point(&axes, flat);
         let e = ev
             .evaluate(&params)
             .with_context(|| format!("grasp at {params:?}"))?;

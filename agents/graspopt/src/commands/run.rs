@@ -11,7 +11,7 @@ use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use graspopt_bus::BusArgs;
-use graspopt_protocol::{PlannerMethod, RunPhase, RunStatus};
+use graspopt_protocol::{PlannerMethod, RunPhase};
 use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
@@ -19,7 +19,7 @@ use tokio::sync::watch;
 use super::setup::SimArgs;
 use crate::out::outln;
 use graspopt_protocol::named_params;
-use graspopt_runner::{Embedded, RunSettings, placeholder, run_embedded};
+use graspopt_runner::{RunSettings, placeholder, run_embedded};
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
@@ -115,19 +115,6 @@ impl RunArgs {
     }
 }
 
-/// Writes the run's results folder from its journal
-/// ([`graspopt_report::run::write_results`]).
-pub fn write_results(e: &Embedded, status: &RunStatus) -> Result<()> {
-    let folder = graspopt_report::run::RunFolder {
-        out: &e.out,
-        journal: &e.coordinator.journal,
-        run: e.run.as_str(),
-        params: &e.spec.params,
-        evaluator: &e.evaluator,
-    };
-    graspopt_report::run::write_results(&folder, &status.object)
-}
-
 /// `graspopt run`; `explicit(name)` says whether `--name` was given on the command line.
 pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> {
     let e = args.settings().resolve(explicit)?;
@@ -177,7 +164,14 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
         s
     })?;
     bar.finish_and_clear();
-    write_results(&e, &status)?;
+    let folder = graspopt_report::run::RunFolder {
+        out: &e.out,
+        journal: &e.coordinator.journal,
+        run: e.run.as_str(),
+        params: &e.spec.params,
+        evaluator: &e.evaluator,
+    };
+    graspopt_report::run::write_results(&folder, &status.object)?;
     let stopped = status.phase != RunPhase::Finished;
     outln!(
         "run {:?}: {} trials completed, {} failed{}",

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use graspopt_report::trial::{self as trial_report, has_extension};
-use graspopt_trial::Evaluation;
+use graspopt_report::trial as trial_report;
+use graspopt_trial::{Evaluation, NamedPoint};
 use serde::Serialize;
 
 use super::setup::SimArgs;
@@ -60,121 +60,18 @@ impl<'a> TrialJson<'a> {
     }
 }
 
-/// Extensions `--scene` writes (glTF 2.0 JSON, Wavefront OBJ).
-const SCENE_EXTENSIONS: [&str; 2] = ["gltf", "obj"];
-
-/// A value for a message: as given when that is short, else `1.0000e300`.
-fn compact(v: f64) -> String {
-    let plain = format!("{v}");
-    if plain.len() <= 12 {
-        plain
-    } else {
-        format!("{v:.4e}")
-    }
-}
-
-/// A bound for a message: at most 4 decimals (`-0.7854`), or `1.0000e-6` when tiny or huge.
-fn compact_bound(v: f64) -> String {
-    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" { "0".into() } else { s.into() }
-    } else {
-        format!("{v:.4e}")
-    }
-}
-
-/// A parameter as the user named it, with its full name when that differs: `x (approach)`.
-fn described(name: &str, kind: graspopt_sim::ParamKind) -> String {
-    let full = kind.name();
-    if name == full {
-        name.to_string()
-    } else {
-        format!("{name} ({full})")
-    }
-}
-
-/// Checks the extensions of `--scene` and `--preview` before any work.
-fn check_outputs(args: &TrialArgs) -> Result<()> {
-    if let Some(path) = &args.scene
-        && !SCENE_EXTENSIONS.iter().any(|e| has_extension(path, e))
-    {
-        let note = if has_extension(path, "glb") {
-            " (binary glTF is not supported)"
-        } else {
-            ""
-        };
-        bail!(
-            "--scene {}: unsupported file type{note}; the supported extensions are .gltf (glTF 2.0) \
-             and .obj (Wavefront OBJ with an MTL)",
-            path.display()
-        );
-    }
-    if let Some(path) = &args.preview
-        && !has_extension(path, "png")
-    {
-        bail!(
-            "--preview {}: unsupported file type; previews are PNG pictures, the supported \
-             extension is .png",
-            path.display()
-        );
-    }
-    Ok(())
-}
-
 pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
-    check_outputs(args)?;
-    let mut names = Vec::new();
-    let mut kinds = Vec::new();
-    let mut values = Vec::new();
-    for part in args.at.split(',').filter(|p| !p.trim().is_empty()) {
-        let (name, value) = part
-            .split_once('=')
-            .with_context(|| format!("--at: expected NAME=VALUE, got {part:?}"))?;
-        let kind = graspopt_sim::ParamKind::parse(name)?;
-        if kinds.contains(&kind) {
-            bail!("--at: {} given twice", kind.name());
-        }
-        let value: f64 = value
-            .trim()
-            .parse()
-            .with_context(|| format!("--at: {name} is not a number: {value:?}"))?;
-        if !value.is_finite() {
-            bail!(
-                "--at: {} = {value} is not a finite number",
-                described(name.trim(), kind)
-            );
-        }
-        names.push(name.trim());
-        kinds.push(kind);
-        values.push(value);
-    }
-    let ev = args.sim.evaluator(&kinds)?;
-    for (((name, kind), value), (lo, hi)) in
-        names.iter().zip(&kinds).zip(&values).zip(ev.space.bounds())
-    {
-        // The simulator's own slack, so exact bounds pass.
-        if *value < lo - 1e-9 || *value > hi + 1e-9 {
-            let unit = match kind {
-                graspopt_sim::ParamKind::RotX
-                | graspopt_sim::ParamKind::RotY
-                | graspopt_sim::ParamKind::RotZ => "rad",
-                _ => "m",
-            };
-            bail!(
-                "--at: {} = {} is outside [{}, {}] {unit} for the {}",
-                described(name, *kind),
-                compact(*value),
-                compact_bound(lo),
-                compact_bound(hi),
-                ev.object.name()
-            );
-        }
-    }
-    let e = ev.evaluate(&values)?;
+    trial_report::check_outputs(args.scene.as_deref(), args.preview.as_deref())?;
+    let point = NamedPoint::parse(&args.at).context("--at")?;
+    let ev = args.sim.evaluator(&point.kinds)?;
+    point
+        .check_within(&ev.space, ev.object.name())
+        .context("--at")?;
+    let (kinds, values) = (&point.kinds, &point.values);
+    let e = ev.evaluate(values)?;
     let at: Vec<String> = kinds
         .iter()
-        .zip(&values)
+        .zip(values)
         .map(|(k, v)| format!("{}={v}", k.name()))
         .collect();
     let title = format!(
@@ -205,7 +102,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                 ev.score.contacts,
                 args.sim.metric
             )?;
-            for (k, v) in kinds.iter().zip(&values) {
+            for (k, v) in kinds.iter().zip(values) {
                 outln!("  {} = {v}", k.name())?;
             }
             let t = e.outcome.grasp.palm_pose.translation.vector;
@@ -265,20 +162,4 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         }
     }
     Ok(std::process::ExitCode::SUCCESS)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn numbers_in_messages_stay_short() {
-        assert_eq!(compact(1e300), "1.0000e300");
-        assert_eq!(compact(-0.08), "-0.08");
-        assert_eq!(compact(0.020_000_1), "0.0200001");
-        assert_eq!(compact_bound(-std::f64::consts::FRAC_PI_4), "-0.7854");
-        assert_eq!(compact_bound(0.02), "0.02");
-        assert_eq!(compact_bound(0.0), "0");
-        assert_eq!(compact_bound(1e-7), "1.0000e-7");
-    }
 }

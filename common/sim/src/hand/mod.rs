@@ -82,6 +82,18 @@ pub enum LinkShape {
 }
 
 impl LinkShape {
+    /// The shape's kind: `box`, `cylinder`, `sphere` or `mesh`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            LinkShape::Box { .. } => "box",
+            LinkShape::Cylinder { .. } => "cylinder",
+            LinkShape::Sphere { .. } => "sphere",
+            LinkShape::Mesh { .. } => "mesh",
+        }
+    }
+}
+
+impl LinkShape {
     /// A triangle mesh of the shape in the link frame.
     pub fn mesh(&self) -> TriangleMesh {
         match self {
