@@ -48,14 +48,7 @@ pub const MAX_STEPS: usize = 1000;
 /// The parameters of the 2D part: approach x vertical.
 pub const TWO_D: [ParamKind; 2] = [ParamKind::Approach, ParamKind::Vertical];
 /// The parameters of the 6D part: three offsets and a rotation vector.
-pub const SIX_D: [ParamKind; 6] = [
-    ParamKind::Approach,
-    ParamKind::Lateral,
-    ParamKind::Vertical,
-    ParamKind::RotX,
-    ParamKind::RotY,
-    ParamKind::RotZ,
-];
+pub const SIX_D: [ParamKind; 6] = ParamKind::ALL;
 
 /// A part of the study.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
