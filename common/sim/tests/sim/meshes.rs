@@ -2,9 +2,13 @@
 //! rounded apart, binary STL with a `solid` header, meshes in millimetres, and meshes with
 //! holes (a precise message, the same every time).
 
+use graspopt_sim::hand::BarrettHand;
 use graspopt_sim::mesh::{self, TriangleMesh};
+use graspopt_sim::pose::reference_pose;
 use graspopt_sim::{Object, SimError};
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use crate::trials::trial;
 
 /// A binary STL of `mesh` in float32; `nudge(t, c)` is added to the bits of each coordinate
 /// of corner `c` of triangle `t` (a CAD exporter that writes each face apart rounds shared
@@ -143,4 +147,94 @@ fn a_mesh_with_holes_gets_the_same_precise_message_every_time() {
     for _ in 0..8 {
         assert_eq!(Object::from_file(&path).unwrap_err().to_string(), first);
     }
+}
+
+/// A scratch folder, deleted when dropped.
+fn temp_dir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("graspopt-sim-{tag}-"))
+        .tempdir()
+        .unwrap()
+}
+
+#[test]
+fn obj_and_stl_meshes_load_and_can_be_grasped() {
+    let scratch = temp_dir("meshes");
+    let dir = scratch.path().to_path_buf();
+    // A 4 cm cube standing on z = 0, as OBJ with quads (1-based indices, one `v/vt/vn` face).
+    let obj = "# cube\nv -0.02 -0.02 0\nv 0.02 -0.02 0\nv 0.02 0.02 0\nv -0.02 0.02 0\n\
+               v -0.02 -0.02 0.04\nv 0.02 -0.02 0.04\nv 0.02 0.02 0.04\nv -0.02 0.02 0.04\n\
+               f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2/1/1 3/1/1 7/1/1 6/1/1\nf 3 4 8 7\nf 4 1 5 8\n";
+    let obj_path = dir.join("cube.obj");
+    std::fs::write(&obj_path, obj).unwrap();
+    // The same cube as binary and ASCII STL (triangles from the generator, each corner repeated).
+    let cube = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02))
+        .transformed(&Isometry3::translation(0.0, 0.0, 0.02));
+    let mut bin = vec![0u8; 80];
+    bin.extend_from_slice(&(cube.triangles.len() as u32).to_le_bytes());
+    let mut ascii = String::from("solid cube\n");
+    for t in &cube.triangles {
+        bin.extend_from_slice(&[0u8; 12]);
+        ascii.push_str(" facet normal 0 0 0\n  outer loop\n");
+        for &i in t {
+            let v = cube.vertices[i as usize];
+            for c in [v.x, v.y, v.z] {
+                bin.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+            ascii.push_str(&format!("   vertex {} {} {}\n", v.x, v.y, v.z));
+        }
+        bin.extend_from_slice(&[0u8; 2]);
+        ascii.push_str("  endloop\n endfacet\n");
+    }
+    ascii.push_str("endsolid cube\n");
+    let bin_path = dir.join("cube_bin.stl");
+    let ascii_path = dir.join("cube_ascii.STL");
+    std::fs::write(&bin_path, &bin).unwrap();
+    std::fs::write(&ascii_path, &ascii).unwrap();
+
+    let hand = BarrettHand::default();
+    for path in [&obj_path, &bin_path, &ascii_path] {
+        let o = Object::from_file(path).unwrap();
+        let (lo, hi) = o.aabb();
+        assert!(
+            (lo - Point3::new(-0.02, -0.02, 0.0)).norm() < 1e-6,
+            "{path:?}: {lo:?}"
+        );
+        assert!(
+            (hi - Point3::new(0.02, 0.02, 0.04)).norm() < 1e-6,
+            "{path:?}: {hi:?}"
+        );
+        assert!((o.centre_of_mass() - Point3::new(0.0, 0.0, 0.02)).norm() < 1e-6);
+        let out = trial(&o, &hand, &reference_pose(&o));
+        assert!(out.fingers_in_contact() >= 2, "{path:?}");
+    }
+    // Errors: unknown extension, missing file, garbage, an open mesh.
+    let txt = dir.join("cube.txt");
+    std::fs::write(&txt, obj).unwrap();
+    assert!(matches!(
+        Object::from_file(&txt).unwrap_err(),
+        SimError::UnsupportedFormat { .. }
+    ));
+    assert!(matches!(
+        Object::from_file(&dir.join("missing.obj")).unwrap_err(),
+        SimError::Io { .. }
+    ));
+    let junk = dir.join("junk.stl");
+    std::fs::write(&junk, b"not a mesh").unwrap();
+    assert!(matches!(
+        Object::from_file(&junk).unwrap_err(),
+        SimError::MeshParse { .. }
+    ));
+    let holey = dir.join("holey.obj");
+    std::fs::write(&holey, obj.replace("f 5 6 7 8\n", "")).unwrap();
+    assert!(matches!(
+        Object::from_file(&holey).unwrap_err(),
+        SimError::NotWatertight { .. }
+    ));
+    let empty = dir.join("empty.obj");
+    std::fs::write(&empty, "# nothing\n").unwrap();
+    assert!(matches!(
+        Object::from_file(&empty).unwrap_err(),
+        SimError::EmptyMesh { .. }
+    ));
 }
