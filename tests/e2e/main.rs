@@ -18,6 +18,7 @@ mod pipeline;
 mod reliability;
 mod replay;
 mod resume;
+mod scratch;
 mod security;
 mod support;
 mod topic;

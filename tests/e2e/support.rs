@@ -31,13 +31,7 @@ pub fn graspopt(args: &[&str]) -> Output {
         .expect("run graspopt")
 }
 
-/// A fresh, empty scratch folder unique to this test process and `name`.
-pub fn tempdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("graspopt-e2e-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+pub use crate::scratch::{Scratch, tempdir};
 
 /// A free TCP port on 127.0.0.1.
 pub fn free_port() -> u16 {
@@ -145,7 +139,7 @@ pub fn wait_for_port(port: u16, timeout: Duration) {
 
 /// A router on a free loopback port and the flags every agent of one run needs to join it.
 pub struct Cluster {
-    pub dir: PathBuf,
+    pub dir: Scratch,
     /// The router's endpoint, `tcp/127.0.0.1:<port>`.
     pub endpoint: String,
     pub run: String,

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::support::tempdir;
+
 /// Runs the `graspopt` binary built for these tests.
 fn graspopt(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_graspopt"))
@@ -34,15 +36,6 @@ fn graspopt_within(args: &[&str], limit: Duration) -> Option<Output> {
         }
         std::thread::sleep(Duration::from_millis(50));
     }
-}
-
-/// A fresh scratch folder, unique per test process and `name`.
-fn tempdir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("graspopt-bad-input-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Asserts `out` is a refusal (exit 1, no panic) whose message holds every one of `expected`.

@@ -8,5 +8,7 @@ mod quality_cli;
 mod render_cli;
 mod run_pictures_cli;
 mod scene_cli;
+#[path = "../../../../tests/e2e/scratch.rs"]
+mod scratch;
 mod sim_cli;
 mod support;

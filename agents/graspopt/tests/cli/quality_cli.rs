@@ -5,6 +5,7 @@ use std::process::Output;
 
 use serde_json::Value;
 
+use crate::scratch::Scratch;
 use crate::support::{graspopt, tempdir};
 
 fn reference_file() -> PathBuf {
@@ -206,10 +207,12 @@ fn unreadable_input_is_a_clear_error() {
 }
 
 /// Writes `cases` (JSON objects) as a quality input file in a fresh folder.
-fn case_file(name: &str, cases: &[&str]) -> PathBuf {
-    let file = tempdir(name).join("cases.json");
+/// (The folder is deleted when the first value is dropped.)
+fn case_file(name: &str, cases: &[&str]) -> (Scratch, PathBuf) {
+    let dir = tempdir(name);
+    let file = dir.join("cases.json");
     std::fs::write(&file, format!("{{\"cases\": [{}]}}", cases.join(","))).unwrap();
-    file
+    (dir, file)
 }
 
 /// Runs `graspopt quality` on `file` with extra arguments: exit code, JSON rows, stderr.
@@ -250,7 +253,7 @@ fn huge_counts_and_magnitudes_are_errors_with_both_solvers() {
     let good = format!(
         r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 8}}, "contacts": {TRIANGLE}}}"#
     );
-    let file = case_file(
+    let (_dir, file) = case_file(
         "huge",
         &[
             &edges,
@@ -291,7 +294,7 @@ fn huge_counts_and_magnitudes_are_errors_with_both_solvers() {
 #[test]
 fn unknown_fields_are_errors_and_descriptive_keys_are_accepted() {
     let contact = r#"{"position": [1,0,0], "normal": [-1,0,0]}"#;
-    let file = case_file(
+    let (_dir, file) = case_file(
         "unknown",
         &[
             &format!(
@@ -337,7 +340,7 @@ fn unknown_fields_are_errors_and_descriptive_keys_are_accepted() {
 
 #[test]
 fn zero_is_printed_without_a_sign_and_solvers_agree_at_large_scale() {
-    let file = case_file(
+    let (_dir, file) = case_file(
         "zero",
         &[
             // Antipodal frictionless contacts: the origin is on the hull, bw = 0.
@@ -394,7 +397,7 @@ fn a_hull_too_large_for_memory_is_refused_with_a_hint() {
     let case = format!(
         r#"{{"params": {{"model": "point_friction", "mu": 0.5, "edges": 256}}, "contacts": {TRIANGLE}}}"#
     );
-    let file = case_file("dense", &[&case]);
+    let (_dir, file) = case_file("dense", &[&case]);
     let (code, rows, stderr) = quality(&file, &[]);
     assert_eq!(code, Some(1));
     let message = rows[0]["error"].as_str().unwrap_or_default();

@@ -3,7 +3,7 @@
 
 use std::fs::File;
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs the `graspopt` binary built for these tests.
@@ -14,12 +14,7 @@ pub fn graspopt(args: &[&str]) -> Output {
         .expect("run graspopt")
 }
 
-/// A fresh scratch folder, unique per test process and `name`.
-pub fn tempdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("graspopt-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+pub use crate::scratch::tempdir;
 
 /// Width, height and RGB pixels of an 8-bit RGB PNG.
 pub fn decode_png(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
