@@ -177,14 +177,6 @@ fn the_barrett_settings_make_the_spread_hold_and_the_distal_joints_break_away() 
     );
 }
 
-/// A scratch folder, deleted when dropped.
-fn temp_dir(tag: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("graspopt-urdf-{tag}-"))
-        .tempdir()
-        .unwrap()
-}
-
 fn parse_err(urdf: &str, settings: Option<&str>) -> String {
     let settings = settings.map(|s| HandSettings::parse(s, "t.toml").unwrap());
     match HandDescription::parse("t.urdf", urdf, settings.as_ref()) {
@@ -296,7 +288,7 @@ fn bad_urdf_gives_errors_that_name_the_joint_link_or_file() {
 
 #[test]
 fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
-    let scratch = temp_dir("mesh");
+    let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().to_path_buf();
     let urdf = |file: &str| {
         format!(

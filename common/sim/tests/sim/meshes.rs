@@ -149,17 +149,9 @@ fn a_mesh_with_holes_gets_the_same_precise_message_every_time() {
     }
 }
 
-/// A scratch folder, deleted when dropped.
-fn temp_dir(tag: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("graspopt-sim-{tag}-"))
-        .tempdir()
-        .unwrap()
-}
-
 #[test]
 fn obj_and_stl_meshes_load_and_can_be_grasped() {
-    let scratch = temp_dir("meshes");
+    let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().to_path_buf();
     // A 4 cm cube standing on z = 0, as OBJ with quads (1-based indices, one `v/vt/vn` face).
     let obj = "# cube\nv -0.02 -0.02 0\nv 0.02 -0.02 0\nv 0.02 0.02 0\nv -0.02 0.02 0\n\

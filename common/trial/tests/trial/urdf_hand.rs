@@ -33,17 +33,9 @@ const CUBE_OBJ: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.
 v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
 f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
 
-/// A scratch folder, deleted when dropped.
-fn temp_dir(tag: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("graspopt-urdf-{tag}-"))
-        .tempdir()
-        .unwrap()
-}
-
 #[test]
 fn a_urdf_hand_written_here_loads_and_grasps_the_cylinder_with_force_closure() {
-    let scratch = temp_dir("file");
+    let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().to_path_buf();
     std::fs::create_dir_all(dir.join("meshes")).unwrap();
     std::fs::write(dir.join("meshes/cube.obj"), CUBE_OBJ).unwrap();
