@@ -5,15 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::support::tempdir;
-
-/// Runs the `graspopt` binary built for these tests.
-fn graspopt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_graspopt"))
-        .args(args)
-        .output()
-        .expect("run graspopt")
-}
+use crate::support::{graspopt, graspopt_ok, tempdir};
 
 /// Runs `graspopt`, killing it after `limit` (a command that should have refused its input
 /// at once must not hang the tests); `None` if it had to be killed.
@@ -58,7 +50,7 @@ fn refused(args: &[&str], expected: &[&str]) -> Output {
 
 /// A finished run of three trials in `dir`; returns its journal.
 fn small_run(dir: &Path) -> PathBuf {
-    let out = graspopt(&[
+    graspopt_ok(&[
         "run",
         "--run",
         "r1",
@@ -74,11 +66,6 @@ fn small_run(dir: &Path) -> PathBuf {
         dir.to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let journal = dir.join("journal.sqlite");
     assert!(std::fs::metadata(&journal).unwrap().len() > 0);
     journal
@@ -135,12 +122,7 @@ fn failed_export_leaves_an_existing_output_alone() {
     assert_eq!(bad.status.code(), Some(1));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous export\n");
     // A successful export replaces it, leaving no temporary file behind.
-    let ok = graspopt(&["export", "r1", "--journal", j, "-o", o]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    graspopt_ok(&["export", "r1", "--journal", j, "-o", o]);
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.starts_with("trial,state"), "{text}");
     assert_eq!(text.lines().count(), 1 + 3);
@@ -359,7 +341,7 @@ fn experiment_metrics_refuses_fewer_than_two_steps() {
 #[test]
 fn experiment_metrics_report_tables_each_have_a_header() {
     let dir = tempdir("metrics-report");
-    let out = graspopt(&[
+    graspopt_ok(&[
         "experiment",
         "metrics",
         "--steps",
@@ -369,11 +351,6 @@ fn experiment_metrics_report_tables_each_have_a_header() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let lines: Vec<&str> = report.lines().collect();
     // Every block of table lines starts with a header and its |---| separator.

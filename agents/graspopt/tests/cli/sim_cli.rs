@@ -2,20 +2,15 @@
 
 use serde_json::Value;
 
-use crate::support::{decode_png, graspopt, tempdir};
+use crate::support::{decode_png, graspopt, graspopt_ok, tempdir};
 
 #[test]
 fn trial_prints_contacts_and_metrics() {
-    let out = graspopt(&[
+    let out = graspopt_ok(&[
         // x = 0.01: inside the sphere's force-closure window (+0.005 to +0.02 with the corrected
         // BH8, whose bent fingertips meet the sphere first when farther).
         "trial", "--object", "sphere", "--at", "x=0.01", "--format", "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(e["params"], serde_json::json!([0.01]));
     // The score and what it was computed from sit at the top level, not nested.
@@ -97,7 +92,7 @@ fn trial_bad_input_is_named() {
 #[test]
 fn scan_writes_csv_and_svg() {
     let dir = tempdir("scan");
-    let out = graspopt(&[
+    let out = graspopt_ok(&[
         "scan",
         "--object",
         "cylinder",
@@ -110,11 +105,6 @@ fn scan_writes_csv_and_svg() {
         "--threads",
         "2",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let csv = std::fs::read_to_string(dir.join("cylinder-bw-approach-vertical.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 1 + 12);
@@ -135,7 +125,7 @@ fn scan_writes_csv_and_svg() {
 #[test]
 fn scan_2d_writes_a_png_heatmap_too() {
     let dir = tempdir("png");
-    let out = graspopt(&[
+    graspopt_ok(&[
         "scan",
         "--object",
         "sphere",
@@ -146,11 +136,6 @@ fn scan_2d_writes_a_png_heatmap_too() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let (width, height, _) = decode_png(&dir.join("sphere-bw-approach-vertical.png"));
     // 4 x 3 cells of 8 px, plus the colour bar, the title and the legend.
     assert!(height > 3 * 8 + 30, "{height}");
@@ -160,7 +145,7 @@ fn scan_2d_writes_a_png_heatmap_too() {
 #[test]
 fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
     let dir = tempdir("misses");
-    let out = graspopt(&[
+    graspopt_ok(&[
         "scan",
         "--object",
         "sphere",
@@ -171,11 +156,6 @@ fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     // CSV: a grasp that touched nothing has empty metric cells, never NaN.
     let csv = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.csv")).unwrap();
     assert!(!csv.contains("NaN"), "{csv}");
@@ -384,7 +364,7 @@ fn a_mesh_in_millimetres_is_refused_until_scaled() {
         err.contains("cube_mm.obj") && err.contains("--mesh-scale 0.001"),
         "{err}"
     );
-    let out = graspopt(&[
+    let out = graspopt_ok(&[
         "trial",
         "--mesh",
         path,
@@ -393,11 +373,6 @@ fn a_mesh_in_millimetres_is_refused_until_scaled() {
         "--format",
         "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(!e["outcome"]["fingers"].as_array().unwrap().is_empty());
     // The scale needs a mesh.
@@ -408,12 +383,7 @@ fn a_mesh_in_millimetres_is_refused_until_scaled() {
 
 #[test]
 fn hands_lists_the_built_in_hands_and_describes_one() {
-    let out = graspopt(&["hands"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = graspopt_ok(&["hands"]);
     let text = String::from_utf8(out.stdout).unwrap();
     for (name, fingers, joints, source) in [
         ("barrett", 3, 8, "common/sim/hands/bh8_280.urdf"),
@@ -457,14 +427,9 @@ fn trial_takes_a_urdf_hand_file_and_names_a_bad_one() {
     let path = dir.join("two_jaws.urdf");
     std::fs::write(&path, JAWS_URDF).unwrap();
     let hand = path.to_str().unwrap();
-    let out = graspopt(&[
+    let out = graspopt_ok(&[
         "trial", "--object", "cuboid", "--hand", hand, "--format", "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let e: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(e["outcome"]["grasp"]["hand"], "two_jaws");
     // The cuboid is 0.05 wide across the jaws: each jaw travels 0.06 - 0.025 less the gap.
@@ -503,7 +468,7 @@ fn experiment_takes_the_hand_flag() {
     let dir = tempdir("experiment-hand");
     let csv = |hand: &str, tag: &str| {
         let out_dir = dir.join(tag);
-        let out = graspopt(&[
+        graspopt_ok(&[
             "experiment",
             "metrics",
             "--steps",
@@ -515,11 +480,6 @@ fn experiment_takes_the_hand_flag() {
             "--out",
             out_dir.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         std::fs::read_to_string(out_dir.join("fig4.3-sphere.csv")).unwrap()
     };
     let barrett = csv("barrett", "a");

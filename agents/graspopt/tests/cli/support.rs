@@ -14,6 +14,17 @@ pub fn graspopt(args: &[&str]) -> Output {
         .expect("run graspopt")
 }
 
+/// Runs the `graspopt` binary and asserts it succeeded, showing its stderr if not.
+pub fn graspopt_ok(args: &[&str]) -> Output {
+    let out = graspopt(args);
+    assert!(
+        out.status.success(),
+        "graspopt {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 pub use crate::scratch::tempdir;
 
 /// Width, height and RGB pixels of an 8-bit RGB PNG.
