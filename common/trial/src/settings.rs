@@ -2,7 +2,7 @@
 //! file), hand, contact model, metric, reference frame and torque scale. The CLI builds them
 //! from its flags; [`Evaluator::from_settings`] turns them into an evaluator.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{ContactModel, Object, ParamKind, TrialSpace};
@@ -50,18 +50,15 @@ impl Default for TrialSettings {
 impl TrialSettings {
     /// The object named by the settings.
     pub fn object(&self) -> Result<Object, TrialError> {
-        load_object(&self.object, self.mesh.as_deref(), self.mesh_scale)
-    }
-}
-
-/// The built-in object `name`, or the mesh file `mesh` (scaled by `scale` to metres) if given.
-pub fn load_object(name: &str, mesh: Option<&Path>, scale: f64) -> Result<Object, TrialError> {
-    match mesh {
-        Some(path) => Object::from_file_scaled(path, scale).map_err(|source| TrialError::Mesh {
-            path: path.to_path_buf(),
-            source: Box::new(source),
-        }),
-        None => Ok(Object::by_name(name)?),
+        match &self.mesh {
+            Some(path) => {
+                Object::from_file_scaled(path, self.mesh_scale).map_err(|source| TrialError::Mesh {
+                    path: path.clone(),
+                    source: Box::new(source),
+                })
+            }
+            None => Ok(Object::by_name(&self.object)?),
+        }
     }
 }
 

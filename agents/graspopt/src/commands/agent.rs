@@ -15,8 +15,7 @@ use graspopt_runner::config::load;
 use graspopt_runner::signal::{shutdown_signal, until_signal};
 use graspopt_sim::ParamKind;
 
-use super::run::{planner_method, trial_param};
-use super::setup::SimArgs;
+use super::setup::{SimArgs, planner_method, trial_param};
 use crate::out::outln;
 
 #[derive(Args, Debug)]

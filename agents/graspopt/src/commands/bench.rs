@@ -7,7 +7,7 @@ use clap::{Args, Subcommand};
 use graspopt_protocol::PlannerMethod;
 use graspopt_runner::bench::{self, PipelineSettings};
 
-use super::run::planner_method;
+use super::setup::planner_method;
 use crate::out::outln;
 
 /// The most hand workers of one throughput run.

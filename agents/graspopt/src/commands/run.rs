@@ -9,14 +9,13 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Args;
-use clap::builder::{PossibleValuesParser, TypedValueParser};
 use graspopt_bus::BusArgs;
 use graspopt_protocol::{PlannerMethod, RunPhase};
 use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
-use super::setup::SimArgs;
+use super::setup::{SimArgs, planner_method, trial_param};
 use crate::out::outln;
 use graspopt_protocol::named_params;
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
@@ -79,17 +78,6 @@ pub struct RunArgs {
     pub quiet: bool,
     #[command(flatten)]
     pub bus: BusArgs,
-}
-
-/// `--params`: a trial parameter by any of its names ([`ParamKind::parse`]).
-pub fn trial_param() -> impl TypedValueParser<Value = ParamKind> {
-    clap::builder::NonEmptyStringValueParser::new().try_map(|s| ParamKind::parse(&s))
-}
-
-/// `--method`: the planner's methods by name.
-pub fn planner_method() -> impl TypedValueParser<Value = PlannerMethod> {
-    PossibleValuesParser::new(PlannerMethod::ALL.map(PlannerMethod::name))
-        .try_map(|s| PlannerMethod::parse(&s).ok_or("unknown method"))
 }
 
 impl RunArgs {

@@ -1,11 +1,13 @@
-//! The flags every simulated-trial command shares (`trial`, `scan`, later `run`): which
-//! object, hand, contact model, metric and reference frame. One flag set for every tool.
+//! The flags every simulated-trial command shares (`trial`, `scan`, `run`): which
+//! object, hand, contact model, metric and reference frame, and the value parsers of the flags
+//! that name a library type (`--contacts`, `--metric`, `--frame`, `--params`, `--method`).
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use graspopt_protocol::PlannerMethod;
 use graspopt_sim::{ContactModel, Object, ParamKind};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
@@ -58,6 +60,17 @@ fn metric() -> impl TypedValueParser<Value = Metric> {
 fn frame() -> impl TypedValueParser<Value = ReferenceFrame> {
     PossibleValuesParser::new(ReferenceFrame::NAMED.map(|f| f.name()))
         .try_map(|s| ReferenceFrame::parse(&s))
+}
+
+/// `--params`: a trial parameter by any of its names ([`ParamKind::parse`]).
+pub fn trial_param() -> impl TypedValueParser<Value = ParamKind> {
+    clap::builder::NonEmptyStringValueParser::new().try_map(|s| ParamKind::parse(&s))
+}
+
+/// `--method`: the planner's methods by name.
+pub fn planner_method() -> impl TypedValueParser<Value = PlannerMethod> {
+    PossibleValuesParser::new(PlannerMethod::ALL.map(PlannerMethod::name))
+        .try_map(|s| PlannerMethod::parse(&s).ok_or("unknown method"))
 }
 
 impl SimArgs {
