@@ -149,6 +149,7 @@ fn main() {
         cloud_points: 3,
         cloud_transport: "shm".into(),
         error: None,
+        forces: None,
     };
     out.message("decode_result", "scored", &result, Some(Topic::Result));
     result.metrics = None;

@@ -128,6 +128,7 @@ fn templates() -> (
         cloud_points: 3,
         cloud_transport: "zenoh".into(),
         error: None,
+        forces: None,
     };
     let object = ObjectEstimate {
         run_id: elsewhere(),

@@ -47,6 +47,7 @@ fn forged(id: u64) -> TrialResult {
         cloud_points: 3,
         cloud_transport: "zenoh".into(),
         error: None,
+        forces: None,
     }
 }
 

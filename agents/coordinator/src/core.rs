@@ -542,6 +542,7 @@ fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
             "cloud_transport": r.cloud_transport,
         })
         .to_string(),
+        forces: r.forces.clone(),
     }
 }
 

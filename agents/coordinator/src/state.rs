@@ -523,6 +523,7 @@ pub(crate) mod tests {
             cloud_points: 1,
             cloud_transport: String::new(),
             error: None,
+            forces: None,
         }
     }
 

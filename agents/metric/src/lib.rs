@@ -60,6 +60,7 @@ pub fn score_clouds(clouds: &ContactClouds, object: &Object, config: &MetricConf
         cloud_points: clouds.point_count() as u32,
         cloud_transport: String::new(),
         error: clouds.error.clone(),
+        forces: None,
     };
     if result.error.is_some() {
         return result;
@@ -98,6 +99,7 @@ pub fn invalid_clouds_result(
         cloud_points: 0,
         cloud_transport: transport.to_string(),
         error: Some(format!("invalid contact clouds: {detail}")),
+        forces: None,
     }
 }
 

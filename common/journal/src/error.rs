@@ -19,6 +19,9 @@ pub enum JournalError {
     /// A NaN or infinite value where a finite number is required; nothing was written.
     #[error("non-finite value in field {field} (NaN and infinities are refused)")]
     NonFinite { field: String },
+    /// A value out of its range (the message names the field); nothing was written.
+    #[error("invalid value: {0}")]
+    Invalid(String),
     /// The database file carries a schema version this code does not know.
     #[error(
         "journal schema version {found} is not supported (this build reads version {expected})"

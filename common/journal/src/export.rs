@@ -8,7 +8,7 @@ use crate::journal::Journal;
 use crate::types::TrialRow;
 
 /// The columns after `completed_ms` and the parameter columns.
-const RESULT_COLUMNS: [&str; 11] = [
+const RESULT_COLUMNS: [&str; 16] = [
     "score",
     "rank",
     "force_closure",
@@ -19,6 +19,11 @@ const RESULT_COLUMNS: [&str; 11] = [
     "contacts",
     "fingers_in_contact",
     "cloud_points",
+    "can_resist",
+    "resisting_force",
+    "resisting_max",
+    "net_force",
+    "min_slip_margin",
     "error",
 ];
 
@@ -26,8 +31,12 @@ const RESULT_COLUMNS: [&str; 11] = [
 ///
 /// Header: `trial,state,attempts,worker,issued_ms,completed_ms,<param
 /// names...>,score,rank,force_closure,epsilon,volume,distance,bw,contacts,
-/// fingers_in_contact,cloud_points,error`, without `volume` when no trial has
-/// one (only runs scored by the volume compute it). A missing value (`None`)
+/// fingers_in_contact,cloud_points,can_resist,resisting_force,resisting_max,net_force,
+/// min_slip_margin,error`, without `volume` when no trial has one (only runs scored by the
+/// volume compute it). The force columns come from the result's force analysis
+/// ([`crate::ForceAnalysis`]): whether forces in the friction cones can resist the object's
+/// weight, the norm and the largest of the least such forces (N), and for hands that measure
+/// forces the net measured force (N) and the smallest slip margin (N). A missing value (`None`)
 /// is an empty field, and so are the result columns of a trial without a
 /// result. Numbers are written
 /// so that they parse back to the same f64. Fields containing a comma, a
@@ -107,6 +116,12 @@ fn trial_fields(t: &TrialRow, volume: bool) -> Vec<Cow<'_, str>> {
     f.push(opt(has_result.then_some(t.contacts)));
     f.push(opt(has_result.then_some(t.fingers_in_contact)));
     f.push(opt(has_result.then_some(t.cloud_points)));
+    let forces = t.forces.as_ref();
+    f.push(opt(forces.map(|a| a.can_resist())));
+    f.push(opt(forces.and_then(|a| a.resisting_norm)));
+    f.push(opt(forces.and_then(|a| a.resisting_max)));
+    f.push(opt(forces.and_then(|a| a.net_force())));
+    f.push(opt(forces.and_then(|a| a.min_slip_margin())));
     f.push(t.error.as_deref().map_or(Cow::Borrowed(""), Cow::Borrowed));
     f
 }

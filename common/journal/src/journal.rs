@@ -19,7 +19,7 @@ const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
 /// Columns read into a [`TrialRow`], in the order [`trial_from_row`] expects.
 const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, issued_ms, \
      lease_until_ms, completed_ms, result_attempt, score, rank, force_closure, epsilon, volume, \
-     distance, bw, contacts, fingers_in_contact, cloud_points, details_json, error";
+     distance, bw, contacts, fingers_in_contact, cloud_points, details_json, error, forces_json";
 
 /// The durable trial journal: runs, trials and their event log in one SQLite
 /// database file (write-ahead log, so a killed process loses at most the
@@ -389,6 +389,9 @@ impl Journal {
             check_finite(|| "metrics.distance".to_string(), m.distance)?;
             check_finite(|| "metrics.bw".to_string(), m.bw)?;
         }
+        if let Some(f) = &result.forces {
+            f.validate("forces").map_err(JournalError::Invalid)?;
+        }
         let Ok(id) = db_id(result.trial_id) else {
             return Ok(ResultOutcome::UnknownTrial);
         };
@@ -437,11 +440,16 @@ impl Journal {
                     None
                 };
                 let m = result.metrics.as_ref();
+                let forces_json = match &result.forces {
+                    Some(f) => Some(serde_json::to_string(f)?),
+                    None => None,
+                };
                 tx.execute(
                     "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
                          result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
                          epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
-                         fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16
+                         fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16,
+                         forces_json = ?17
                      WHERE run_id = ?1 AND trial_id = ?2",
                     params![
                         result.run_id,
@@ -460,6 +468,7 @@ impl Journal {
                         result.fingers_in_contact,
                         result.cloud_points,
                         result.details_json,
+                        forces_json,
                     ],
                 )?;
                 insert_event(

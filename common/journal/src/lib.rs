@@ -26,6 +26,6 @@ pub use error::{JournalError, Result};
 pub use journal::Journal;
 pub use schema::SCHEMA_VERSION;
 pub use types::{
-    EventRow, MetricValues, ResultOutcome, RunExport, RunLifecycle, RunRecord, StateCounts,
-    TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+    EventRow, ForceAnalysis, MetricValues, ResultOutcome, RunExport, RunLifecycle, RunRecord,
+    StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
 };

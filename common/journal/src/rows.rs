@@ -53,6 +53,12 @@ pub(crate) fn trial_from_row(r: &Row<'_>) -> rusqlite::Result<TrialRow> {
             bw: r.get(16)?,
         }),
     };
+    let forces = match r.get::<_, Option<String>>(22)? {
+        None => None,
+        Some(json) => {
+            Some(serde_json::from_str(&json).map_err(|e| conversion_error(22, Type::Text, e))?)
+        }
+    };
     Ok(TrialRow {
         run_id: r.get(0)?,
         trial_id: u64_col(r, 1)?,
@@ -71,5 +77,6 @@ pub(crate) fn trial_from_row(r: &Row<'_>) -> rusqlite::Result<TrialRow> {
         cloud_points: r.get::<_, Option<u32>>(19)?.unwrap_or(0),
         details_json: r.get(20)?,
         error: r.get(21)?,
+        forces,
     })
 }

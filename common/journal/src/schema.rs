@@ -5,12 +5,27 @@ use rusqlite::{Connection, TransactionBehavior};
 use crate::error::{JournalError, Result};
 
 /// The schema version stored in `PRAGMA user_version`.
-pub const SCHEMA_VERSION: i64 = 2;
+pub const SCHEMA_VERSION: i64 = 3;
 
-/// The current layout: version 1 ([`DDL_V1`]) and what version 2 added
-/// ([`DDL_V2_ADDITIONS`]).
+/// The current layout: version 1 ([`DDL_V1`]) and what each later version added
+/// ([`DDL_V2_ADDITIONS`], [`DDL_V3_ADDITIONS`]).
 pub(crate) fn ddl() -> String {
-    format!("{DDL_V1}{DDL_V2_ADDITIONS}")
+    format!("{DDL_V1}{DDL_V2_ADDITIONS}{DDL_V3_ADDITIONS}")
+}
+
+/// Version 3 adds each trial's contact-force analysis (`TrialResult::forces`, JSON). An
+/// older journal is upgraded in place when opened; its trials have none.
+pub(crate) const DDL_V3_ADDITIONS: &str = "
+ALTER TABLE trials ADD COLUMN forces_json TEXT;
+";
+
+/// What upgrades a journal of version `from` to the next version.
+fn additions_after(from: i64) -> Option<&'static str> {
+    match from {
+        1 => Some(DDL_V2_ADDITIONS),
+        2 => Some(DDL_V3_ADDITIONS),
+        _ => None,
+    }
 }
 
 /// Version 2 adds the planner's engine state per run (opaque bytes the planner replies
@@ -120,6 +135,7 @@ const LAYOUT: &[(&str, &[&str])] = &[
             "cloud_points",
             "details_json",
             "error",
+            "forces_json",
         ],
     ),
     (
@@ -140,8 +156,8 @@ fn user_version(conn: &Connection) -> Result<i64> {
 pub(crate) fn ensure(conn: &mut Connection) -> Result<()> {
     match user_version(conn)? {
         0 => create(conn),
-        1 => upgrade_from_v1(conn),
         SCHEMA_VERSION => check_layout(conn),
+        found if additions_after(found).is_some() => upgrade(conn, found),
         found => Err(JournalError::SchemaVersion {
             found,
             expected: SCHEMA_VERSION,
@@ -149,18 +165,20 @@ pub(crate) fn ensure(conn: &mut Connection) -> Result<()> {
     }
 }
 
-/// Adds version 2's table to a version-1 journal (nothing else changed), under the write
-/// lock: another process may be upgrading the same journal right now.
-fn upgrade_from_v1(conn: &mut Connection) -> Result<()> {
+/// Upgrades a journal of version `from` by one version (what that version added, nothing
+/// else changed), under the write lock: another process may be upgrading the same journal
+/// right now. Then looks again, up to the current version.
+fn upgrade(conn: &mut Connection, from: i64) -> Result<()> {
     let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-    if user_version(&tx)? == 1 {
-        tx.execute_batch(DDL_V2_ADDITIONS)?;
-        tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
-        tx.commit()?;
-    } else {
-        drop(tx);
+    match additions_after(from) {
+        Some(ddl) if user_version(&tx)? == from => {
+            tx.execute_batch(ddl)?;
+            tx.pragma_update(None, "user_version", from + 1)?;
+            tx.commit()?;
+        }
+        _ => drop(tx),
     }
-    // Now current (upgraded here or by the other process): checked as any other.
+    // Upgraded here or by the other process: checked (or upgraded further) as any other.
     ensure(conn)
 }
 

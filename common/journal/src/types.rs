@@ -75,11 +75,16 @@ pub struct TrialResultRecord {
     pub cloud_points: u32,
     /// Free-form JSON from the worker, stored verbatim.
     pub details_json: String,
+    /// The contact-force analysis of the result, stored as JSON.
+    pub forces: Option<ForceAnalysis>,
 }
 
 /// Grasp-quality metrics of one trial, stored as real columns: the result message's own
 /// type, so a result is journaled without a copy of its fields.
 pub use graspopt_protocol::MetricValues;
+
+/// A trial's contact-force analysis: the result message's own type, stored as JSON.
+pub use graspopt_protocol::ForceAnalysis;
 
 /// What `record_result` did with a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -153,6 +158,8 @@ pub struct TrialRow {
     pub details_json: Option<String>,
     /// The failure message of a failed trial.
     pub error: Option<String>,
+    /// The accepted result's contact-force analysis, if it had one.
+    pub forces: Option<ForceAnalysis>,
 }
 
 /// One line of a run's event log.

@@ -299,6 +299,87 @@ pub struct TrialResult {
     /// Set when the trial failed (the hand's error, or a scoring error): the trial is
     /// recorded as failed and not re-issued.
     pub error: Option<String>,
+    /// The contact-force analysis, when anything was touched. Added last, within wire
+    /// version 3: a result without it (an older metric agent's) decodes with none (see
+    /// [`TrialResult::decode_older`]).
+    #[serde(default)]
+    pub forces: Option<ForceAnalysis>,
+}
+
+/// The contact-force analysis of a trial (the thesis's "contact force analysis"), reported
+/// beside its metrics. Wrenches are `[fx, fy, fz, tx, ty, tz]` in newtons and newton-metres,
+/// world axes, torques about the reference point of the metrics (the object's centre of
+/// mass by default).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ForceAnalysis {
+    /// The wrench the world applies to the object that the grasp must resist: the object's
+    /// weight by default.
+    pub external: [f64; 6],
+    /// The contact forces of least Euclidean norm, each inside its friction cone, that resist
+    /// `external`: their norm (N). `None`: no forces in the cones can ("cannot resist").
+    pub resisting_norm: Option<f64>,
+    /// The largest single contact force of that solution (N).
+    pub resisting_max: Option<f64>,
+    /// Measured forces only (a hand with force sensors): the net wrench the measured contact
+    /// forces apply to the object.
+    pub net_wrench: Option<[f64; 6]>,
+    /// Measured forces only: per sensed contact, `mu f_n - |f_t|` (N), how much more
+    /// tangential force the contact takes before it slips (negative: outside its cone).
+    pub slip_margins: Vec<f64>,
+}
+
+impl ForceAnalysis {
+    /// Whether forces in the friction cones can resist the external wrench.
+    pub fn can_resist(&self) -> bool {
+        self.resisting_norm.is_some()
+    }
+
+    /// The smallest slip margin of the measured contacts (N), if any were measured.
+    pub fn min_slip_margin(&self) -> Option<f64> {
+        self.slip_margins.iter().copied().reduce(f64::min)
+    }
+
+    /// The norm of the net measured force (N), if forces were measured.
+    pub fn net_force(&self) -> Option<f64> {
+        self.net_wrench
+            .map(|w| (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt())
+    }
+
+    /// Checks that every number is finite and the norms are >= 0; the error names the field.
+    pub fn validate(&self, field: &str) -> Result<(), String> {
+        finite(&format!("{field}.external"), &self.external)?;
+        for (name, v) in [
+            ("resisting_norm", self.resisting_norm),
+            ("resisting_max", self.resisting_max),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v >= 0.0)
+            {
+                return Err(format!("{field}.{name} must be finite and >= 0, got {v}"));
+            }
+        }
+        if let Some(w) = &self.net_wrench {
+            finite(&format!("{field}.net_wrench"), w)?;
+        }
+        finite(&format!("{field}.slip_margins"), &self.slip_margins)
+    }
+}
+
+/// [`TrialResult`] as wire version 3 first had it, before `forces`.
+#[derive(Deserialize)]
+struct TrialResultBeforeForces {
+    run_id: RunId,
+    trial_id: u64,
+    attempt: u32,
+    worker: String,
+    scorer: String,
+    score: f64,
+    metrics: Option<MetricValues>,
+    contacts: u32,
+    fingers_in_contact: u32,
+    cloud_points: u32,
+    cloud_transport: String,
+    error: Option<String>,
 }
 
 impl Message for TrialResult {
@@ -317,7 +398,29 @@ impl Message for TrialResult {
                 &[m.epsilon, m.distance, m.bw, m.volume.unwrap_or(0.0)],
             )?;
         }
+        if let Some(f) = &self.forces {
+            f.validate("forces")?;
+        }
         Ok(())
+    }
+    fn decode_older(body: &[u8]) -> Option<(Self, usize)> {
+        let (r, read) = crate::codec::decode_bincode_body::<TrialResultBeforeForces>(body).ok()?;
+        let result = TrialResult {
+            run_id: r.run_id,
+            trial_id: r.trial_id,
+            attempt: r.attempt,
+            worker: r.worker,
+            scorer: r.scorer,
+            score: r.score,
+            metrics: r.metrics,
+            contacts: r.contacts,
+            fingers_in_contact: r.fingers_in_contact,
+            cloud_points: r.cloud_points,
+            cloud_transport: r.cloud_transport,
+            error: r.error,
+            forces: None,
+        };
+        Some((result, read))
     }
 }
 

@@ -63,6 +63,7 @@ fn result() -> TrialResult {
         cloud_points: 120,
         cloud_transport: "zenoh".into(),
         error: None,
+        forces: None,
     }
 }
 
@@ -288,4 +289,50 @@ fn a_status_from_before_waiting_still_decodes() {
     let mut long = encode(&empty, Encoding::Bincode).unwrap();
     long.push(0);
     assert!(decode::<RunStatus>(&long, Encoding::Bincode).is_err());
+}
+
+/// `TrialResult.forces` was appended within wire version 3: a result written before it (an
+/// older metric agent's) still decodes, in both encodings, without a force analysis.
+#[test]
+fn a_result_from_before_forces_still_decodes() {
+    let with = TrialResult {
+        forces: Some(ForceAnalysis {
+            external: [0.0, 0.0, -4.905, 0.0, 0.0, 0.0],
+            resisting_norm: Some(5.5),
+            resisting_max: Some(3.0),
+            net_wrench: None,
+            slip_margins: vec![0.25, 1.5],
+        }),
+        ..result()
+    };
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        assert_eq!(
+            decode::<TrialResult>(&encode(&with, enc).unwrap(), enc).unwrap(),
+            with
+        );
+    }
+    // The old bincode layout ends where `forces` begins: `None` is one 0 byte.
+    let without = result();
+    let mut old = encode(&without, Encoding::Bincode).unwrap();
+    assert_eq!(old.pop(), Some(0));
+    assert_eq!(
+        decode::<TrialResult>(&old, Encoding::Bincode).unwrap(),
+        without
+    );
+    let mut old_json: serde_json::Value =
+        serde_json::from_slice(&encode(&without, Encoding::Json).unwrap()).unwrap();
+    old_json.as_object_mut().unwrap().remove("forces");
+    let old_json = serde_json::to_vec(&old_json).unwrap();
+    assert_eq!(
+        decode::<TrialResult>(&old_json, Encoding::Json).unwrap(),
+        without
+    );
+    // A force analysis with a NaN is refused, naming the field.
+    let mut bad = with.clone();
+    if let Some(f) = bad.forces.as_mut() {
+        f.slip_margins[1] = f64::NAN;
+    }
+    let err = decode::<TrialResult>(&encode(&bad, Encoding::Bincode).unwrap(), Encoding::Bincode)
+        .unwrap_err();
+    assert!(err.to_string().contains("forces.slip_margins[1]"), "{err}");
 }

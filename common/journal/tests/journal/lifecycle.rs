@@ -44,6 +44,7 @@ fn issue_result_round_trip() {
         cloud_points: 4096,
         details_json: Some(r#"{"trial":1,"note":"ok"}"#.to_string()),
         error: None,
+        forces: None,
     };
     assert_eq!(row, expected);
     assert_eq!(bits(&row.params), bits(&iss.params));

@@ -98,6 +98,7 @@ fn result(
         fingers_in_contact: 3,
         cloud_points: 4096,
         details_json: format!(r#"{{"trial":{trial},"note":"ok"}}"#),
+        forces: None,
     }
 }
 
@@ -156,6 +157,7 @@ fn parse_csv(text: &str) -> Vec<Vec<String>> {
 // -------------------------------------------------------------------- tests
 
 /// Issue, result, re-issue, failure and reopening: the life of a trial in the journal.
+mod forces;
 mod lifecycle;
 
 #[test]
@@ -474,10 +476,15 @@ fn csv_export_fields() {
             "contacts",
             "fingers_in_contact",
             "cloud_points",
+            "can_resist",
+            "resisting_force",
+            "resisting_max",
+            "net_force",
+            "min_slip_margin",
             "error"
         ]
     );
-    assert!(records.iter().all(|r| r.len() == 20), "{records:?}");
+    assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
     let f64_at = |rec: &[String], i: usize| rec[i].parse::<f64>().unwrap().to_bits();
 
     let done = &records[1];
@@ -498,12 +505,12 @@ fn csv_export_fields() {
     assert_eq!(f64_at(done, 13), m.volume.unwrap().to_bits());
     assert_eq!(f64_at(done, 14), m.distance.to_bits());
     assert_eq!(f64_at(done, 15), m.bw.to_bits());
-    assert_eq!(&done[16..], ["7", "3", "4096", ""]);
+    assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", ""]);
 
     let failed = &records[2];
     assert_eq!(&failed[..6], ["2", "failed", "1", "w,2", "300", ""]);
-    assert!(failed[9..19].iter().all(String::is_empty), "{failed:?}");
-    assert_eq!(failed[19], message);
+    assert!(failed[9..24].iter().all(String::is_empty), "{failed:?}");
+    assert_eq!(failed[24], message);
 
     let no_metrics = &records[3];
     assert_eq!(no_metrics[9], "1.0");
@@ -511,7 +518,10 @@ fn csv_export_fields() {
         no_metrics[10..16].iter().all(String::is_empty),
         "{no_metrics:?}"
     );
-    assert_eq!(&no_metrics[16..], ["7", "3", "4096", ""]);
+    assert_eq!(
+        &no_metrics[16..],
+        ["7", "3", "4096", "", "", "", "", "", ""]
+    );
 
     let running = &records[4];
     assert_eq!(&running[..6], ["4", "running", "1", "w4", "700", ""]);
@@ -533,7 +543,7 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
     let records = parse_csv(&text);
     assert_eq!(records.len(), 3, "{text}");
     assert!(!records[0].contains(&"volume".to_string()), "{text}");
-    assert!(records.iter().all(|r| r.len() == 19), "{records:?}");
+    assert!(records.iter().all(|r| r.len() == 24), "{records:?}");
     let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
     let m = metrics_for(1);
     assert_eq!(records[1][column("epsilon")], format!("{:?}", m.epsilon));
@@ -761,11 +771,14 @@ fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
         j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
         j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
     }
-    // Version 1 is version 2 without the planner_state table.
+    // Version 1 is version 3 without the planner_state table and the forces column.
     {
         let raw = rusqlite::Connection::open(&db).unwrap();
-        raw.execute_batch("DROP TABLE planner_state; PRAGMA user_version = 1")
-            .unwrap();
+        raw.execute_batch(
+            "DROP TABLE planner_state; ALTER TABLE trials DROP COLUMN forces_json;
+             PRAGMA user_version = 1",
+        )
+        .unwrap();
     }
     let mut j = Journal::open(&db).unwrap();
     let version: i64 = rusqlite::Connection::open(&db)
