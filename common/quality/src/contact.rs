@@ -92,7 +92,7 @@ pub fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 }
 
 /// Errors when a coordinate of `v` exceeds [`MAX_COORDINATE`] in absolute value.
-fn check_range(
+pub(crate) fn check_range(
     what: &'static str,
     index: usize,
     field: &'static str,

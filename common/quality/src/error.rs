@@ -112,8 +112,43 @@ pub enum QualityError {
     /// checks); reported rather than printed as a number.
     #[error("the {metric} came out as {value}: numerical failure")]
     NotFiniteMetric { metric: &'static str, value: f64 },
-    /// The conic solver failed.
-    #[error("the distance QP solver failed: {0}")]
+    /// Contact forces (force analysis) that do not match the contacts one to one.
+    #[error(
+        "{forces} forces and {torsions} torsions given for {contacts} contacts: give one force and one torsion (0 unless a soft finger) per contact"
+    )]
+    ForceCount {
+        contacts: usize,
+        forces: usize,
+        torsions: usize,
+    },
+    /// A contact's torsion (moment about its normal) is not finite or beyond
+    /// [`MAX_COORDINATE`](crate::limits::MAX_COORDINATE) in absolute value.
+    #[error(
+        "contact {index}: torsion {} must be finite and at most {} in absolute value",
+        num(*value),
+        num(*limit)
+    )]
+    TorsionOutOfRange {
+        index: usize,
+        value: f64,
+        limit: f64,
+    },
+    /// A contact carries a torsion but the friction model has no torsional friction
+    /// (only a soft finger transmits a moment about the normal).
+    #[error(
+        "contact {index}: torsion {} given, but only a soft finger transmits a moment about its normal",
+        num(*value)
+    )]
+    TorsionWithoutSoftFinger { index: usize, value: f64 },
+    /// The external wrench to resist is not finite or has a component beyond
+    /// [`MAX_COORDINATE`](crate::limits::MAX_COORDINATE) in absolute value.
+    #[error(
+        "the external wrench {value:?} must be finite with each component at most {} in absolute value",
+        num(*limit)
+    )]
+    ExternalWrench { value: [f64; 6], limit: f64 },
+    /// The conic solver (Clarabel) failed; the text names the problem and its status.
+    #[error("the conic solver failed: {0}")]
     Solver(String),
 }
 

@@ -15,6 +15,8 @@
 //!   expanding polytope, full hull).
 //! - [`limits`]: bounds on edge counts, wrench counts and magnitudes, so bad input is an
 //!   error naming the field rather than an allocation failure or an overflowed metric.
+//! - [`forces`]: force analysis: the net wrench of contact forces, their slip margins,
+//!   and the least-norm forces in the friction cones that resist an external wrench.
 //! - [`metrics`]: force closure, Largest Sphere, Grasp Wrench Volume, distance and the
 //!   Bimodal Wrench metric (section 2.6).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -23,6 +25,7 @@ pub mod cases;
 pub mod cloud;
 pub mod contact;
 pub mod error;
+pub mod forces;
 pub mod grasp_map;
 pub mod hull;
 pub mod limits;
@@ -32,6 +35,10 @@ pub mod wrench;
 pub use cloud::{MeanContact, mean_contact};
 pub use contact::{Contact, FrictionModel, GraspModel};
 pub use error::QualityError;
+pub use forces::{
+    ContactForces, Resisting, SlipMargin, gravity_wrench, net_wrench, resisting_forces,
+    slip_margins,
+};
 pub use grasp_map::GraspMap;
 pub use metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
 pub use wrench::Wrench;

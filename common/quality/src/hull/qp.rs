@@ -17,7 +17,7 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
-use super::coordinate_scale;
+use super::{coordinate_scale, power_of_two_scale};
 use crate::error::QualityError;
 use crate::wrench::Wrench;
 
@@ -35,20 +35,6 @@ pub fn distance_to_hull(w: &[Wrench]) -> Result<f64, QualityError> {
     }
     let scaled: Vec<Wrench> = w.iter().map(|x| x / unit).collect();
     Ok(solve(&scaled)? * unit)
-}
-
-/// The power of two nearest `scale` (1 for a zero, subnormal or non-finite scale, or
-/// one whose power of two is not representable).
-fn power_of_two_scale(scale: f64) -> f64 {
-    if !scale.is_finite() || scale < f64::MIN_POSITIVE {
-        return 1.0;
-    }
-    let exponent = scale.log2().round();
-    if !(-1021.0..=1022.0).contains(&exponent) {
-        return 1.0;
-    }
-    // In range, so the exponent is a small integer and 2^exponent is exact.
-    2f64.powi(exponent as i32)
 }
 
 /// [`distance_to_hull`] without the scaling.
@@ -106,7 +92,11 @@ fn solve(w: &[Wrench]) -> Result<f64, QualityError> {
     solver.solve();
     match solver.solution.status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-        other => return Err(QualityError::Solver(format!("status {other:?}"))),
+        other => {
+            return Err(QualityError::Solver(format!(
+                "distance to the hull: status {other:?}"
+            )));
+        }
     }
     // Report the norm of the feasible point nearest to the solver's weights.
     let x = &solver.solution.x;
@@ -114,7 +104,7 @@ fn solve(w: &[Wrench]) -> Result<f64, QualityError> {
     let total: f64 = weights.iter().sum();
     if total.is_nan() || total <= 0.0 {
         return Err(QualityError::Solver(
-            "no convex weights in the solution".into(),
+            "distance to the hull: no convex weights in the solution".into(),
         ));
     }
     let y: Wrench = w.iter().zip(&weights).map(|(wj, l)| wj * (l / total)).sum();
@@ -151,8 +141,5 @@ mod tests {
             let d = distance_to_hull(&w).unwrap() / s;
             assert!((d - 1.0).abs() < 1e-8, "scale {s}: {d}");
         }
-        assert_eq!(power_of_two_scale(3.0), 4.0);
-        assert_eq!(power_of_two_scale(0.0), 1.0);
-        assert_eq!(power_of_two_scale(f64::INFINITY), 1.0);
     }
 }

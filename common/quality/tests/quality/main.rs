@@ -2,6 +2,7 @@
 //! instead of one per file). A new file here needs a `mod` line below.
 
 mod bad_input;
+mod forces;
 mod known_values;
 mod properties;
 mod reference_cases;

@@ -1,0 +1,464 @@
+//! Readings, settings, sensed contacts and the solver: [`locate`] (a reading to a contact)
+//! and [`reading_of`] (a contact to a reading).
+
+use nalgebra::{Point3, Unit, Vector3};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::error::{SensingError, check, finite};
+use crate::surface::{Domain, FingertipSurface, Piece};
+
+/// What the sensor measures: the wrench the object applies to the fingertip, in the sensor
+/// frame, the torque taken about the sensor frame's origin (N, N m).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Reading {
+    pub force: Vector3<f64>,
+    pub torque: Vector3<f64>,
+}
+
+const FORCE: [&str; 3] = ["force[0]", "force[1]", "force[2]"];
+const TORQUE: [&str; 3] = ["torque[0]", "torque[1]", "torque[2]"];
+
+impl Reading {
+    /// Checks that every component is finite; the error names it.
+    pub fn validate(&self) -> Result<(), SensingError> {
+        for (name, value) in FORCE.iter().zip(self.force.iter()) {
+            finite(name, *value)?;
+        }
+        for (name, value) in TORQUE.iter().zip(self.torque.iter()) {
+            finite(name, *value)?;
+        }
+        Ok(())
+    }
+}
+
+/// The contact model a reading is interpreted with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactKind {
+    /// A point contact: a force only (torque = p x F).
+    Point,
+    /// A soft finger: a force and a moment about the contact normal
+    /// (torque = p x F - t n).
+    SoftFinger,
+}
+
+/// How readings are turned into contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensingSettings {
+    /// The contact model.
+    pub kind: ContactKind,
+    /// Readings with a force below this (N) are no contact. Default 0.05 N.
+    pub force_threshold: f64,
+    /// How far (m) the solution may lie off the surface and still be taken, snapped onto
+    /// it: a point-contact force line that grazes the surface within this distance gives
+    /// the surface point nearest the line; a point this far beyond a capsule's seam or
+    /// below the base height still counts. Default 1e-4 m.
+    pub surface_tolerance: f64,
+    /// Point contact only: the largest pitch (m) of the measured wrench, |torque . F| /
+    /// |F|^2, that is taken as noise. A point contact's wrench has pitch 0; a larger pitch
+    /// is a torsional moment the point model cannot explain, and the reading is refused
+    /// ([`NoContact::Torsion`]). Default 2e-4 m.
+    pub pitch_tolerance: f64,
+}
+
+impl Default for SensingSettings {
+    fn default() -> Self {
+        Self {
+            kind: ContactKind::Point,
+            force_threshold: 0.05,
+            surface_tolerance: 1e-4,
+            pitch_tolerance: 2e-4,
+        }
+    }
+}
+
+impl SensingSettings {
+    /// Checks that the threshold and tolerances are finite and >= 0.
+    pub fn validate(&self) -> Result<(), SensingError> {
+        let non_negative = |v: f64| v >= 0.0;
+        check(
+            "force_threshold",
+            self.force_threshold,
+            ">= 0",
+            non_negative,
+        )?;
+        check(
+            "surface_tolerance",
+            self.surface_tolerance,
+            ">= 0",
+            non_negative,
+        )?;
+        check(
+            "pitch_tolerance",
+            self.pitch_tolerance,
+            ">= 0",
+            non_negative,
+        )
+    }
+}
+
+/// A contact recovered from one reading, in the sensor frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SensedContact {
+    pub point: Point3<f64>,
+    /// The fingertip's outward normal at `point` (it points into the object).
+    pub normal: Unit<Vector3<f64>>,
+    /// The force the fingertip applies to the object (= -reading.force).
+    pub force: Vector3<f64>,
+    /// The moment about `normal` the fingertip applies to the object (0 for
+    /// [`ContactKind::Point`]).
+    pub torsion: f64,
+}
+
+/// Why a reading gives no contact.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum NoContact {
+    /// The force is below the threshold (or zero): nothing touches the fingertip.
+    #[error("the force is {force:.4} N, below the contact threshold of {threshold:.4} N")]
+    BelowThreshold { force: f64, threshold: f64 },
+    /// Point contact only: the torque has a component `torsion` (N m) along the force,
+    /// a wrench of pitch `pitch` = torsion / |F| (m) beyond `tolerance` (m). A point
+    /// contact cannot apply it: the reading needs the soft-finger model (or is corrupt).
+    #[error(
+        "the torque has a component of {torsion:.3e} N m along the force (pitch {:.4} mm), beyond the {:.4} mm a point contact allows: a torsional moment the point-contact model cannot explain (use the soft-finger model)",
+        pitch * 1e3,
+        tolerance * 1e3
+    )]
+    Torsion {
+        torsion: f64,
+        pitch: f64,
+        tolerance: f64,
+    },
+    /// No point of the surface explains the reading: for a point contact the force's line
+    /// of action passes `distance` (m) from the surface, beyond the surface tolerance; for
+    /// a soft finger (capsule only) the nearest solution lies `distance` beyond the
+    /// surface's pieces.
+    #[error(
+        "no point of the fingertip surface explains the reading: the solution lies {:.4} mm off the surface, beyond the surface tolerance",
+        distance * 1e3
+    )]
+    MissesSurface { distance: f64 },
+    /// The only points of the usable surface (above the base) that explain the reading
+    /// are ones where the fingertip would pull the object: its normal force there,
+    /// `normal_force` (N), is negative. The pushing solution lies on the mount.
+    #[error(
+        "the only point of the fingertip's usable surface that explains the reading is one where the fingertip would pull the object (normal force {normal_force:.4} N); the pushing solution lies below the base, where the fingertip is mounted"
+    )]
+    Pulling { normal_force: f64 },
+    /// The only point where the contact pushes lies at height `z`, below `base_z` (m,
+    /// sensor frame) where the fingertip is mounted, and no usable point explains the
+    /// reading.
+    #[error(
+        "the contact point that explains the reading is at z = {:.4} mm, below the base at z = {:.4} mm where the fingertip is mounted",
+        z * 1e3,
+        base_z * 1e3
+    )]
+    OnMount { z: f64, base_z: f64 },
+    /// Two distinct points of the surface, `separation` (m) apart, both explain the
+    /// reading; none is chosen.
+    #[error(
+        "two points of the fingertip surface {:.4} mm apart both explain the reading",
+        separation * 1e3
+    )]
+    Ambiguous { separation: f64 },
+    /// The surface, the settings or the reading is invalid.
+    #[error("invalid input: {0}")]
+    Invalid(#[from] SensingError),
+}
+
+/// Candidates closer than this (m) are one solution (a capsule seam gives the same
+/// point from two pieces).
+const SAME_POINT: f64 = 1e-8;
+
+/// One solution of the reading on one piece's whole quadric.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    point: Vector3<f64>,
+    normal: Unit<Vector3<f64>>,
+    torsion: f64,
+    /// How far (m) the point lies outside the part of the quadric that is surface.
+    excess: f64,
+    /// Whether the fingertip pushes the object there (f . n > 0).
+    pushing: bool,
+}
+
+/// The reading produced by the fingertip applying `force` and the moment `torsion` about
+/// the outward normal at surface point `point` (the forward model: the sensor measures the
+/// opposite wrench, force -`force` and torque `point` x (-`force`) - `torsion` n).
+pub fn reading_of(
+    surface: &FingertipSurface,
+    point: &Point3<f64>,
+    force: &Vector3<f64>,
+    torsion: f64,
+) -> Reading {
+    let n = surface.outward_normal(point);
+    let on_tip = -force;
+    Reading {
+        force: on_tip,
+        torque: point.coords.cross(&on_tip) - n.into_inner() * torsion,
+    }
+}
+
+/// The contact that explains `reading` on `surface`, or why there is none. See the crate
+/// documentation for the method.
+pub fn locate(
+    surface: &FingertipSurface,
+    reading: &Reading,
+    settings: &SensingSettings,
+) -> Result<SensedContact, NoContact> {
+    surface.validate()?;
+    settings.validate()?;
+    reading.validate()?;
+    let f = reading.force;
+    let f_norm = f.norm();
+    if f_norm < settings.force_threshold || f_norm == 0.0 {
+        return Err(NoContact::BelowThreshold {
+            force: f_norm,
+            threshold: settings.force_threshold,
+        });
+    }
+    let soft = settings.kind == ContactKind::SoftFinger;
+    let mut torque = reading.torque;
+    if !soft {
+        let torsion = torque.dot(&f) / f_norm;
+        let pitch = torsion / f_norm;
+        if pitch.abs() > settings.pitch_tolerance {
+            return Err(NoContact::Torsion {
+                torsion,
+                pitch,
+                tolerance: settings.pitch_tolerance,
+            });
+        }
+        torque -= f * (torque.dot(&f) / (f_norm * f_norm));
+    }
+    let candidates: Vec<Candidate> = surface
+        .pieces()
+        .iter()
+        .flat_map(|piece| piece_candidates(piece, &f, &torque, soft))
+        .collect();
+    let tol = settings.surface_tolerance;
+    let base = surface.base_z();
+    let usable = |p: &Vector3<f64>| base.is_none_or(|b| p.z >= b - tol);
+    let contact = |c: &Candidate| SensedContact {
+        point: Point3::from(c.point),
+        normal: c.normal,
+        force: -f,
+        torsion: c.torsion,
+    };
+
+    // A pushing solution on its piece and on the usable surface: the contact, unless
+    // there are two distinct ones.
+    let exact: Vec<&Candidate> = candidates
+        .iter()
+        .filter(|c| c.pushing && c.excess == 0.0 && usable(&c.point))
+        .collect();
+    if let Some(first) = exact.first() {
+        let separation = exact
+            .iter()
+            .map(|c| (c.point - first.point).norm())
+            .fold(0.0, f64::max);
+        if separation > SAME_POINT {
+            return Err(NoContact::Ambiguous { separation });
+        }
+        return Ok(contact(first));
+    }
+    // Just beyond a capsule seam (noise): the least outside, snapped onto the surface.
+    let near = candidates
+        .iter()
+        .filter(|c| c.pushing && c.excess <= tol)
+        .map(|c| {
+            let point = surface.snap(&Point3::from(c.point));
+            Candidate {
+                point: point.coords,
+                normal: surface.outward_normal(&point),
+                ..*c
+            }
+        })
+        .filter(|c| usable(&c.point))
+        .min_by(|a, b| a.excess.total_cmp(&b.excess));
+    if let Some(c) = near {
+        return Ok(contact(&c));
+    }
+    // A pushing solution exists but only on the mount.
+    if let (Some(base_z), Some(mounted)) = (
+        base,
+        candidates.iter().find(|c| c.pushing && c.excess <= tol),
+    ) {
+        let pulling = candidates
+            .iter()
+            .find(|c| !c.pushing && c.excess <= tol && usable(&c.point));
+        return Err(match pulling {
+            Some(c) => NoContact::Pulling {
+                normal_force: -f.dot(&c.normal),
+            },
+            None => NoContact::OnMount {
+                z: mounted.point.z,
+                base_z,
+            },
+        });
+    }
+    if soft {
+        let distance = candidates
+            .iter()
+            .filter(|c| c.pushing)
+            .map(|c| c.excess)
+            .fold(f64::INFINITY, f64::min);
+        return Err(NoContact::MissesSurface { distance });
+    }
+    // Point contact whose line of action misses the surface: within the tolerance, the
+    // surface point nearest the line.
+    let line_point = f.cross(&torque) / (f_norm * f_norm);
+    let direction = Unit::new_unchecked(f / f_norm);
+    let (point, distance) = surface.nearest_to_line(&line_point, &direction);
+    if distance > tol {
+        return Err(NoContact::MissesSurface { distance });
+    }
+    match base {
+        Some(base_z) if !usable(&point.coords) => Err(NoContact::OnMount { z: point.z, base_z }),
+        _ => Ok(SensedContact {
+            point,
+            normal: surface.outward_normal(&point),
+            force: -f,
+            torsion: 0.0,
+        }),
+    }
+}
+
+/// The pushing and pulling solutions of a reading (force `f` on the fingertip, torque
+/// about the origin) on one piece's whole quadric.
+fn piece_candidates(
+    piece: &Piece,
+    f: &Vector3<f64>,
+    torque: &Vector3<f64>,
+    soft: bool,
+) -> Vec<Candidate> {
+    match *piece {
+        Piece::Quadric {
+            center,
+            semi_axes,
+            domain,
+        } => quadric_candidates(&center, &semi_axes, domain, f, torque, soft),
+        Piece::Cylinder {
+            center,
+            radius,
+            half_length,
+        } => cylinder_candidates(&center, radius, half_length, f, torque, soft),
+    }
+}
+
+/// Solutions on the ellipsoid with semi-axes `a` about `center` (crate doc, "Ellipsoid
+/// and sphere"): in the coordinates v = D^-1 (p - center), D = diag(a), the ellipsoid is
+/// the unit sphere and the reading equation becomes v x G - k v = b.
+fn quadric_candidates(
+    center: &Vector3<f64>,
+    a: &Vector3<f64>,
+    domain: Domain,
+    f: &Vector3<f64>,
+    torque: &Vector3<f64>,
+    soft: bool,
+) -> Vec<Candidate> {
+    let torque_c = torque - center.cross(f);
+    let g_vec = Vector3::new(a.y * a.z * f.x, a.x * a.z * f.y, a.x * a.y * f.z);
+    let g = g_vec.norm();
+    if g <= 0.0 || !g.is_finite() {
+        return Vec::new();
+    }
+    let g_hat = g_vec / g;
+    let b = a.component_mul(&torque_c);
+    let beta = if soft { b.dot(&g_hat) } else { 0.0 };
+    let b_perp = b - g_hat * b.dot(&g_hat);
+    let g2 = g * g;
+    let diff = g2 - b_perp.norm_squared() - beta * beta;
+    let root = (diff * diff + 4.0 * beta * beta * g2).sqrt();
+    // x = k^2 solves x^2 + (g^2 - |b|^2) x - beta^2 g^2 = 0 (its root >= 0), and
+    // |alpha| = |beta| / sqrt(x); both written without cancellation.
+    let (x, alpha_mag) = if diff > 0.0 {
+        (
+            2.0 * beta * beta * g2 / (diff + root),
+            ((diff + root) / 2.0).sqrt() / g,
+        )
+    } else {
+        let x = (root - diff) / 2.0;
+        let alpha = if x > 0.0 { beta.abs() / x.sqrt() } else { 0.0 };
+        (x, alpha)
+    };
+    // alpha = 0: the line of a point contact misses or grazes; a soft finger's solution
+    // is tangent. Neither pushes nor pulls.
+    if alpha_mag <= 0.0 {
+        return Vec::new();
+    }
+    let cross = b_perp.cross(&g_hat);
+    [true, false]
+        .into_iter()
+        .map(|pushing| {
+            // Pushing: alpha < 0 (G . v < 0, i.e. F . n < 0); k alpha = -beta.
+            let alpha = if pushing { -alpha_mag } else { alpha_mag };
+            let k = if beta == 0.0 { 0.0 } else { -beta / alpha };
+            let w = -(cross * g + b_perp * k) / (g2 + x);
+            let v = g_hat * alpha + w;
+            let u = a.component_mul(&v);
+            let grad = v.component_div(a);
+            let grad_norm = grad.norm();
+            let point = center + u;
+            Candidate {
+                point,
+                normal: Unit::new_unchecked(grad / grad_norm),
+                torsion: k * grad_norm,
+                excess: domain.excess(point.z),
+                pushing,
+            }
+        })
+        .collect()
+}
+
+/// Solutions on the cylinder of `radius` about the vertical line through `center`
+/// (crate doc, "Capsule"): the torque about the axis fixes the normal's angle, then the
+/// height and the torsion follow linearly.
+fn cylinder_candidates(
+    center: &Vector3<f64>,
+    radius: f64,
+    half_length: f64,
+    f: &Vector3<f64>,
+    torque: &Vector3<f64>,
+    soft: bool,
+) -> Vec<Candidate> {
+    let torque_c = torque - center.cross(f);
+    let f_xy = f.x.hypot(f.y);
+    if f_xy <= 1e-12 * f.norm() {
+        return Vec::new();
+    }
+    let e = Vector3::new(f.x / f_xy, f.y / f_xy, 0.0);
+    let e_perp = Vector3::new(-e.y, e.x, 0.0);
+    let s = torque_c.z / (radius * f_xy);
+    if s.abs() >= 1.0 {
+        return Vec::new();
+    }
+    let c = (1.0 - s * s).sqrt();
+    let z_cross_f = Vector3::new(-f.y, f.x, 0.0);
+    [true, false]
+        .into_iter()
+        .map(|pushing| {
+            let n = if pushing {
+                -e * c - e_perp * s
+            } else {
+                e * c - e_perp * s
+            };
+            let torsion = if soft {
+                -torque_c.dot(f) / n.dot(f)
+            } else {
+                0.0
+            };
+            let z = (torque_c - n.cross(f) * radius + n * torsion).dot(&z_cross_f) / (f_xy * f_xy);
+            let point = center + n * radius + Vector3::z() * z;
+            Candidate {
+                point,
+                normal: Unit::new_unchecked(n),
+                torsion,
+                excess: (z.abs() - half_length).max(0.0),
+                pushing,
+            }
+        })
+        .collect()
+}
