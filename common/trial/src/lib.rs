@@ -9,6 +9,10 @@
 //! - [`score`]: settings and scoring of one trial outcome.
 //! - [`evaluator`]: an object, a hand and a trial space: parameters in, score out.
 //! - [`measured`]: scoring clouds a hand measured (the metric agent's side).
+//! - [`fingertips`]: simulated fingertip force/torque sensors, and contacts from their
+//!   readings.
+//! - [`forces`]: the contact-force analysis of a trial (least forces resisting the object's
+//!   weight; measured forces' net wrench and slip margins).
 //! - [`point`]: a trial point as users write it (`x=-0.08,y=0.01`), checked against a space.
 //! - [`scan`]: 1D/2D (any-D) grid scans over the trial space, in parallel, and their grids.
 //! - [`settings`]: a trial's settings as a user states them ([`Evaluator::from_settings`]).
@@ -16,6 +20,8 @@
 
 pub mod error;
 pub mod evaluator;
+pub mod fingertips;
+pub mod forces;
 pub mod measured;
 pub mod point;
 pub mod scan;

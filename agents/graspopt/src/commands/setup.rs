@@ -22,7 +22,7 @@ pub struct SimArgs {
     /// Factor from the mesh file's units to metres (0.001 for a mesh in millimetres).
     #[arg(long, default_value_t = 1.0, requires = "mesh")]
     pub mesh_scale: f64,
-    /// Hand: a built-in name (barrett, parallel_jaw, franka_hand; see `graspopt hands`) or a
+    /// Hand: a built-in name (barrett, barrett_ft, parallel_jaw, franka_hand; see `graspopt hands`) or a
     /// URDF file (FILE.urdf, settings in FILE.toml beside it).
     #[arg(long, default_value = "barrett")]
     pub hand: String,

@@ -243,7 +243,7 @@ impl BuiltinHand {
     }
 }
 
-const BUILTIN_HANDS: [BuiltinHand; 3] = [
+const BUILTIN_HANDS: [BuiltinHand; 4] = [
     BuiltinHand {
         name: "barrett",
         aliases: &["bh8", "bh8_280"],
@@ -251,6 +251,14 @@ const BUILTIN_HANDS: [BuiltinHand; 3] = [
         settings_source: Some("common/sim/hands/bh8_280.toml"),
         urdf: include_str!("../../hands/bh8_280.urdf"),
         settings: Some(include_str!("../../hands/bh8_280.toml")),
+    },
+    BuiltinHand {
+        name: "barrett_ft",
+        aliases: &["bh8_ft", "bh8_280_ft"],
+        source: "common/sim/hands/bh8_280_ft.urdf",
+        settings_source: Some("common/sim/hands/bh8_280_ft.toml"),
+        urdf: include_str!("../../hands/bh8_280_ft.urdf"),
+        settings: Some(include_str!("../../hands/bh8_280_ft.toml")),
     },
     BuiltinHand {
         name: "parallel_jaw",

@@ -2,6 +2,7 @@
 //! instead of one per file). A new file here needs a `mod` line below.
 
 mod contacts;
+mod fingertips;
 mod grid;
 mod qualitative;
 mod scoring;

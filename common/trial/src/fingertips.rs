@@ -1,0 +1,262 @@
+//! Fingertips with force/torque sensors, simulated: where each spherical fingertip of a
+//! simulated hand touches the object, the force it applies there, and the reading a six-axis
+//! sensor under it would give (with Nano17-like noise); and the way back, from readings to
+//! contacts (intrinsic contact sensing, `graspopt-sensing`).
+//!
+//! A fingertip is a collision body of a sphere shape on a finger (the last such body of each
+//! finger): `barrett_ft`'s 12 mm spheres, or a user URDF's. Its sensor sits
+//! [`FingertipSettings::sensor_depth`] below the sphere's centre along the body's `z` (the
+//! direction of the phalanx), axes parallel to the body's, so the fingertip surface in the
+//! sensor frame is a sphere centred at `(0, 0, sensor_depth)`.
+//!
+//! The contact of a touching fingertip is the point of its sphere towards the nearest point of
+//! the object (the simulator leaves a gap of at most 0.2 mm), the normal that direction (into
+//! the object). The forces are the least-norm forces in the friction cones that hold the
+//! object's weight ([`crate::forces`]); when the fingertips alone cannot (the palm or the
+//! phalanges carry the object, or only one tip touches), each touching tip presses
+//! [`FingertipSettings::squeeze`] newtons along its normal, as a closed hand does.
+
+use graspopt_quality::forces::{ContactForces, Resisting};
+use graspopt_quality::{Contact, FrictionModel};
+use graspopt_sensing::{
+    ContactKind, FingertipSurface, NoContact, Reading, SensingSettings, SensorNoise, locate,
+    reading_of,
+};
+use graspopt_sim::{Hand, LinkShape, Object, TrialOutcome};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::TrialError;
+use crate::forces::{ForceSettings, analyse_contacts};
+use crate::score::{ScoreSettings, grasp_model};
+
+/// How the simulated fingertips sense.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FingertipSettings {
+    /// What a fingertip transmits: a point contact with friction (no torsion) or a soft
+    /// finger (a moment about the normal too).
+    pub kind: ContactKind,
+    /// The sensor noise (Nano17 by default; [`SensorNoise::NONE`] for exact readings).
+    pub noise: SensorNoise,
+    /// How far below the sphere's centre the sensor's origin is (m). Default 15 mm.
+    pub sensor_depth: f64,
+    /// The normal force each touching tip applies when the tips alone cannot hold the
+    /// object (N). Default 2 N.
+    pub squeeze: f64,
+}
+
+impl Default for FingertipSettings {
+    fn default() -> Self {
+        FingertipSettings {
+            kind: ContactKind::Point,
+            noise: SensorNoise::default(),
+            sensor_depth: 0.015,
+            squeeze: 2.0,
+        }
+    }
+}
+
+/// A fingertip of a hand: a sphere body on a finger.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fingertip {
+    pub finger: usize,
+    /// Index of the body in [`Hand::links`] (and in a grasp's link poses).
+    pub link: usize,
+    /// The body's name.
+    pub name: String,
+    pub radius: f64,
+}
+
+/// The fingertips of `hand`: the last sphere body of each finger. A hand without any is an
+/// error naming it (a force-sensing hand needs spherical fingertips).
+pub fn fingertips(hand: &dyn Hand) -> Result<Vec<Fingertip>, TrialError> {
+    let mut tips: Vec<Fingertip> = Vec::new();
+    for (i, link) in hand.links().iter().enumerate() {
+        if let (Some(finger), LinkShape::Sphere { radius }) = (link.finger, &link.shape) {
+            let tip = Fingertip {
+                finger,
+                link: i,
+                name: link.name.clone(),
+                radius: *radius,
+            };
+            match tips.iter_mut().find(|t| t.finger == finger) {
+                Some(t) => *t = tip,
+                None => tips.push(tip),
+            }
+        }
+    }
+    if tips.is_empty() {
+        return Err(TrialError::Settings(format!(
+            "hand {} has no spherical fingertips to carry force sensors (barrett_ft has)",
+            hand.name()
+        )));
+    }
+    tips.sort_by_key(|t| t.finger);
+    Ok(tips)
+}
+
+/// A contact of a fingertip, in the world frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FingertipContact {
+    pub point: Point3<f64>,
+    /// Unit normal into the object (the fingertip's outward normal).
+    pub normal: Vector3<f64>,
+    /// The force the fingertip applies to the object (N).
+    pub force: Vector3<f64>,
+    /// The moment about `normal` the fingertip applies to the object (N m).
+    pub torsion: f64,
+}
+
+impl FingertipContact {
+    /// As a quality contact (position and normal).
+    pub fn contact(&self) -> Contact {
+        Contact::new(self.point.coords, self.normal)
+    }
+}
+
+/// One fingertip's sensor in a trial: where it is, its surface, what it read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorReading {
+    pub finger: usize,
+    /// The fingertip body's name.
+    pub link: String,
+    /// The sensor frame in the world.
+    pub sensor_pose: Isometry3<f64>,
+    /// The fingertip surface in the sensor frame.
+    pub surface: FingertipSurface,
+    /// The wrench on the fingertip, sensor frame.
+    pub reading: Reading,
+}
+
+/// A simulated fingertip: its sensor reading and the contact it was made from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulatedFingertip {
+    pub sensor: SensorReading,
+    pub truth: FingertipContact,
+}
+
+/// The friction model the fingertips transmit: the score's friction (and torsion, for soft
+/// fingers) with the kind of contact the sensors assume.
+pub fn fingertip_model(kind: ContactKind, score: &FrictionModel) -> FrictionModel {
+    let (mu, edges, gamma) = match *score {
+        FrictionModel::Frictionless => (0.0, 8, 0.0),
+        FrictionModel::PointFriction { mu, edges } => (mu, edges, 0.0),
+        FrictionModel::SoftFinger { mu, edges, gamma } => (mu, edges, gamma),
+    };
+    match kind {
+        ContactKind::Point => FrictionModel::PointFriction { mu, edges },
+        ContactKind::SoftFinger => FrictionModel::SoftFinger { mu, edges, gamma },
+    }
+}
+
+/// The sensor readings of the touching fingertips of a simulated trial (see the module
+/// documentation), with noise from `rng`.
+pub fn simulate_readings<R: rand::Rng + ?Sized>(
+    outcome: &TrialOutcome,
+    hand: &dyn Hand,
+    object: &Object,
+    score: &ScoreSettings,
+    forces: &ForceSettings,
+    settings: &FingertipSettings,
+    rng: &mut R,
+) -> Result<Vec<SimulatedFingertip>, TrialError> {
+    settings.noise.validate().map_err(sensing_settings)?;
+    if !(settings.sensor_depth.is_finite()
+        && settings.squeeze.is_finite()
+        && settings.squeeze > 0.0)
+    {
+        return Err(TrialError::Settings(format!(
+            "sensor_depth must be finite and squeeze finite and > 0, got {} and {}",
+            settings.sensor_depth, settings.squeeze
+        )));
+    }
+    let grasp = &outcome.grasp;
+    let mut touching = Vec::new();
+    for tip in fingertips(hand)? {
+        if !grasp.link_touching.get(tip.link).copied().unwrap_or(false) {
+            continue;
+        }
+        let Some(body) = grasp.link_poses.get(tip.link) else {
+            continue;
+        };
+        let centre = Point3::from(body.translation.vector);
+        let nearest = object.closest_point(&centre)?;
+        let to = nearest.point - centre;
+        if to.norm() <= 0.0 {
+            continue;
+        }
+        let normal = to.normalize();
+        let sensor_pose = body * Translation3::new(0.0, 0.0, -settings.sensor_depth);
+        let point = centre + normal * tip.radius;
+        touching.push((tip, sensor_pose, point, normal));
+    }
+    let contacts: Vec<Contact> = touching
+        .iter()
+        .map(|(_, _, p, n)| Contact::new(p.coords, *n))
+        .collect();
+    let model = fingertip_model(settings.kind, &score.model);
+    let reference = grasp_model(outcome, object, score)?.reference_point;
+    let applied =
+        match analyse_contacts(&contacts, &model, &reference, object, forces, None)?.resisting {
+            Resisting::Forces { forces, .. } if !contacts.is_empty() => forces,
+            _ => ContactForces::without_torsion(
+                contacts
+                    .iter()
+                    .map(|c| c.normal * settings.squeeze)
+                    .collect(),
+            ),
+        };
+    let mut out = Vec::with_capacity(touching.len());
+    for (i, (tip, sensor_pose, point, normal)) in touching.into_iter().enumerate() {
+        let truth = FingertipContact {
+            point,
+            normal,
+            force: applied.forces[i],
+            torsion: applied.torsions[i],
+        };
+        let surface = FingertipSurface::Sphere {
+            center: [0.0, 0.0, settings.sensor_depth],
+            radius: tip.radius,
+            base_z: None,
+        };
+        let inverse = sensor_pose.inverse();
+        let exact = reading_of(
+            &surface,
+            &(inverse * point),
+            &(inverse * truth.force),
+            truth.torsion,
+        );
+        let reading = settings.noise.apply(&exact, rng);
+        out.push(SimulatedFingertip {
+            sensor: SensorReading {
+                finger: tip.finger,
+                link: tip.name,
+                sensor_pose,
+                surface,
+                reading,
+            },
+            truth,
+        });
+    }
+    Ok(out)
+}
+
+/// The contact a sensor reading stands for, in the world frame, or why there is none.
+pub fn sense(
+    sensor: &SensorReading,
+    settings: &SensingSettings,
+) -> Result<FingertipContact, NoContact> {
+    let c = locate(&sensor.surface, &sensor.reading, settings)?;
+    let pose = &sensor.sensor_pose;
+    Ok(FingertipContact {
+        point: pose * c.point,
+        normal: pose * c.normal.into_inner(),
+        force: pose * c.force,
+        torsion: c.torsion,
+    })
+}
+
+fn sensing_settings(e: graspopt_sensing::SensingError) -> TrialError {
+    TrialError::Settings(format!("sensor noise: {e}"))
+}
