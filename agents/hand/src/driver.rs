@@ -1,14 +1,48 @@
 //! What a hand driver is: the one trait a real robot's integrator implements.
 
-use graspopt_protocol::{FingerCloud, ObjectEstimate, Pose, TrialCommand};
+use graspopt_protocol::{FingerCloud, FingertipWrench, ObjectEstimate, Pose, TrialCommand};
+use serde::{Deserialize, Serialize};
+
+/// What a hand measures of its contacts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sensing {
+    /// Contact clouds (points and normals) per finger: tactile skins, or the simulator.
+    #[default]
+    Clouds,
+    /// A six-axis force/torque sensor under each fingertip: the metric agent finds the
+    /// contacts from the readings.
+    Ft,
+}
+
+impl Sensing {
+    /// Every kind, in the order `--help` lists them.
+    pub const ALL: [Sensing; 2] = [Sensing::Clouds, Sensing::Ft];
+
+    /// The name users type (the serde name): `clouds`, `ft`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sensing::Clouds => "clouds",
+            Sensing::Ft => "ft",
+        }
+    }
+
+    /// A kind from its name.
+    pub fn parse(name: &str) -> Option<Sensing> {
+        Self::ALL.into_iter().find(|s| s.name() == name.trim())
+    }
+}
 
 /// What a hand measured in one trial.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HandReading {
     /// The palm pose actually reached (world).
     pub palm_pose: Pose,
-    /// The raw contact cloud of each finger in finger order, then the palm's.
+    /// The raw contact cloud of each finger in finger order, then the palm's (hands that
+    /// sense [`Sensing::Clouds`]).
     pub fingers: Vec<FingerCloud>,
+    /// The fingertip force/torque readings (hands that sense [`Sensing::Ft`]).
+    pub fingertips: Vec<FingertipWrench>,
     /// Smallest distance between a link and the object (metres) when nothing touches;
     /// `None` when unknown.
     pub min_gap: Option<f64>,
@@ -25,6 +59,12 @@ pub trait HandDriver: Send + 'static {
     /// The hand this driver moves (`barrett`, ...): commands for another hand are refused
     /// without calling [`HandDriver::execute`]. `None`: the driver decides per command.
     fn hand(&self) -> Option<&str>;
+
+    /// What the hand measures: clouds (sent as `ContactClouds`) or fingertip forces (sent as
+    /// `FingertipWrenches`).
+    fn sensing(&self) -> Sensing {
+        Sensing::Clouds
+    }
 
     /// Whether it cannot execute yet for want of the run's object estimate (the simulated
     /// hand builds its world from it): a command then waits for an estimate.

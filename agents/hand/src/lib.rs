@@ -44,6 +44,7 @@
 //!         Ok(HandReading {
 //!             palm_pose: command.palm_pose,
 //!             fingers: vec![finger(0, 1.0), finger(1, -1.0)],
+//!             fingertips: Vec::new(),
 //!             min_gap: None,
 //!         })
 //!     }
@@ -67,9 +68,11 @@ use std::time::Duration;
 
 use graspopt_bus::Bus;
 use graspopt_protocol::RunId;
+use graspopt_trial::fingertips::FingertipSettings;
+use graspopt_trial::forces::ForceSettings;
 use serde::{Deserialize, Serialize};
 
-pub use driver::{HandDriver, HandError, HandReading};
+pub use driver::{HandDriver, HandError, HandReading, Sensing};
 pub use replay::ReplayHand;
 pub use serve::{UNIQUE_WAIT, serve};
 pub use simulated::{SimulatedHand, world_object};
@@ -91,6 +94,13 @@ pub struct HandConfig {
     pub trial_cost_ms: u64,
     /// Answer trials from this recording (JSON lines, see [`replay`]) instead of simulating.
     pub replay: Option<PathBuf>,
+    /// What the simulated hand measures: contact clouds, or fingertip force/torque readings
+    /// (a hand with spherical fingertips, `barrett_ft`).
+    pub sensing: Sensing,
+    /// The simulated fingertip sensors (with `sensing = "ft"`).
+    pub fingertips: FingertipSettings,
+    /// The simulated world's object: its mass and gravity, which the fingertips' forces hold.
+    pub forces: ForceSettings,
 }
 
 impl Default for HandConfig {
@@ -103,12 +113,16 @@ impl Default for HandConfig {
             mesh_scale: 1.0,
             trial_cost_ms: 0,
             replay: None,
+            sensing: Sensing::Clouds,
+            fingertips: FingertipSettings::default(),
+            forces: ForceSettings::default(),
         }
     }
 }
 
 /// Serves trial commands with the hand `config` describes (the replay hand when `replay`
-/// is set, else the simulated one) until the task is cancelled.
+/// is set, else the simulated one, measuring clouds or fingertip forces per `sensing`) until
+/// the task is cancelled.
 pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
     let cost = Duration::from_millis(config.trial_cost_ms);
     if let Some(path) = &config.replay {

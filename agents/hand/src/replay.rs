@@ -157,6 +157,7 @@ impl RecordedTrial {
             palm_pose: self.palm_pose,
             fingers: self.fingers.clone(),
             min_gap: self.min_gap,
+            fingertips: Vec::new(),
         }
     }
 

@@ -4,10 +4,12 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudSender, Inbox, Subscription, now_ms};
-use graspopt_protocol::keys::{COMMAND, OBJECT};
-use graspopt_protocol::{AgentKind, ContactClouds, ObjectEstimate, RunId, TrialCommand};
+use graspopt_protocol::keys::{COMMAND, OBJECT, WRENCHES};
+use graspopt_protocol::{
+    AgentKind, ContactClouds, Encoding, FingertipWrenches, ObjectEstimate, RunId, TrialCommand,
+};
 
-use crate::driver::{HandDriver, HandError, HandReading};
+use crate::driver::{HandDriver, HandError, HandReading, Sensing};
 
 /// How long a starting hand waits for a predecessor with its id to vanish (a worker killed
 /// and restarted at once) before refusing to start.
@@ -18,8 +20,10 @@ pub const UNIQUE_WAIT: Duration = Duration::from_secs(5);
 /// it is alive, see [`UNIQUE_WAIT`]), subscribes, declares itself alive, then for each
 /// command of this run and worker executes it on a thread of its own, pads the trial to at
 /// least `cost` (a robot's cycle time), and sends the clouds, tagged with the trial, to the
-/// metric agents. A failed execution is sent as clouds with the reason in `error`. Messages
-/// of other runs or workers, and ones that do not decode, are counted and logged.
+/// metric agents (or, for a driver that senses [`Sensing::Ft`], the fingertip readings on
+/// the wrenches topic). A failed execution is sent as clouds (readings) with the reason in
+/// `error`. Messages of other runs or workers, and ones that do not decode, are counted and
+/// logged.
 pub async fn serve(
     bus: &Bus,
     run: &RunId,
@@ -65,11 +69,21 @@ pub async fn serve(
         if let Some(rest) = cost.checked_sub(started.elapsed()) {
             tokio::time::sleep(rest).await;
         }
-        let clouds = tag(&command, id, driver.hand(), outcome);
-        if let Err(e) = sender.send(&clouds).await {
+        let sent = match driver.sensing() {
+            Sensing::Clouds => sender
+                .send(&tag(&command, id, driver.hand(), outcome))
+                .await
+                .map(|_| ()),
+            Sensing::Ft => {
+                let readings = tag_wrenches(&command, id, driver.hand(), outcome);
+                bus.put(&WRENCHES.key(run.into()), &readings, Encoding::Bincode)
+                    .await
+            }
+        };
+        if let Err(e) = sent {
             tracing::warn!(
-                "hand {id}: cannot send the clouds of trial {}: {e}",
-                clouds.trial_id
+                "hand {id}: cannot send what it measured in trial {}: {e}",
+                command.trial_id
             );
         }
     }
@@ -143,6 +157,32 @@ pub fn tag(
     }
 }
 
+/// The fingertip readings answering `command`, sent by worker `id` now: the reading, or no
+/// readings and the reason in `error`. `hand`: the driver's hand (`None`: the one asked for).
+pub fn tag_wrenches(
+    command: &TrialCommand,
+    id: &str,
+    hand: Option<&str>,
+    outcome: Result<HandReading, HandError>,
+) -> FingertipWrenches {
+    let (palm_pose, fingertips, min_gap, error) = match outcome {
+        Ok(r) => (r.palm_pose, r.fingertips, r.min_gap, None),
+        Err(e) => (command.palm_pose, Vec::new(), None, Some(e.0)),
+    };
+    FingertipWrenches {
+        run_id: command.run_id.clone(),
+        trial_id: command.trial_id,
+        attempt: command.attempt,
+        worker: id.to_string(),
+        hand: hand.unwrap_or(&command.hand).to_string(),
+        palm_pose,
+        fingertips,
+        min_gap,
+        error,
+        executed_ms: now_ms(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::{Arc, Mutex};
@@ -191,6 +231,7 @@ mod tests {
                     }],
                 }],
                 min_gap: Some(0.5),
+                fingertips: Vec::new(),
             })
         }
     }

@@ -1,12 +1,19 @@
-//! The simulated hand: a [`HandDriver`] on the grasp simulator.
+//! The simulated hand: a [`HandDriver`] on the grasp simulator. It measures contact clouds, or
+//! with [`Sensing::Ft`] the readings of force/torque sensors under its spherical fingertips
+//! (`graspopt_trial::fingertips`), with sensor noise drawn from a generator seeded by the
+//! trial and attempt, so a trial reads the same each time it is executed.
 
 use anyhow::Context;
-use graspopt_convert::{TrialTag, clouds_from_outcome, isometry};
-use graspopt_protocol::{ObjectEstimate, TrialCommand};
+use graspopt_convert::{TrialTag, clouds_from_outcome, isometry, pose};
+use graspopt_protocol::{FingertipWrench, ObjectEstimate, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
+use graspopt_trial::ScoreSettings;
+use graspopt_trial::fingertips::{fingertips, simulate_readings};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 
 use crate::HandConfig;
-use crate::driver::{HandDriver, HandError, HandReading};
+use crate::driver::{HandDriver, HandError, HandReading, Sensing};
 
 /// A simulated hand in a simulated world: the world holds the configured object, or the one
 /// perception names at its true pose.
@@ -22,10 +29,21 @@ pub struct SimulatedHand {
 
 impl SimulatedHand {
     /// The hand `config.hand` in the world of `config` (empty until an object estimate
-    /// arrives when no object is configured).
+    /// arrives when no object is configured). Sensing forces needs a hand with spherical
+    /// fingertips.
     pub fn new(config: &HandConfig) -> anyhow::Result<SimulatedHand> {
+        let hand = hand_by_name(&config.hand).context("hand agent")?;
+        if config.sensing == Sensing::Ft {
+            fingertips(hand.as_ref()).context("hand agent with --sensing ft")?;
+            config
+                .fingertips
+                .noise
+                .validate()
+                .context("hand agent: fingertip sensor noise")?;
+            config.forces.validate().context("hand agent")?;
+        }
         Ok(SimulatedHand {
-            hand: hand_by_name(&config.hand).context("hand agent")?,
+            hand,
             settings: ContactModelSettings::default(),
             config: config.clone(),
             world: world_object(config, None),
@@ -49,9 +67,41 @@ impl SimulatedHand {
             worker: command.worker.clone(),
         };
         let clouds = clouds_from_outcome(&tag, &outcome, 0);
+        if self.config.sensing == Sensing::Clouds {
+            return Ok(HandReading {
+                palm_pose: clouds.palm_pose,
+                fingers: clouds.fingers,
+                fingertips: Vec::new(),
+                min_gap: clouds.min_gap,
+            });
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(command.trial_id ^ (u64::from(command.attempt) << 48));
+        let tips = simulate_readings(
+            &outcome,
+            self.hand.as_ref(),
+            world,
+            &ScoreSettings::default(),
+            &self.config.forces,
+            &self.config.fingertips,
+            &mut rng,
+        )
+        .map_err(|e| HandError(format!("fingertip sensors: {e}")))?;
+        let stamp_ms = graspopt_bus::now_ms();
         Ok(HandReading {
             palm_pose: clouds.palm_pose,
-            fingers: clouds.fingers,
+            fingers: Vec::new(),
+            fingertips: tips
+                .into_iter()
+                .map(|t| FingertipWrench {
+                    finger: t.sensor.finger as u32,
+                    link: t.sensor.link,
+                    sensor_pose: pose(&t.sensor.sensor_pose),
+                    surface: t.sensor.surface,
+                    force: t.sensor.reading.force.into(),
+                    torque: t.sensor.reading.torque.into(),
+                    stamp_ms,
+                })
+                .collect(),
             min_gap: clouds.min_gap,
         })
     }
@@ -60,6 +110,10 @@ impl SimulatedHand {
 impl HandDriver for SimulatedHand {
     fn hand(&self) -> Option<&str> {
         Some(self.hand.name())
+    }
+
+    fn sensing(&self) -> Sensing {
+        self.config.sensing
     }
 
     fn needs_object(&self) -> bool {

@@ -1,11 +1,20 @@
-//! The metric agent: turns each trial's contact clouds into a quality result.
+//! The metric agent: turns each trial's contact clouds, or its fingertip force/torque
+//! readings, into a quality result with its contact-force analysis.
 //!
 //! Contact models are built from the raw clouds on the *estimated* object (perception's), as
 //! a real system must, then scored with the configured contact model, frame and metric (the
 //! thesis's defaults: surface model, soft fingers, object frame, BW). Clouds arrive over
-//! shared memory from hands on this host and over Zenoh from the others.
+//! shared memory from hands on this host and over Zenoh from the others. A hand with
+//! force/torque sensors in its fingertips sends readings instead: each fingertip's contact is
+//! found from its reading (intrinsic contact sensing), and the contacts are scored as one-point
+//! clouds; a reading that admits no contact is left out, with the reason in the log.
 //!
-//! [`score_clouds`] is the logic (no network); [`run`] wires it to the bus.
+//! Every result carries a force analysis (`TrialResult::forces`): the least forces in the
+//! friction cones that hold the object's weight, and for measured forces their net wrench and
+//! slip margins (`graspopt_trial::forces`).
+//!
+//! [`score_clouds`] and [`score_wrenches`] are the logic (no network); [`run`] wires them to
+//! the bus.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 use std::collections::VecDeque;
@@ -13,14 +22,23 @@ use std::sync::Arc;
 
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudReceiver};
-use graspopt_convert::{measured_from_clouds, metric_values, object_from_estimate};
-use graspopt_protocol::keys::{OBJECT, RESULT};
-use graspopt_protocol::{
-    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, RunId, TrialResult,
+use graspopt_convert::{
+    force_analysis, measured_from_clouds, measured_from_fingertips, metric_values,
+    object_from_estimate, sensor_reading,
 };
+use graspopt_protocol::keys::{OBJECT, RESULT, WRENCHES};
+use graspopt_protocol::{
+    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, FingertipWrenches, RunId,
+    TrialResult,
+};
+use graspopt_quality::forces::ContactForces;
+use graspopt_sensing::SensingSettings;
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
-use graspopt_trial::measured::score_measured;
+use graspopt_trial::fingertips::{fingertip_model, sense};
+use graspopt_trial::forces::{ForceSettings, analyse_contacts, analyse_outcome};
+use graspopt_trial::measured::{MeasuredTrial, score_measured};
+use graspopt_trial::score::grasp_model;
 use serde::{Deserialize, Serialize};
 
 /// Metric settings.
@@ -32,6 +50,10 @@ pub struct MetricConfig {
     pub contacts: ContactModelSettings,
     /// Contact model, frame, torque scale and metric of the score.
     pub score: ScoreSettings,
+    /// How fingertip force/torque readings are turned into contacts.
+    pub sensing: SensingSettings,
+    /// What the force analysis holds the grasp against (the object's weight).
+    pub forces: ForceSettings,
 }
 
 impl Default for MetricConfig {
@@ -40,6 +62,8 @@ impl Default for MetricConfig {
             id: "metric".into(),
             contacts: ContactModelSettings::default(),
             score: ScoreSettings::default(),
+            sensing: SensingSettings::default(),
+            forces: ForceSettings::default(),
         }
     }
 }
@@ -66,16 +90,103 @@ pub fn score_clouds(clouds: &ContactClouds, object: &Object, config: &MetricConf
         return result;
     }
     let measured = measured_from_clouds(clouds);
-    match score_measured(&measured, object, &config.contacts, &config.score) {
-        Ok((s, _)) => {
+    let scored = score_measured(&measured, object, &config.contacts, &config.score)
+        .and_then(|(s, outcome)| {
+            let forces = analyse_outcome(&outcome, object, &config.score, &config.forces)?;
+            Ok((s, forces))
+        });
+    match scored {
+        Ok((s, forces)) => {
             result.score = s.score;
             result.metrics = s.metrics.as_ref().map(metric_values);
             result.contacts = s.contacts as u32;
             result.fingers_in_contact = s.fingers_in_contact as u32;
+            result.forces = Some(force_analysis(&forces));
         }
         Err(e) => result.error = Some(format!("scoring failed: {e}")),
     }
     result
+}
+
+/// Scores one trial's fingertip readings on the estimated object: each reading's contact
+/// (intrinsic contact sensing), scored as a one-point cloud per fingertip, and the measured
+/// forces analysed. A reading that admits no contact is left out and its reason returned
+/// (`finger: reason`). Errors become a result with `error` set, as for clouds.
+pub fn score_wrenches(
+    readings: &FingertipWrenches,
+    object: &Object,
+    config: &MetricConfig,
+) -> (TrialResult, Vec<String>) {
+    let mut result = TrialResult {
+        run_id: readings.run_id.clone(),
+        trial_id: readings.trial_id,
+        attempt: readings.attempt,
+        worker: readings.worker.clone(),
+        scorer: config.id.clone(),
+        score: 0.0,
+        metrics: None,
+        contacts: 0,
+        fingers_in_contact: 0,
+        cloud_points: readings.fingertips.len() as u32,
+        cloud_transport: String::new(),
+        error: readings.error.clone(),
+        forces: None,
+    };
+    let mut refused = Vec::new();
+    if result.error.is_some() {
+        return (result, refused);
+    }
+    let mut contacts = Vec::new();
+    for tip in &readings.fingertips {
+        match sense(&sensor_reading(tip), &config.sensing) {
+            Ok(c) => contacts.push((tip.finger as usize, tip.link.clone(), c)),
+            Err(why) => refused.push(format!("finger {} ({}): {why}", tip.finger, tip.link)),
+        }
+    }
+    let measured = measured_from_fingertips(
+        &readings.hand,
+        &readings.palm_pose,
+        &contacts,
+        readings.min_gap,
+    );
+    match score_sensed(&measured, &contacts, object, config) {
+        Ok((s, forces)) => {
+            result.score = s.score;
+            result.metrics = s.metrics.as_ref().map(metric_values);
+            result.contacts = s.contacts as u32;
+            result.fingers_in_contact = s.fingers_in_contact as u32;
+            result.forces = Some(forces);
+        }
+        Err(e) => result.error = Some(format!("scoring failed: {e}")),
+    }
+    (result, refused)
+}
+
+/// The score of sensed fingertip contacts and the analysis of their measured forces.
+fn score_sensed(
+    measured: &MeasuredTrial,
+    contacts: &[(usize, String, graspopt_trial::fingertips::FingertipContact)],
+    object: &Object,
+    config: &MetricConfig,
+) -> Result<(graspopt_trial::TrialScore, graspopt_protocol::ForceAnalysis), graspopt_trial::TrialError>
+{
+    let (s, outcome) = score_measured(measured, object, &config.contacts, &config.score)?;
+    let reference = grasp_model(&outcome, object, &config.score)?.reference_point;
+    let quality: Vec<_> = contacts.iter().map(|(_, _, c)| c.contact()).collect();
+    let forces = ContactForces::new(
+        contacts.iter().map(|(_, _, c)| c.force).collect(),
+        contacts.iter().map(|(_, _, c)| c.torsion).collect(),
+    );
+    let model = fingertip_model(config.sensing.kind, &config.score.model);
+    let analysis = analyse_contacts(
+        &quality,
+        &model,
+        &reference,
+        object,
+        &config.forces,
+        (!contacts.is_empty()).then_some(forces),
+    )?;
+    Ok((s, force_analysis(&analysis)))
 }
 
 /// The failed result of an attempt whose clouds were invalid (a NaN, a normal that is not
@@ -110,13 +221,14 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
         .validate()
         .context("metric agent settings")?;
     let mut clouds = CloudReceiver::open(bus, run).await?;
+    let wrenches = bus.subscribe(&WRENCHES.key(run.into())).await?;
     let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
     let _token = bus
         .declare_alive(run, AgentKind::Metric, &config.id)
         .await?;
     let config = Arc::new(config.clone());
     let mut object: Option<(u64, String, Arc<Object>)> = None;
-    let mut waiting: VecDeque<(ContactClouds, &'static str)> = VecDeque::new();
+    let mut waiting: VecDeque<Measured> = VecDeque::new();
     let mut bad = 0u64;
     let key = RESULT.key(run.into());
     loop {
@@ -144,7 +256,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                 }
             },
             Some(r) = clouds.recv() => match r.message {
-                Ok(c) if c.run_id == *run => waiting.push_back((c, r.path.as_str())),
+                Ok(c) if c.run_id == *run => waiting.push_back(Measured::Clouds(c, r.path.as_str())),
                 Ok(c) => {
                     bad += 1;
                     tracing::warn!("metric {}: clouds of run {:?} ignored ({bad} bad messages)", config.id, c.run_id);
@@ -165,15 +277,33 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                     }
                 }
             },
+            Some(r) = wrenches.recv() => match r.message {
+                Ok(w) if w.run_id == *run => waiting.push_back(Measured::Wrenches(w)),
+                Ok(w) => {
+                    bad += 1;
+                    tracing::warn!("metric {}: fingertip readings of run {:?} ignored ({bad} bad messages)", config.id, w.run_id);
+                }
+                Err(e) => {
+                    bad += 1;
+                    tracing::warn!("metric {}: bad fingertip readings on {} ({bad} bad messages): {e}", config.id, r.key);
+                    if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
+                        && a.run_id == *run
+                    {
+                        let failed = invalid_clouds_result(a, detail, &config.id, "zenoh");
+                        if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
+                            tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
+                        }
+                    }
+                }
+            },
             else => return Ok(()),
         }
         if let Some((_, _, o)) = &object {
-            while let Some((c, path)) = waiting.pop_front() {
+            while let Some(measured) = waiting.pop_front() {
                 let (o, cfg) = (o.clone(), config.clone());
-                let mut result = tokio::task::spawn_blocking(move || score_clouds(&c, &o, &cfg))
+                let result = tokio::task::spawn_blocking(move || measured.score(&o, &cfg))
                     .await
                     .context("metric: scoring thread panicked")?;
-                result.cloud_transport = path.to_string();
                 if let Err(e) = bus.put(&key, &result, Encoding::Bincode).await {
                     tracing::warn!(
                         "metric {}: cannot publish result of trial {}: {e}",
@@ -181,6 +311,38 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                         result.trial_id
                     );
                 }
+            }
+        }
+    }
+}
+
+/// What a hand sent for one trial, waiting for the object estimate.
+enum Measured {
+    /// Clouds and how they came (`shm`, `zenoh`).
+    Clouds(ContactClouds, &'static str),
+    Wrenches(FingertipWrenches),
+}
+
+impl Measured {
+    /// Its result; refused fingertip readings are logged.
+    fn score(self, object: &Object, config: &MetricConfig) -> TrialResult {
+        match self {
+            Measured::Clouds(c, path) => {
+                let mut result = score_clouds(&c, object, config);
+                result.cloud_transport = path.to_string();
+                result
+            }
+            Measured::Wrenches(w) => {
+                let (mut result, refused) = score_wrenches(&w, object, config);
+                for why in refused {
+                    tracing::info!(
+                        "metric {}: trial {}: no contact from fingertip reading of {why}",
+                        config.id,
+                        w.trial_id
+                    );
+                }
+                result.cloud_transport = "zenoh".to_string();
+                result
             }
         }
     }

@@ -4,9 +4,14 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 use graspopt_protocol::{
-    CloudPoint, ContactClouds, FingerCloud, MeshData, MetricValues, ObjectEstimate, Pose, RunId,
+    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData,
+    MetricValues, ObjectEstimate, Pose, RunId,
 };
+use graspopt_quality::forces::Resisting;
 use graspopt_quality::metrics::Metrics;
+use graspopt_sensing::Reading;
+use graspopt_trial::fingertips::{FingertipContact, SensorReading};
+use graspopt_trial::forces::GraspForces;
 use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::measured::{MeasuredFinger, MeasuredTrial};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
@@ -122,6 +127,66 @@ pub fn measured_from_clouds(clouds: &ContactClouds) -> MeasuredTrial {
             })
             .collect(),
         min_gap: clouds.min_gap,
+    }
+}
+
+/// A fingertip sensor's reading from its message.
+pub fn sensor_reading(w: &FingertipWrench) -> SensorReading {
+    SensorReading {
+        finger: w.finger as usize,
+        link: w.link.clone(),
+        sensor_pose: isometry(&w.sensor_pose),
+        surface: w.surface,
+        reading: Reading {
+            force: Vector3::from(w.force),
+            torque: Vector3::from(w.torque),
+        },
+    }
+}
+
+/// What a force-sensing hand measured, as contacts: one point per sensed fingertip, on the
+/// fingertip (`contacts`: `(finger, fingertip name, contact)`), for scoring as clouds are.
+pub fn measured_from_fingertips(
+    hand: &str,
+    palm_pose: &Pose,
+    contacts: &[(usize, String, FingertipContact)],
+    min_gap: Option<f64>,
+) -> MeasuredTrial {
+    MeasuredTrial {
+        hand: hand.to_string(),
+        palm_pose: isometry(palm_pose),
+        fingers: contacts
+            .iter()
+            .map(|(finger, link, c)| MeasuredFinger {
+                finger: Some(*finger),
+                links: vec![link.clone()],
+                points: vec![ContactPoint {
+                    position: c.point,
+                    normal: c.normal,
+                    weight: 1.0,
+                }],
+            })
+            .collect(),
+        min_gap,
+    }
+}
+
+/// A trial's force analysis on the wire.
+pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
+    let (resisting_norm, resisting_max) = match &g.resisting {
+        Resisting::Forces { norm, .. } => (Some(*norm), g.resisting_max()),
+        Resisting::CannotResist { .. } => (None, None),
+    };
+    ForceAnalysis {
+        external: g.external.into(),
+        resisting_norm,
+        resisting_max,
+        net_wrench: g.measured.as_ref().map(|m| m.net.into()),
+        slip_margins: g
+            .measured
+            .as_ref()
+            .map(|m| m.margins.iter().map(|s| s.friction).collect())
+            .unwrap_or_default(),
     }
 }
 

@@ -240,7 +240,9 @@ pub fn decode_topic(
     encoding: Encoding,
 ) -> Result<Value, DecodeError> {
     use crate::Topic;
-    use crate::messages::{ContactClouds, ObjectEstimate, RunStatus, TrialCommand, TrialResult};
+    use crate::messages::{
+        ContactClouds, FingertipWrenches, ObjectEstimate, RunStatus, TrialCommand, TrialResult,
+    };
     fn json<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<Value, DecodeError> {
         let msg = decode::<T>(bytes, encoding)?;
         serde_json::to_value(&msg).map_err(|e| DecodeError::Malformed {
@@ -253,6 +255,7 @@ pub fn decode_topic(
         Topic::Object => json::<ObjectEstimate>(bytes, encoding),
         Topic::Command => json::<TrialCommand>(bytes, encoding),
         Topic::Clouds => json::<ContactClouds>(bytes, encoding),
+        Topic::Wrenches => json::<FingertipWrenches>(bytes, encoding),
         Topic::Result => json::<TrialResult>(bytes, encoding),
         Topic::Status => json::<RunStatus>(bytes, encoding),
     }

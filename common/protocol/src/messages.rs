@@ -264,6 +264,86 @@ impl Message for ContactClouds {
     }
 }
 
+/// The fingertip surface a force/torque sensor carries, in the sensor frame: a sphere, an
+/// ellipsoid or a capsule (`{"shape": "sphere", "center": [0, 0, 0.015], "radius": 0.012}`).
+pub use graspopt_sensing::FingertipSurface;
+
+/// One fingertip force/torque sensor's reading in a trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FingertipWrench {
+    /// The finger (0-based, in the hand's finger order).
+    pub finger: u32,
+    /// The fingertip's name (a link of the hand), for people and logs.
+    pub link: String,
+    /// The sensor frame in the world when it read.
+    pub sensor_pose: Pose,
+    /// The fingertip's surface, in the sensor frame.
+    pub surface: FingertipSurface,
+    /// The force the object applies to the fingertip, sensor frame (N).
+    pub force: [f64; 3],
+    /// The torque of that contact about the sensor frame's origin, sensor frame (N m).
+    pub torque: [f64; 3],
+    /// When the sensor read (milliseconds since the Unix epoch).
+    pub stamp_ms: i64,
+}
+
+/// hand -> metric: what a hand's fingertip force/torque sensors read in one trial (a hand that
+/// senses forces instead of contact clouds). The metric agent finds each fingertip's contact
+/// from its reading (intrinsic contact sensing) and scores the contacts as it scores clouds.
+/// Fingertips that read nothing may be left out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FingertipWrenches {
+    pub run_id: RunId,
+    pub trial_id: u64,
+    pub attempt: u32,
+    /// The hand worker that executed the trial.
+    pub worker: String,
+    pub hand: String,
+    /// The palm pose actually reached (world).
+    pub palm_pose: Pose,
+    pub fingertips: Vec<FingertipWrench>,
+    /// Smallest distance between the hand and the object (metres) when nothing touches;
+    /// `None` when unknown (a real hand does not know it).
+    pub min_gap: Option<f64>,
+    /// Set when the hand could not execute the trial; `fingertips` is then empty.
+    pub error: Option<String>,
+    pub executed_ms: i64,
+}
+
+impl Message for FingertipWrenches {
+    const TYPE: &'static str = "FingertipWrenches";
+    fn run_id(&self) -> &RunId {
+        &self.run_id
+    }
+    fn attempt_ref(&self) -> Option<AttemptRef> {
+        Some(AttemptRef {
+            run_id: self.run_id.clone(),
+            trial_id: self.trial_id,
+            attempt: self.attempt,
+            worker: self.worker.clone(),
+        })
+    }
+    fn validate(&self) -> Result<(), String> {
+        crate::keys::check_agent_id(&self.worker).map_err(|e| format!("worker: {e}"))?;
+        self.palm_pose.validate("palm_pose")?;
+        if let Some(g) = self.min_gap
+            && !(g.is_finite() && g >= 0.0)
+        {
+            return Err(format!("min_gap must be finite and >= 0, got {g}"));
+        }
+        for (i, tip) in self.fingertips.iter().enumerate() {
+            tip.sensor_pose
+                .validate(&format!("fingertips[{i}].sensor_pose"))?;
+            tip.surface
+                .validate()
+                .map_err(|e| format!("fingertips[{i}].surface: {e}"))?;
+            finite(&format!("fingertips[{i}].force"), &tip.force)?;
+            finite(&format!("fingertips[{i}].torque"), &tip.torque)?;
+        }
+        Ok(())
+    }
+}
+
 /// The grasp-quality metrics of a trial (thesis chapter 2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MetricValues {

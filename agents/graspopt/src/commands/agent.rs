@@ -15,7 +15,7 @@ use graspopt_runner::config::load;
 use graspopt_runner::signal::{shutdown_signal, until_signal};
 use graspopt_sim::ParamKind;
 
-use super::setup::{SimArgs, planner_method, trial_param};
+use super::setup::{SimArgs, planner_method, sensing, trial_param};
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -81,11 +81,25 @@ pub enum Kind {
         /// them) instead of simulating.
         #[arg(long, value_name = "FILE")]
         replay: Option<PathBuf>,
+        /// What the simulated hand measures: clouds (contact points and normals), or ft
+        /// (force/torque sensors under spherical fingertips: use --hand barrett_ft).
+        #[arg(long, value_parser = sensing())]
+        sensing: Option<graspopt_hand::Sensing>,
+        /// Fingertip sensors' force resolution (N; the noise's standard deviation and
+        /// quantum; default 1/320, an ATI Nano17's; 0: exact).
+        #[arg(long, requires = "sensing")]
+        force_resolution: Option<f64>,
+        /// Fingertip sensors' torque resolution (N m; default 1.5625e-5, 1/64 N mm; 0: exact).
+        #[arg(long, requires = "sensing")]
+        torque_resolution: Option<f64>,
     },
-    /// Scores contact clouds.
+    /// Scores contact clouds and fingertip force readings.
     Metric {
         #[command(flatten)]
         common: Common,
+        /// The object's mass for the force analysis (kg; default 0.5).
+        #[arg(long)]
+        object_mass: Option<f64>,
     },
     /// Proposes trials.
     Planner {
@@ -174,6 +188,9 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             hand,
             trial_cost_ms,
             replay,
+            sensing,
+            force_resolution,
+            torque_resolution,
         } => {
             let mut c: graspopt_hand::HandConfig = load(common.config.as_deref())?;
             common.set_id(&mut c.id);
@@ -184,13 +201,21 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             if replay.is_some() {
                 c.replay = replay.clone();
             }
+            c.sensing = sensing.unwrap_or(c.sensing);
+            let noise = &mut c.fingertips.noise;
+            noise.force_resolution = force_resolution.unwrap_or(noise.force_resolution);
+            noise.torque_resolution = torque_resolution.unwrap_or(noise.torque_resolution);
             let (bus, run) = join(common).await?;
             until_signal(graspopt_hand::run(&bus, &run, &c)).await?;
             Ok(ExitCode::SUCCESS)
         }
-        Kind::Metric { common } => {
+        Kind::Metric {
+            common,
+            object_mass,
+        } => {
             let mut c: graspopt_metric::MetricConfig = load(common.config.as_deref())?;
             common.set_id(&mut c.id);
+            c.forces.object_mass = object_mass.unwrap_or(c.forces.object_mass);
             let (bus, run) = join(common).await?;
             until_signal(graspopt_metric::run(&bus, &run, &c)).await?;
             Ok(ExitCode::SUCCESS)

@@ -67,6 +67,12 @@ pub fn trial_param() -> impl TypedValueParser<Value = ParamKind> {
     clap::builder::NonEmptyStringValueParser::new().try_map(|s| ParamKind::parse(&s))
 }
 
+/// `--sensing`: what a hand measures, by name.
+pub fn sensing() -> impl TypedValueParser<Value = graspopt_hand::Sensing> {
+    PossibleValuesParser::new(graspopt_hand::Sensing::ALL.map(graspopt_hand::Sensing::name))
+        .try_map(|s| graspopt_hand::Sensing::parse(&s).ok_or("unknown sensing"))
+}
+
 /// `--method`: the planner's methods by name.
 pub fn planner_method() -> impl TypedValueParser<Value = PlannerMethod> {
     PossibleValuesParser::new(PlannerMethod::ALL.map(PlannerMethod::name))

@@ -5,7 +5,7 @@ use std::marker::PhantomData;
 
 use super::{AgentKind, Claim, ROOT, RunId, check_agent_id};
 use crate::messages::{
-    ContactClouds, Message, ObjectEstimate, RunStatus, SuggestReply, SuggestRequest, TrialCommand,
+    ContactClouds, FingertipWrenches, Message, ObjectEstimate, RunStatus, SuggestReply, SuggestRequest, TrialCommand,
     TrialResult,
 };
 
@@ -299,6 +299,9 @@ pub const COMMAND: TopicDef<TrialCommand> =
     TopicDef::new("command", "hand/*/command", AgentKind::Coordinator);
 /// hand -> metric: the contact clouds of a trial (when not through shared memory).
 pub const CLOUDS: TopicDef<ContactClouds> = TopicDef::new("clouds", "clouds", AgentKind::Hand);
+/// hand -> metric: the fingertip force/torque readings of a trial (hands that sense forces).
+pub const WRENCHES: TopicDef<FingertipWrenches> =
+    TopicDef::new("wrenches", "wrenches", AgentKind::Hand);
 /// metric -> coordinator: a trial's score.
 pub const RESULT: TopicDef<TrialResult> = TopicDef::new("result", "result", AgentKind::Metric);
 /// coordinator -> monitors: the run's state.
@@ -311,10 +314,11 @@ pub const STATE: QueryDef<(), RunStatus> =
     QueryDef::without_request("state", "coordinator/state", AgentKind::Coordinator);
 
 /// The key table: every topic, then every query.
-pub const TABLE: [Entry; 7] = [
+pub const TABLE: [Entry; 8] = [
     OBJECT.entry,
     COMMAND.entry,
     CLOUDS.entry,
+    WRENCHES.entry,
     RESULT.entry,
     STATUS.entry,
     SUGGEST.entry,
@@ -384,15 +388,17 @@ pub enum Topic {
     Object,
     Command,
     Clouds,
+    Wrenches,
     Result,
     Status,
 }
 
 impl Topic {
-    pub const ALL: [Topic; 5] = [
+    pub const ALL: [Topic; 6] = [
         Topic::Object,
         Topic::Command,
         Topic::Clouds,
+        Topic::Wrenches,
         Topic::Result,
         Topic::Status,
     ];
@@ -403,6 +409,7 @@ impl Topic {
             Topic::Object => OBJECT.entry,
             Topic::Command => COMMAND.entry,
             Topic::Clouds => CLOUDS.entry,
+            Topic::Wrenches => WRENCHES.entry,
             Topic::Result => RESULT.entry,
             Topic::Status => STATUS.entry,
         }
