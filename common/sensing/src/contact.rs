@@ -61,6 +61,14 @@ pub struct SensingSettings {
     /// is a torsional moment the point model cannot explain, and the reading is refused
     /// ([`NoContact::Torsion`]). Default 2e-4 m.
     pub pitch_tolerance: f64,
+    /// Soft finger only: the largest ratio (m) of the torsion to the normal force,
+    /// |t| / (f . n), accepted. A soft contact's torsion is bounded by its torsional
+    /// friction, a length of the order of its contact patch times the normal force; a
+    /// larger ratio is refused ([`NoContact::TorsionBeyondLimit`]). Every reading of a
+    /// convex fingertip has a soft-finger solution, so this bound is what refuses
+    /// readings no real soft contact gives (a torsion far too large, or a force almost
+    /// tangent to the surface). Default 0.01 m.
+    pub torsion_ratio_limit: f64,
 }
 
 impl Default for SensingSettings {
@@ -70,6 +78,7 @@ impl Default for SensingSettings {
             force_threshold: 0.05,
             surface_tolerance: 1e-4,
             pitch_tolerance: 2e-4,
+            torsion_ratio_limit: 0.01,
         }
     }
 }
@@ -130,6 +139,18 @@ pub enum NoContact {
         torsion: f64,
         pitch: f64,
         tolerance: f64,
+    },
+    /// Soft finger only: the contact that explains the reading needs a torsion `torsion`
+    /// (N m) more than `limit` (m) times its normal force `normal_force` (N): more than a
+    /// soft contact can apply.
+    #[error(
+        "the soft-finger contact that explains the reading needs a torsion of {torsion:.3e} N m with a normal force of {normal_force:.4} N, more than {:.4} mm times the normal force a soft contact can apply",
+        limit * 1e3
+    )]
+    TorsionBeyondLimit {
+        torsion: f64,
+        normal_force: f64,
+        limit: f64,
     },
     /// No point of the surface explains the reading: for a point contact the force's line
     /// of action passes `distance` (m) from the surface, beyond the surface tolerance; for
@@ -204,6 +225,26 @@ pub fn reading_of(
 /// The contact that explains `reading` on `surface`, or why there is none. See the crate
 /// documentation for the method.
 pub fn locate(
+    surface: &FingertipSurface,
+    reading: &Reading,
+    settings: &SensingSettings,
+) -> Result<SensedContact, NoContact> {
+    let contact = solve(surface, reading, settings)?;
+    let normal_force = contact.force.dot(&contact.normal);
+    if settings.kind == ContactKind::SoftFinger
+        && contact.torsion.abs() > settings.torsion_ratio_limit * normal_force
+    {
+        return Err(NoContact::TorsionBeyondLimit {
+            torsion: contact.torsion,
+            normal_force,
+            limit: settings.torsion_ratio_limit,
+        });
+    }
+    Ok(contact)
+}
+
+/// [`locate`] but for the torsion limit.
+fn solve(
     surface: &FingertipSurface,
     reading: &Reading,
     settings: &SensingSettings,
