@@ -104,6 +104,12 @@ impl SensingSettings {
             self.pitch_tolerance,
             ">= 0",
             non_negative,
+        )?;
+        check(
+            "torsion_ratio_limit",
+            self.torsion_ratio_limit,
+            ">= 0",
+            non_negative,
         )
     }
 }
