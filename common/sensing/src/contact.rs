@@ -5,7 +5,7 @@ use nalgebra::{Point3, Unit, Vector3};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::error::{SensingError, check, finite};
+use crate::error::{SensingError, check};
 use crate::surface::{Domain, FingertipSurface, Piece};
 
 /// What the sensor measures: the wrench the object applies to the fingertip, in the sensor
@@ -16,17 +16,27 @@ pub struct Reading {
     pub torque: Vector3<f64>,
 }
 
+/// The largest force (N) or torque (N m) component a reading may have: far beyond any
+/// fingertip sensor's range, far below overflow.
+pub const MAX_READING: f64 = 1.0e6;
+
+/// The smallest force (N) taken as a contact whatever the threshold: below it the
+/// force's direction is noise.
+pub const MIN_FORCE: f64 = 1.0e-9;
+
 const FORCE: [&str; 3] = ["force[0]", "force[1]", "force[2]"];
 const TORQUE: [&str; 3] = ["torque[0]", "torque[1]", "torque[2]"];
 
 impl Reading {
-    /// Checks that every component is finite; the error names it.
+    /// Checks that every component is finite and at most [`MAX_READING`] in absolute
+    /// value; the error names it.
     pub fn validate(&self) -> Result<(), SensingError> {
-        for (name, value) in FORCE.iter().zip(self.force.iter()) {
-            finite(name, *value)?;
-        }
-        for (name, value) in TORQUE.iter().zip(self.torque.iter()) {
-            finite(name, *value)?;
+        let names = FORCE.iter().chain(TORQUE.iter());
+        let values = self.force.iter().chain(self.torque.iter());
+        for (name, value) in names.zip(values) {
+            check(name, *value, "at most 1e6 in absolute value", |v| {
+                v.abs() <= MAX_READING
+            })?;
         }
         Ok(())
     }
@@ -49,7 +59,8 @@ pub enum ContactKind {
 pub struct SensingSettings {
     /// The contact model.
     pub kind: ContactKind,
-    /// Readings with a force below this (N) are no contact. Default 0.05 N.
+    /// Readings with a force below this (N) are no contact (and below [`MIN_FORCE`]
+    /// whatever this is). Default 0.05 N.
     pub force_threshold: f64,
     /// How far (m) the solution may lie off the surface and still be taken, snapped onto
     /// it: a point-contact force line that grazes the surface within this distance gives
@@ -130,7 +141,8 @@ pub struct SensedContact {
 /// Why a reading gives no contact.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum NoContact {
-    /// The force is below the threshold (or zero): nothing touches the fingertip.
+    /// The force `force` (N) is below `threshold` (N): the settings' threshold, or
+    /// [`MIN_FORCE`] if that is larger. Nothing touches the fingertip.
     #[error("the force is {force:.4} N, below the contact threshold of {threshold:.4} N")]
     BelowThreshold { force: f64, threshold: f64 },
     /// Point contact only: the torque has a component `torsion` (N m) along the force,
@@ -260,10 +272,11 @@ fn solve(
     reading.validate()?;
     let f = reading.force;
     let f_norm = f.norm();
-    if f_norm < settings.force_threshold || f_norm == 0.0 {
+    let threshold = settings.force_threshold.max(MIN_FORCE);
+    if f_norm < threshold {
         return Err(NoContact::BelowThreshold {
             force: f_norm,
-            threshold: settings.force_threshold,
+            threshold,
         });
     }
     let soft = settings.kind == ContactKind::SoftFinger;

@@ -97,8 +97,9 @@ mod noise;
 mod surface;
 
 pub use contact::{
-    ContactKind, NoContact, Reading, SensedContact, SensingSettings, locate, reading_of,
+    ContactKind, MAX_READING, MIN_FORCE, NoContact, Reading, SensedContact, SensingSettings,
+    locate, reading_of,
 };
 pub use error::SensingError;
 pub use noise::SensorNoise;
-pub use surface::{FingertipSurface, MAX_SIZE};
+pub use surface::{FingertipSurface, MAX_SIZE, MIN_SIZE};

@@ -4,6 +4,7 @@
 mod analytic;
 mod inputs;
 mod noise;
+mod properties;
 mod refusals;
 mod round_trip;
 mod support;

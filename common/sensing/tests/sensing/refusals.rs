@@ -1,7 +1,8 @@
 //! Readings that admit no contact: each gives its named refusal, never a point.
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, NoContact, Reading, SensingError, SensingSettings, locate,
+    ContactKind, FingertipSurface, MIN_FORCE, NoContact, Reading, SensingError, SensingSettings,
+    locate,
 };
 use nalgebra::{Point3, Vector3};
 
@@ -64,7 +65,7 @@ fn a_small_force_is_below_the_threshold() {
             "the force is 0.0100 N, below the contact threshold of 0.0500 N"
         );
     }
-    // A zero force is no contact even with a zero threshold.
+    // A zero force is no contact even with a zero threshold: MIN_FORCE is the floor.
     let zero = SensingSettings {
         force_threshold: 0.0,
         ..SensingSettings::default()
@@ -74,9 +75,13 @@ fn a_small_force_is_below_the_threshold() {
         locate(&sphere(), &r, &zero),
         Err(NoContact::BelowThreshold {
             force: 0.0,
-            threshold: 0.0
+            threshold: MIN_FORCE
         })
     );
+    // Just above the floor, a contact.
+    let r = reading([0.0, 0.0, -2e-9], [0.0; 3]);
+    let c = locate(&sphere(), &r, &zero).expect("contact");
+    assert!((c.point - Point3::new(0.0, 0.0, 0.018)).norm() < 1e-15);
 }
 
 #[test]
@@ -285,7 +290,13 @@ fn invalid_input_is_refused_with_the_field_named() {
     let e = locate(&flat, &good, &SensingSettings::default()).expect_err("invalid");
     assert_eq!(
         e.to_string(),
-        "invalid input: radius is 0: it must be > 0 and at most 1000 m"
+        "invalid input: radius is 0: it must be between 1e-6 and 1000 m"
+    );
+    let huge = reading([0.0, 0.0, -2e6], [0.0; 3]);
+    let e = locate(&sphere(), &huge, &SensingSettings::default()).expect_err("invalid");
+    assert_eq!(
+        e.to_string(),
+        "invalid input: force[2] is -2000000: it must be at most 1e6 in absolute value"
     );
     let negative = SensingSettings {
         surface_tolerance: -1.0,
