@@ -314,15 +314,8 @@ fn solve(
         .iter()
         .filter(|c| c.pushing && c.excess == 0.0 && usable(&c.point))
         .collect();
-    if let Some(first) = exact.first() {
-        let separation = exact
-            .iter()
-            .map(|c| (c.point - first.point).norm())
-            .fold(0.0, f64::max);
-        if separation > SAME_POINT {
-            return Err(NoContact::Ambiguous { separation });
-        }
-        return Ok(contact(first));
+    if !exact.is_empty() {
+        return one_point(&exact).map(|c| contact(&c));
     }
     // Just beyond a capsule seam (noise): the least outside, snapped onto the surface.
     let near = candidates
@@ -383,6 +376,21 @@ fn solve(
             force: -f,
             torsion: 0.0,
         }),
+    }
+}
+
+/// The one point of `candidates` (not empty), or [`NoContact::Ambiguous`] when two lie
+/// more than [`SAME_POINT`] apart.
+fn one_point(candidates: &[&Candidate]) -> Result<Candidate, NoContact> {
+    let first = candidates[0];
+    let separation = candidates
+        .iter()
+        .map(|c| (c.point - first.point).norm())
+        .fold(0.0, f64::max);
+    if separation > SAME_POINT {
+        Err(NoContact::Ambiguous { separation })
+    } else {
+        Ok(*first)
     }
 }
 
@@ -521,4 +529,32 @@ fn cylinder_candidates(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(x: f64) -> Candidate {
+        Candidate {
+            point: Vector3::new(x, 0.0, 0.01),
+            normal: Vector3::x_axis(),
+            torsion: 0.0,
+            excess: 0.0,
+            pushing: true,
+        }
+    }
+
+    #[test]
+    fn two_distinct_points_are_ambiguous_a_seam_duplicate_is_one() {
+        let (a, b, c) = (candidate(0.008), candidate(0.008 + 1e-12), candidate(0.007));
+        let one = one_point(&[&a, &b]).expect("one point");
+        assert_eq!(one.point, a.point);
+        match one_point(&[&a, &b, &c]) {
+            Err(NoContact::Ambiguous { separation }) => {
+                assert!((separation - 1e-3).abs() < 1e-15, "{separation}")
+            }
+            other => panic!("expected Ambiguous, got {other:?}"),
+        }
+    }
 }

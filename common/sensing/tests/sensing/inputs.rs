@@ -1,6 +1,9 @@
 //! Validation errors (each names its field), normals, and the serde forms.
 
-use graspopt_sensing::{ContactKind, FingertipSurface, SensingError, SensingSettings, SensorNoise};
+use graspopt_sensing::{
+    ContactKind, FingertipSurface, Reading, SensedContact, SensingError, SensingSettings,
+    SensorNoise,
+};
 use nalgebra::{Point3, Vector3};
 
 use crate::support::angle;
@@ -193,6 +196,25 @@ fn json_forms() {
     assert_eq!(settings.kind, ContactKind::SoftFinger);
     assert_eq!(settings.force_threshold, 0.05);
     assert_eq!(settings.surface_tolerance, 1e-4);
+    let r: Reading =
+        serde_json::from_str(r#"{"force":[0,0,-2],"torque":[0.001,0,0]}"#).expect("reading");
+    assert_eq!(r.force, Vector3::new(0.0, 0.0, -2.0));
+    assert_eq!(r.torque, Vector3::new(0.001, 0.0, 0.0));
+    let c = SensedContact {
+        point: Point3::new(0.0, 0.0, 0.018),
+        normal: Vector3::z_axis(),
+        force: Vector3::new(0.0, 0.0, 2.0),
+        torsion: 0.0,
+    };
+    let json = serde_json::to_string(&c).expect("json");
+    assert_eq!(
+        json,
+        r#"{"point":[0.0,0.0,0.018],"normal":[0.0,0.0,1.0],"force":[0.0,0.0,2.0],"torsion":0.0}"#
+    );
+    assert_eq!(
+        serde_json::from_str::<SensedContact>(&json).expect("contact"),
+        c
+    );
     let noise: SensorNoise = serde_json::from_str("{}").expect("noise");
     assert_eq!(noise, SensorNoise::default());
     assert_eq!(noise.force_resolution, 1.0 / 320.0);
