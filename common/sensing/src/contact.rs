@@ -322,7 +322,7 @@ fn solve(
         .iter()
         .filter(|c| c.pushing && c.excess <= tol)
         .map(|c| {
-            let point = surface.snap(&Point3::from(c.point));
+            let point = surface.project(&Point3::from(c.point));
             Candidate {
                 point: point.coords,
                 normal: surface.outward_normal(&point),

@@ -199,11 +199,14 @@ impl FingertipSurface {
         }
     }
 
-    /// A point on the surface near `p` (a point within a small distance of it): `p`
-    /// moved along the normal direction of [`outward_normal`](Self::outward_normal) onto
-    /// the surface. Exact for the sphere and the capsule; for the ellipsoid the scaled
-    /// radial projection, which differs from the nearest point by second-order terms.
-    pub(crate) fn snap(&self, p: &Point3<f64>) -> Point3<f64> {
+    /// `p` moved onto the surface: radially from the centre (sphere), from the nearest
+    /// axis point (capsule), or radially in the coordinates that make the ellipsoid a unit
+    /// sphere. For the sphere and the capsule this is the nearest surface point; for the
+    /// ellipsoid it is near the nearest point when `p` is near the surface (the error is
+    /// of second order in the distance). For a contact point that a simulator puts
+    /// slightly off a fingertip model. At the centre (or on the axis), it returns the top
+    /// of the sphere or ellipsoid, or the +x side of the capsule.
+    pub fn project(&self, p: &Point3<f64>) -> Point3<f64> {
         let c = self.center();
         match *self {
             Self::Sphere { radius, .. } => {

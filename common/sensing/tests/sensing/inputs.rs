@@ -147,6 +147,19 @@ fn outward_normals() {
         0.015 * 0.5f64.sqrt() / 2.25e-4,
     ));
     assert!(angle(&e.outward_normal(&p), &want) < 1e-15);
+    // Projections onto the surface.
+    let k = capsule;
+    let on = k.project(&Point3::new(0.0, 0.007, 0.022));
+    assert!(
+        (on - Point3::new(0.0, 0.006, 0.022)).norm() < 1e-15,
+        "{on:?}"
+    );
+    let on = k.project(&Point3::new(0.0, 0.0, 0.04));
+    assert!((on - Point3::new(0.0, 0.0, 0.036)).norm() < 1e-15, "{on:?}");
+    let on = e.project(&Point3::new(0.0, 0.0, 0.0));
+    assert!((on - Point3::new(0.0, 0.0, 0.005)).norm() < 1e-15, "{on:?}");
+    let near = Point3::new(0.0101, 0.0, 0.02);
+    assert!((e.project(&near) - Point3::new(0.01, 0.0, 0.02)).norm() < 1e-15);
     // At the centre the normal is undefined: +z, not NaN.
     assert_eq!(
         e.outward_normal(&Point3::new(0.0, 0.0, 0.02)),
