@@ -5,7 +5,7 @@ use nalgebra::{Point3, Unit, Vector3};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::error::{SensingError, check, finite};
+use crate::error::{SensingError, check};
 use crate::surface::{Domain, FingertipSurface, Piece};
 
 /// What the sensor measures: the wrench the object applies to the fingertip, in the sensor
@@ -16,17 +16,27 @@ pub struct Reading {
     pub torque: Vector3<f64>,
 }
 
+/// The largest force (N) or torque (N m) component a reading may have: far beyond any
+/// fingertip sensor's range, far below overflow.
+pub const MAX_READING: f64 = 1.0e6;
+
+/// The smallest force (N) taken as a contact whatever the threshold: below it the
+/// force's direction is noise.
+pub const MIN_FORCE: f64 = 1.0e-9;
+
 const FORCE: [&str; 3] = ["force[0]", "force[1]", "force[2]"];
 const TORQUE: [&str; 3] = ["torque[0]", "torque[1]", "torque[2]"];
 
 impl Reading {
-    /// Checks that every component is finite; the error names it.
+    /// Checks that every component is finite and at most [`MAX_READING`] in absolute
+    /// value; the error names it.
     pub fn validate(&self) -> Result<(), SensingError> {
-        for (name, value) in FORCE.iter().zip(self.force.iter()) {
-            finite(name, *value)?;
-        }
-        for (name, value) in TORQUE.iter().zip(self.torque.iter()) {
-            finite(name, *value)?;
+        let names = FORCE.iter().chain(TORQUE.iter());
+        let values = self.force.iter().chain(self.torque.iter());
+        for (name, value) in names.zip(values) {
+            check(name, *value, "at most 1e6 in absolute value", |v| {
+                v.abs() <= MAX_READING
+            })?;
         }
         Ok(())
     }
@@ -49,7 +59,8 @@ pub enum ContactKind {
 pub struct SensingSettings {
     /// The contact model.
     pub kind: ContactKind,
-    /// Readings with a force below this (N) are no contact. Default 0.05 N.
+    /// Readings with a force below this (N) are no contact (and below [`MIN_FORCE`]
+    /// whatever this is). Default 0.05 N.
     pub force_threshold: f64,
     /// How far (m) the solution may lie off the surface and still be taken, snapped onto
     /// it: a point-contact force line that grazes the surface within this distance gives
@@ -61,6 +72,14 @@ pub struct SensingSettings {
     /// is a torsional moment the point model cannot explain, and the reading is refused
     /// ([`NoContact::Torsion`]). Default 2e-4 m.
     pub pitch_tolerance: f64,
+    /// Soft finger only: the largest ratio (m) of the torsion to the normal force,
+    /// |t| / (f . n), accepted. A soft contact's torsion is bounded by its torsional
+    /// friction, a length of the order of its contact patch times the normal force; a
+    /// larger ratio is refused ([`NoContact::TorsionBeyondLimit`]). Every reading of a
+    /// convex fingertip has a soft-finger solution, so this bound is what refuses
+    /// readings no real soft contact gives (a torsion far too large, or a force almost
+    /// tangent to the surface). Default 0.01 m.
+    pub torsion_ratio_limit: f64,
 }
 
 impl Default for SensingSettings {
@@ -70,6 +89,7 @@ impl Default for SensingSettings {
             force_threshold: 0.05,
             surface_tolerance: 1e-4,
             pitch_tolerance: 2e-4,
+            torsion_ratio_limit: 0.01,
         }
     }
 }
@@ -95,6 +115,12 @@ impl SensingSettings {
             self.pitch_tolerance,
             ">= 0",
             non_negative,
+        )?;
+        check(
+            "torsion_ratio_limit",
+            self.torsion_ratio_limit,
+            ">= 0",
+            non_negative,
         )
     }
 }
@@ -115,7 +141,8 @@ pub struct SensedContact {
 /// Why a reading gives no contact.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum NoContact {
-    /// The force is below the threshold (or zero): nothing touches the fingertip.
+    /// The force `force` (N) is below `threshold` (N): the settings' threshold, or
+    /// [`MIN_FORCE`] if that is larger. Nothing touches the fingertip.
     #[error("the force is {force:.4} N, below the contact threshold of {threshold:.4} N")]
     BelowThreshold { force: f64, threshold: f64 },
     /// Point contact only: the torque has a component `torsion` (N m) along the force,
@@ -130,6 +157,18 @@ pub enum NoContact {
         torsion: f64,
         pitch: f64,
         tolerance: f64,
+    },
+    /// Soft finger only: the contact that explains the reading needs a torsion `torsion`
+    /// (N m) more than `limit` (m) times its normal force `normal_force` (N): more than a
+    /// soft contact can apply.
+    #[error(
+        "the soft-finger contact that explains the reading needs a torsion of {torsion:.3e} N m with a normal force of {normal_force:.4} N, more than {:.4} mm times the normal force a soft contact can apply",
+        limit * 1e3
+    )]
+    TorsionBeyondLimit {
+        torsion: f64,
+        normal_force: f64,
+        limit: f64,
     },
     /// No point of the surface explains the reading: for a point contact the force's line
     /// of action passes `distance` (m) from the surface, beyond the surface tolerance; for
@@ -208,15 +247,36 @@ pub fn locate(
     reading: &Reading,
     settings: &SensingSettings,
 ) -> Result<SensedContact, NoContact> {
+    let contact = solve(surface, reading, settings)?;
+    let normal_force = contact.force.dot(&contact.normal);
+    if settings.kind == ContactKind::SoftFinger
+        && contact.torsion.abs() > settings.torsion_ratio_limit * normal_force
+    {
+        return Err(NoContact::TorsionBeyondLimit {
+            torsion: contact.torsion,
+            normal_force,
+            limit: settings.torsion_ratio_limit,
+        });
+    }
+    Ok(contact)
+}
+
+/// [`locate`] but for the torsion limit.
+fn solve(
+    surface: &FingertipSurface,
+    reading: &Reading,
+    settings: &SensingSettings,
+) -> Result<SensedContact, NoContact> {
     surface.validate()?;
     settings.validate()?;
     reading.validate()?;
     let f = reading.force;
     let f_norm = f.norm();
-    if f_norm < settings.force_threshold || f_norm == 0.0 {
+    let threshold = settings.force_threshold.max(MIN_FORCE);
+    if f_norm < threshold {
         return Err(NoContact::BelowThreshold {
             force: f_norm,
-            threshold: settings.force_threshold,
+            threshold,
         });
     }
     let soft = settings.kind == ContactKind::SoftFinger;
@@ -254,22 +314,15 @@ pub fn locate(
         .iter()
         .filter(|c| c.pushing && c.excess == 0.0 && usable(&c.point))
         .collect();
-    if let Some(first) = exact.first() {
-        let separation = exact
-            .iter()
-            .map(|c| (c.point - first.point).norm())
-            .fold(0.0, f64::max);
-        if separation > SAME_POINT {
-            return Err(NoContact::Ambiguous { separation });
-        }
-        return Ok(contact(first));
+    if !exact.is_empty() {
+        return one_point(&exact).map(|c| contact(&c));
     }
     // Just beyond a capsule seam (noise): the least outside, snapped onto the surface.
     let near = candidates
         .iter()
         .filter(|c| c.pushing && c.excess <= tol)
         .map(|c| {
-            let point = surface.snap(&Point3::from(c.point));
+            let point = surface.project(&Point3::from(c.point));
             Candidate {
                 point: point.coords,
                 normal: surface.outward_normal(&point),
@@ -323,6 +376,21 @@ pub fn locate(
             force: -f,
             torsion: 0.0,
         }),
+    }
+}
+
+/// The one point of `candidates` (not empty), or [`NoContact::Ambiguous`] when two lie
+/// more than [`SAME_POINT`] apart.
+fn one_point(candidates: &[&Candidate]) -> Result<Candidate, NoContact> {
+    let first = candidates[0];
+    let separation = candidates
+        .iter()
+        .map(|c| (c.point - first.point).norm())
+        .fold(0.0, f64::max);
+    if separation > SAME_POINT {
+        Err(NoContact::Ambiguous { separation })
+    } else {
+        Ok(*first)
     }
 }
 
@@ -461,4 +529,32 @@ fn cylinder_candidates(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(x: f64) -> Candidate {
+        Candidate {
+            point: Vector3::new(x, 0.0, 0.01),
+            normal: Vector3::x_axis(),
+            torsion: 0.0,
+            excess: 0.0,
+            pushing: true,
+        }
+    }
+
+    #[test]
+    fn two_distinct_points_are_ambiguous_a_seam_duplicate_is_one() {
+        let (a, b, c) = (candidate(0.008), candidate(0.008 + 1e-12), candidate(0.007));
+        let one = one_point(&[&a, &b]).expect("one point");
+        assert_eq!(one.point, a.point);
+        match one_point(&[&a, &b, &c]) {
+            Err(NoContact::Ambiguous { separation }) => {
+                assert!((separation - 1e-3).abs() < 1e-15, "{separation}")
+            }
+            other => panic!("expected Ambiguous, got {other:?}"),
+        }
+    }
 }

@@ -59,10 +59,11 @@ impl SensorNoise {
         )
     }
 
-    /// The reading `r` as the sensor reports it. For each component x with resolution q
-    /// > 0, in the order force x, y, z then torque x, y, z, one standard normal draw e
-    /// from `rng` and the value q * round((x + q e) / q). A component whose resolution is
-    /// 0 (or not a finite positive number) is returned unchanged and draws nothing.
+    /// The reading `r` as the sensor reports it. Each component x whose resolution q is
+    /// positive takes one standard normal draw e from `rng` (in the order force x, y, z,
+    /// then torque x, y, z) and becomes q * round((x + q e) / q). A component whose
+    /// resolution is 0 (or not a finite positive number) is returned unchanged and draws
+    /// nothing.
     pub fn apply<R: rand::Rng + ?Sized>(&self, r: &Reading, rng: &mut R) -> Reading {
         Reading {
             force: perturb(&r.force, self.force_resolution, rng),

@@ -10,6 +10,10 @@ use crate::error::{SensingError, check, finite};
 /// across; the bound keeps every square and product far from overflow.
 pub const MAX_SIZE: f64 = 1.0e3;
 
+/// The smallest radius or semi-axis (m) a surface may have (1 micrometre): far below any
+/// fingertip, far above underflow.
+pub const MIN_SIZE: f64 = 1.0e-6;
+
 /// A fingertip's surface, in the sensor frame (metres).
 ///
 /// Each shape may carry `base_z`: the fingertip is mounted below that height (sensor
@@ -47,11 +51,12 @@ pub enum FingertipSurface {
 
 const CENTER: [&str; 3] = ["center[0]", "center[1]", "center[2]"];
 const SEMI_AXES: [&str; 3] = ["semi_axes[0]", "semi_axes[1]", "semi_axes[2]"];
-const SIZE: &str = "> 0 and at most 1000 m";
+const SIZE: &str = "between 1e-6 and 1000 m";
 
 impl FingertipSurface {
     /// Checks that every number is finite, the centre within [`MAX_SIZE`] of the origin,
-    /// radii and semi-axes in (0, [`MAX_SIZE`]], `half_length` in [0, [`MAX_SIZE`]] and
+    /// radii and semi-axes in [[`MIN_SIZE`], [`MAX_SIZE`]], `half_length` in
+    /// [0, [`MAX_SIZE`]] and
     /// `base_z`, when given, below the top of the surface. The error names the field.
     pub fn validate(&self) -> Result<(), SensingError> {
         for (name, value) in CENTER.iter().zip(self.center_array()) {
@@ -59,7 +64,7 @@ impl FingertipSurface {
                 v.abs() <= MAX_SIZE
             })?;
         }
-        let positive = |v: f64| v > 0.0 && v <= MAX_SIZE;
+        let positive = |v: f64| (MIN_SIZE..=MAX_SIZE).contains(&v);
         match *self {
             Self::Sphere { radius, .. } => check("radius", radius, SIZE, positive)?,
             Self::Ellipsoid { semi_axes, .. } => {
@@ -194,11 +199,14 @@ impl FingertipSurface {
         }
     }
 
-    /// A point on the surface near `p` (a point within a small distance of it): `p`
-    /// moved along the normal direction of [`outward_normal`](Self::outward_normal) onto
-    /// the surface. Exact for the sphere and the capsule; for the ellipsoid the scaled
-    /// radial projection, which differs from the nearest point by second-order terms.
-    pub(crate) fn snap(&self, p: &Point3<f64>) -> Point3<f64> {
+    /// `p` moved onto the surface: radially from the centre (sphere), from the nearest
+    /// axis point (capsule), or radially in the coordinates that make the ellipsoid a unit
+    /// sphere. For the sphere and the capsule this is the nearest surface point; for the
+    /// ellipsoid it is near the nearest point when `p` is near the surface (the error is
+    /// of second order in the distance). For a contact point that a simulator puts
+    /// slightly off a fingertip model. At the centre (or on the axis), it returns the top
+    /// of the sphere or ellipsoid, or the +x side of the capsule.
+    pub fn project(&self, p: &Point3<f64>) -> Point3<f64> {
         let c = self.center();
         match *self {
             Self::Sphere { radius, .. } => {
@@ -333,7 +341,7 @@ fn nearest_on_ellipsoid(a: &Vector3<f64>, y: &Vector3<f64>) -> Vector3<f64> {
         };
     }
     let mut t = 0.0_f64;
-    for _ in 0..500 {
+    for _ in 0..200 {
         let mut h = -1.0;
         let mut dh = 0.0;
         for i in 0..3 {
@@ -344,11 +352,13 @@ fn nearest_on_ellipsoid(a: &Vector3<f64>, y: &Vector3<f64>) -> Vector3<f64> {
         if dh >= 0.0 {
             break;
         }
+        // From the left of the root every step is positive; a step that is not, or is
+        // at rounding level, means converged.
         let step = -h / dh;
-        t += step;
-        if step.abs() <= 1e-16 * (a2.max() + t) {
+        if step.is_nan() || step <= 1e-15 * (a2.max() + t) {
             break;
         }
+        t += step;
     }
     Vector3::new(
         a2.x * y.x / (a2.x + t),
