@@ -36,6 +36,10 @@ use crate::wrench::{Wrench, force, torque};
 /// Solver tolerance (gap and feasibility), relative to the scaled data (of order 1).
 const TOLERANCE: f64 = 1e-10;
 
+/// The tolerance of a solution the solver reports as almost solved (Clarabel's default,
+/// 5e-5, would let the forces miss equilibrium by that much).
+const REDUCED_TOLERANCE: f64 = 1e-8;
+
 /// The outcome of [`resisting_forces`].
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resisting {
@@ -101,13 +105,22 @@ pub fn resisting_forces(
     let mut torsions = Vec::with_capacity(m);
     let mut norm2 = 0.0;
     for (i, c) in contacts.iter().enumerate() {
+        // The solver's point, moved onto its cones where it is outside them (by at most
+        // the solver's tolerance), so that every slip margin is >= 0.
         let v = problem.variables(i);
+        let normal = x[v.normal].max(0.0);
         let (t1, t2) = tangent_basis(&c.normal);
-        let mut f = c.normal * x[v.normal];
+        let mut f = c.normal * normal;
         if let Some(a) = v.tangent {
-            f += t1 * x[a] + t2 * x[a + 1];
+            let tangential = t1 * x[a] + t2 * x[a + 1];
+            let (limit, magnitude) = (mu * normal, tangential.norm());
+            f += if magnitude > limit {
+                tangential * (limit / magnitude)
+            } else {
+                tangential
+            };
         }
-        let s = v.torsion.map_or(0.0, |s| x[s]);
+        let s = v.torsion.map_or(0.0, |s| x[s].clamp(-normal, normal));
         norm2 += f.norm_squared() + s * s;
         forces.push(f * unit);
         torsions.push(gamma * s * unit);
@@ -246,6 +259,9 @@ impl Problem<'_> {
             .tol_gap_abs(TOLERANCE)
             .tol_gap_rel(TOLERANCE)
             .tol_feas(TOLERANCE)
+            .reduced_tol_gap_abs(REDUCED_TOLERANCE)
+            .reduced_tol_gap_rel(REDUCED_TOLERANCE)
+            .reduced_tol_feas(REDUCED_TOLERANCE)
             .build()
             .map_err(|e| QualityError::Solver(format!("contact forces: {e:?}")))?;
         let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)

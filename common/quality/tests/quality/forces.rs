@@ -495,3 +495,98 @@ fn bad_input_is_named() {
         Err(QualityError::ExternalWrench { .. })
     ));
 }
+
+#[test]
+fn force_closure_grasps_resist_any_wrench() {
+    // The metrics' sampled cones are inscribed in the exact ones, so a grasp in force
+    // closure by the metrics resists every wrench here. Grasps not in force closure
+    // resist some wrenches and not others; the forces, when found, are checked inside
+    // `solve`.
+    use graspopt_quality::GraspModel;
+    use graspopt_quality::metrics::{MetricsOptions, evaluate_contacts};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    let mut rng = ChaCha8Rng::seed_from_u64(20);
+    let model = soft(0.5, 0.005);
+    let origin = Vector3::zeros();
+    let (mut closed, mut resisted, mut refused) = (0, 0, 0);
+    for _ in 0..60 {
+        let contacts: Vec<Contact> = (0..3)
+            .map(|_| {
+                let z: f64 = rng.random_range(-1.0..1.0);
+                let lon: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                let r = (1.0 - z * z).sqrt();
+                let n = Vector3::new(r * lon.cos(), r * lon.sin(), z);
+                Contact::new(n * 0.04, -n)
+            })
+            .collect();
+        let external = Wrench::from_fn(|_, _| rng.random_range(-1.0..1.0))
+            .component_mul(&Wrench::new(5.0, 5.0, 5.0, 0.1, 0.1, 0.1));
+        let metrics = evaluate_contacts(
+            &contacts,
+            &GraspModel::new(model),
+            &MetricsOptions::without_volume(),
+        )
+        .unwrap();
+        match resisting_forces(&contacts, &model, &external, &origin).unwrap() {
+            Resisting::Forces { .. } => {
+                solve(&contacts, &model, &external, &origin);
+                resisted += 1;
+            }
+            Resisting::CannotResist { .. } => {
+                assert!(!metrics.force_closure, "{contacts:?} {external:?}");
+                refused += 1;
+            }
+        }
+        closed += usize::from(metrics.force_closure);
+    }
+    // The sample holds both outcomes and grasps in force closure.
+    assert!(
+        closed >= 5 && resisted > closed && refused >= 5,
+        "{closed} {resisted} {refused}"
+    );
+}
+
+#[test]
+fn extreme_valid_input_gives_forces_or_a_named_error() {
+    // Parameters far from ordinary grasps: the forces cancel the external wrench
+    // (relative to its size, torques to its size times the grasp's length: its largest
+    // coordinate or gamma). At mu = 1e6, the largest accepted, the solver may stop
+    // short (a named error), never a panic.
+    let origin = Vector3::zeros();
+    let weight = |m: f64| gravity_wrench(m, &G, &origin, &origin).unwrap();
+    let cases = [
+        (opposing(0.04), point(1e5), weight(0.3)),
+        (opposing(0.04), soft(1e5, 0.01), weight(0.3)),
+        (opposing(0.04), point(1e-6), weight(0.3)),
+        (opposing(1e11), soft(0.5, 1e12), weight(0.3)),
+        (opposing(1e-9), soft(0.5, 1e-12), weight(0.3)),
+        (opposing(0.04), point(0.5), weight(1e-300)),
+        (opposing(0.04), point(0.5), weight(1e11)),
+        (opposing(0.04), point(1e6), weight(0.3)),
+    ];
+    for (contacts, model, external) in cases {
+        let gamma = match model {
+            FrictionModel::SoftFinger { gamma, .. } => gamma,
+            _ => 0.0,
+        };
+        let length = gamma.max(contacts[0].position.amax());
+        match resisting_forces(&contacts, &model, &external, &origin) {
+            Ok(Resisting::Forces { forces, norm }) => {
+                let residual = net_wrench(&contacts, &forces, &origin).unwrap() + external;
+                let scale = external.amax();
+                assert!(
+                    residual.fixed_rows::<3>(0).amax() <= 1e-6 * scale
+                        && residual.fixed_rows::<3>(3).amax() <= 1e-6 * scale * length,
+                    "{model:?} {external:?}: {residual:?}"
+                );
+                assert!(norm.is_finite());
+            }
+            Err(QualityError::Solver(status)) if model == point(1e6) => {
+                assert!(status.contains("status"), "{status}");
+            }
+            other => panic!("{model:?} {external:?}: {other:?}"),
+        }
+    }
+}
