@@ -187,6 +187,7 @@ fn main() {
             reason: WaitReason::MetricAgent,
             since_ms: 1_700_000_000_000,
         }],
+        best_forces: None,
     };
     out.message("decode_status", "status", &status, Some(Topic::Status));
 

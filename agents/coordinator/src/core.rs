@@ -331,6 +331,7 @@ impl Coordinator {
             } else {
                 self.waits.shown(now)
             },
+            best_forces: self.state.best_forces().cloned(),
         }
     }
 

@@ -333,6 +333,7 @@ fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<
                 row.params.clone(),
                 score,
                 row.metrics.as_ref().map(|m| m.force_closure),
+                row.forces.as_ref(),
             );
         }
     }

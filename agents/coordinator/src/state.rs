@@ -4,7 +4,9 @@
 
 use std::collections::BTreeMap;
 
-use graspopt_protocol::{BestTrial, ErrorCounts, Observation, TrialResult, WorkerStatus};
+use graspopt_protocol::{
+    BestTrial, ErrorCounts, ForceAnalysis, Observation, TrialResult, WorkerStatus,
+};
 
 /// Where a trial is.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,6 +86,8 @@ pub struct RunState {
     /// Completed trials in completion order, for the planner.
     observations: Vec<Observation>,
     best: Option<BestTrial>,
+    /// The best trial's force analysis, if its result had one.
+    best_forces: Option<ForceAnalysis>,
     best_history: Vec<f64>,
     errors: ErrorCounts,
     /// How long a worker that may still be executing a trial stays busy after the trial no
@@ -133,6 +137,10 @@ impl RunState {
 
     pub fn best(&self) -> Option<&BestTrial> {
         self.best.as_ref()
+    }
+
+    pub fn best_forces(&self) -> Option<&ForceAnalysis> {
+        self.best_forces.as_ref()
     }
 
     pub fn best_history(&self) -> &[f64] {
@@ -404,6 +412,7 @@ impl RunState {
             params,
             result.score,
             result.metrics.map(|m| m.force_closure),
+            result.forces.as_ref(),
         );
         Disposition::Completed
     }
@@ -438,6 +447,7 @@ impl RunState {
         params: Vec<f64>,
         score: f64,
         force_closure: Option<bool>,
+        forces: Option<&ForceAnalysis>,
     ) {
         self.observations.push(Observation {
             x: params.clone(),
@@ -450,6 +460,7 @@ impl RunState {
                 params,
                 force_closure,
             });
+            self.best_forces = forces.cloned();
         }
         if let Some(b) = &self.best {
             self.best_history.push(b.score);

@@ -23,8 +23,8 @@ use std::sync::Arc;
 use anyhow::Context;
 use graspopt_bus::{Bus, CloudReceiver};
 use graspopt_convert::{
-    force_analysis, measured_from_clouds, measured_from_fingertips, metric_values,
-    object_from_estimate, sensor_reading,
+    force_analysis, isometry, measured_from_clouds, metric_values, object_from_estimate,
+    sensor_reading,
 };
 use graspopt_protocol::keys::{OBJECT, RESULT, WRENCHES};
 use graspopt_protocol::{
@@ -35,7 +35,7 @@ use graspopt_quality::forces::ContactForces;
 use graspopt_sensing::SensingSettings;
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
-use graspopt_trial::fingertips::{fingertip_model, sense};
+use graspopt_trial::fingertips::{fingertip_model, fingertip_score, sense};
 use graspopt_trial::forces::{ForceSettings, analyse_contacts, analyse_outcome};
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use graspopt_trial::score::grasp_model;
@@ -109,8 +109,8 @@ pub fn score_clouds(clouds: &ContactClouds, object: &Object, config: &MetricConf
 }
 
 /// Scores one trial's fingertip readings on the estimated object: each reading's contact
-/// (intrinsic contact sensing), scored as a one-point cloud per fingertip, and the measured
-/// forces analysed. A reading that admits no contact is left out and its reason returned
+/// (intrinsic contact sensing), scored as a one-point cloud per fingertip with the mean-point
+/// model (`graspopt_trial::fingertips::fingertip_score`), and the measured forces analysed. A reading that admits no contact is left out and its reason returned
 /// (`finger: reason`). Errors become a result with `error` set, as for clouds.
 pub fn score_wrenches(
     readings: &FingertipWrenches,
@@ -143,9 +143,9 @@ pub fn score_wrenches(
             Err(why) => refused.push(format!("finger {} ({}): {why}", tip.finger, tip.link)),
         }
     }
-    let measured = measured_from_fingertips(
+    let measured = MeasuredTrial::from_fingertips(
         &readings.hand,
-        &readings.palm_pose,
+        isometry(&readings.palm_pose),
         &contacts,
         readings.min_gap,
     );
@@ -170,8 +170,9 @@ fn score_sensed(
     config: &MetricConfig,
 ) -> Result<(graspopt_trial::TrialScore, graspopt_protocol::ForceAnalysis), graspopt_trial::TrialError>
 {
-    let (s, outcome) = score_measured(measured, object, &config.contacts, &config.score)?;
-    let reference = grasp_model(&outcome, object, &config.score)?.reference_point;
+    let score = fingertip_score(&config.score);
+    let (s, outcome) = score_measured(measured, object, &config.contacts, &score)?;
+    let reference = grasp_model(&outcome, object, &score)?.reference_point;
     let quality: Vec<_> = contacts.iter().map(|(_, _, c)| c.contact()).collect();
     let forces = ContactForces::new(
         contacts.iter().map(|(_, _, c)| c.force).collect(),

@@ -118,5 +118,6 @@ pub fn placeholder(e: &Embedded) -> RunStatus {
         errors: Default::default(),
         stamp_ms: 0,
         waiting: Vec::new(),
+        best_forces: None,
     }
 }

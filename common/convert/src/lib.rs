@@ -10,7 +10,7 @@ use graspopt_protocol::{
 use graspopt_quality::forces::Resisting;
 use graspopt_quality::metrics::Metrics;
 use graspopt_sensing::Reading;
-use graspopt_trial::fingertips::{FingertipContact, SensorReading};
+use graspopt_trial::fingertips::SensorReading;
 use graspopt_trial::forces::GraspForces;
 use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::measured::{MeasuredFinger, MeasuredTrial};
@@ -141,33 +141,6 @@ pub fn sensor_reading(w: &FingertipWrench) -> SensorReading {
             force: Vector3::from(w.force),
             torque: Vector3::from(w.torque),
         },
-    }
-}
-
-/// What a force-sensing hand measured, as contacts: one point per sensed fingertip, on the
-/// fingertip (`contacts`: `(finger, fingertip name, contact)`), for scoring as clouds are.
-pub fn measured_from_fingertips(
-    hand: &str,
-    palm_pose: &Pose,
-    contacts: &[(usize, String, FingertipContact)],
-    min_gap: Option<f64>,
-) -> MeasuredTrial {
-    MeasuredTrial {
-        hand: hand.to_string(),
-        palm_pose: isometry(palm_pose),
-        fingers: contacts
-            .iter()
-            .map(|(finger, link, c)| MeasuredFinger {
-                finger: Some(*finger),
-                links: vec![link.clone()],
-                points: vec![ContactPoint {
-                    position: c.point,
-                    normal: c.normal,
-                    weight: 1.0,
-                }],
-            })
-            .collect(),
-        min_gap,
     }
 }
 

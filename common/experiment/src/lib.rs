@@ -12,6 +12,8 @@
 //! - [`snapshot`]: the GP mean, its standard deviation and EI along a 1D space after each step.
 //! - [`scans`]: grid scans of a built-in object for the studies.
 //! - [`metric_study`]: the metric figures 4.3-4.15 (which scans, what is read off them).
+//! - [`sensing_study`]: the force-sensing round trip (fingertip contacts to sensor readings and
+//!   back) on the seven objects.
 //! - [`bo_study`]: the BO figures 4.16-4.27 and Table 4.1 (the checked plan, the results of
 //!   each part per object).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
@@ -22,6 +24,7 @@ pub mod error;
 pub mod metric_study;
 pub mod scans;
 pub mod search;
+pub mod sensing_study;
 pub mod snapshot;
 pub mod target;
 

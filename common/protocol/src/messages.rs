@@ -425,6 +425,30 @@ impl ForceAnalysis {
             .map(|w| (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt())
     }
 
+    /// The analysis for people, as the tools print it: "holds the load (4.905 N) with contact
+    /// forces of norm 6.250 N at least (largest 3.500 N)" or "cannot hold the load (4.905 N)",
+    /// then for measured forces "; measured: net force 0.012 N, smallest slip margin 0.840 N".
+    pub fn describe(&self) -> String {
+        let e = &self.external;
+        let load = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+        let mut text = match (self.resisting_norm, self.resisting_max) {
+            (Some(norm), Some(max)) => format!(
+                "holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least (largest {max:.3} N)"
+            ),
+            (Some(norm), None) => {
+                format!("holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least")
+            }
+            (None, _) => format!("cannot hold the load ({load:.3} N)"),
+        };
+        if let Some(net) = self.net_force() {
+            text.push_str(&format!("; measured: net force {net:.3} N"));
+            if let Some(m) = self.min_slip_margin() {
+                text.push_str(&format!(", smallest slip margin {m:.3} N"));
+            }
+        }
+        text
+    }
+
     /// Checks that every number is finite and the norms are >= 0; the error names the field.
     pub fn validate(&self, field: &str) -> Result<(), String> {
         finite(&format!("{field}.external"), &self.external)?;
@@ -765,7 +789,12 @@ pub struct RunStatus {
     /// (see [`RunStatus::decode_older`]).
     #[serde(default)]
     pub waiting: Vec<Waiting>,
+    /// The best trial's force analysis, if its result had one. Added last, within wire
+    /// version 3 (see [`RunStatus::decode_older`]).
+    #[serde(default)]
+    pub best_forces: Option<ForceAnalysis>,
 }
+
 
 /// [`RunStatus`] as wire version 3 first had it, before `waiting`.
 #[derive(Deserialize)]
@@ -793,8 +822,22 @@ impl Message for RunStatus {
     fn validate(&self) -> Result<(), String> {
         Ok(())
     }
+    /// Two older layouts: before `best_forces` (the fields up to `waiting`, which bincode
+    /// writes as the pair below), and before `waiting`.
     fn decode_older(body: &[u8]) -> Option<(Self, usize)> {
-        let (s, read) = crate::codec::decode_bincode_body::<RunStatusBeforeWaiting>(body).ok()?;
+        let whole = |read: &usize| *read == body.len();
+        let (s, waiting, read) =
+            match crate::codec::decode_bincode_body::<(RunStatusBeforeWaiting, Vec<Waiting>)>(body)
+                .ok()
+                .filter(|(_, read)| whole(read))
+            {
+                Some(((s, waiting), read)) => (s, waiting, read),
+                None => {
+                    let (s, read) =
+                        crate::codec::decode_bincode_body::<RunStatusBeforeWaiting>(body).ok()?;
+                    (s, Vec::new(), read)
+                }
+            };
         let status = RunStatus {
             run_id: s.run_id,
             phase: s.phase,
@@ -809,7 +852,8 @@ impl Message for RunStatus {
             workers: s.workers,
             errors: s.errors,
             stamp_ms: s.stamp_ms,
-            waiting: Vec::new(),
+            waiting,
+            best_forces: None,
         };
         Some((status, read))
     }

@@ -243,6 +243,7 @@ fn status(waiting: Vec<Waiting>) -> RunStatus {
         errors: ErrorCounts::default(),
         stamp_ms: 1_700_000_005_000,
         waiting,
+        best_forces: None,
     }
 }
 

@@ -22,7 +22,7 @@ use graspopt_sensing::{
     ContactKind, FingertipSurface, NoContact, Reading, SensingSettings, SensorNoise, locate,
     reading_of,
 };
-use graspopt_sim::{Hand, LinkShape, Object, TrialOutcome};
+use graspopt_sim::{ContactModel, Hand, LinkShape, Object, TrialOutcome};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -147,6 +147,17 @@ pub fn fingertip_model(kind: ContactKind, score: &FrictionModel) -> FrictionMode
     match kind {
         ContactKind::Point => FrictionModel::PointFriction { mu, edges },
         ContactKind::SoftFinger => FrictionModel::SoftFinger { mu, edges, gamma },
+    }
+}
+
+/// How a force-sensing hand's contacts are scored: as `score` says, but each sensed contact as
+/// the one point it is (the mean-point model). A sensor gives one point and normal per
+/// fingertip; the surface or patch models would make up the extent of a contact it did not
+/// measure (and a surface patch grown from one point jumps with its position near an edge).
+pub fn fingertip_score(score: &ScoreSettings) -> ScoreSettings {
+    ScoreSettings {
+        contacts: ContactModel::MeanPoint,
+        ..*score
     }
 }
 

@@ -3,11 +3,11 @@
 //! the object's weight (or "cannot resist"); for forces a hand measured, also the net wrench
 //! they apply to the object and how far each is inside its friction cone.
 //!
-//! The contacts are one per finger (and the palm's, when the score counts it): the mean
-//! contact of each finger's cloud for a simulated or cloud-measured trial, the sensed contact
-//! of each fingertip for a hand with force sensors. One contact per finger is what a force
-//! solve needs (a finger pushes with one force), and it keeps the solve at a fraction of a
-//! millisecond where the surface model's dozens of points per finger would not.
+//! The contacts are the ones the metric scores: the score's contact model (the surface model by
+//! default, a few dozen points per finger) for a simulated or cloud-measured trial, the sensed
+//! contact of each fingertip for a hand with force sensors. The same contacts keep "cannot
+//! resist" consistent with force closure: a grasp in force closure resists any load. (One mean
+//! contact per finger would be cheaper, but it loses a finger wrapped around a handle.)
 //!
 //! Frames: the contacts' frame (world), torques about the score's reference point
 //! ([`crate::score::grasp_model`]), gravity along world `-z` by default.
@@ -17,7 +17,7 @@ use graspopt_quality::forces::{
     slip_margins,
 };
 use graspopt_quality::{Contact, FrictionModel, Wrench};
-use graspopt_sim::{ContactModel, Object, TrialOutcome};
+use graspopt_sim::{Object, TrialOutcome};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -149,9 +149,9 @@ pub fn analyse_contacts(
     })
 }
 
-/// The force analysis of a simulated or cloud-measured trial: the mean contact of each
-/// finger (and of the palm when the score counts it), the score's contact model and
-/// reference point.
+/// The force analysis of a simulated or cloud-measured trial: the contacts of the score's
+/// contact model (the palm's too when the score counts it), its friction model and reference
+/// point.
 pub fn analyse_outcome(
     outcome: &TrialOutcome,
     object: &Object,
@@ -159,7 +159,7 @@ pub fn analyse_outcome(
     settings: &ForceSettings,
 ) -> Result<GraspForces, TrialError> {
     let contacts = outcome
-        .contacts(ContactModel::MeanPoint, score.include_palm)
+        .contacts(score.contacts, score.include_palm)
         .iter()
         .map(|c| Contact::normalized(c.position.coords, c.normal))
         .collect::<Result<Vec<_>, _>>()?;

@@ -10,6 +10,7 @@ use graspopt_sim::{
 use nalgebra::Isometry3;
 
 use crate::error::TrialError;
+use crate::fingertips::FingertipContact;
 use crate::score::{ScoreSettings, TrialScore, closest_gap, score_outcome};
 
 /// One finger's raw cloud as measured (`finger: None` for the palm).
@@ -50,6 +51,33 @@ impl MeasuredTrial {
                 .map(finger)
                 .collect(),
             min_gap: closest_gap(outcome),
+        }
+    }
+
+    /// What a force-sensing hand measured, as contacts: one point per sensed fingertip, on
+    /// the fingertip (`contacts`: `(finger, fingertip name, contact)`), scored as clouds are.
+    pub fn from_fingertips(
+        hand: &str,
+        palm_pose: Isometry3<f64>,
+        contacts: &[(usize, String, FingertipContact)],
+        min_gap: Option<f64>,
+    ) -> MeasuredTrial {
+        MeasuredTrial {
+            hand: hand.to_string(),
+            palm_pose,
+            fingers: contacts
+                .iter()
+                .map(|(finger, link, c)| MeasuredFinger {
+                    finger: Some(*finger),
+                    links: vec![link.clone()],
+                    points: vec![ContactPoint {
+                        position: c.point,
+                        normal: c.normal,
+                        weight: 1.0,
+                    }],
+                })
+                .collect(),
+            min_gap,
         }
     }
 

@@ -1,11 +1,15 @@
 //! `graspopt trial --object mug --hand barrett --at x=-0.08,y=0.01`: run one simulated
-//! trial and print its contacts and metrics (`--format json` for everything).
+//! trial and print its contacts, metrics and force analysis (`--format json` for everything).
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use graspopt_convert::force_analysis;
+use graspopt_protocol::ForceAnalysis;
+use graspopt_quality::forces::Resisting;
 use graspopt_report::trial as trial_report;
+use graspopt_trial::forces::{ForceSettings, analyse_outcome};
 use graspopt_trial::{Evaluation, NamedPoint};
 use serde::Serialize;
 
@@ -32,6 +36,9 @@ pub struct TrialArgs {
     /// (FILE must end in `.png`).
     #[arg(long, value_name = "FILE.png")]
     pub preview: Option<PathBuf>,
+    /// The object's mass for the force analysis (kg): the grasp must hold its weight.
+    #[arg(long, default_value_t = ForceSettings::default().object_mass)]
+    pub object_mass: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -41,20 +48,23 @@ pub enum TrialFormat {
 }
 
 /// `--format json`: the parameters, the score with what it was computed from (contacts,
-/// fingers in contact, metrics) at the top level, and the simulated outcome.
+/// fingers in contact, metrics) at the top level, the force analysis (as in results) and the
+/// simulated outcome.
 #[derive(Serialize)]
 struct TrialJson<'a> {
     params: &'a [f64],
     #[serde(flatten)]
     score: &'a graspopt_trial::TrialScore,
+    forces: &'a ForceAnalysis,
     outcome: &'a graspopt_sim::TrialOutcome,
 }
 
 impl<'a> TrialJson<'a> {
-    fn of(e: &'a Evaluation) -> Self {
+    fn of(e: &'a Evaluation, forces: &'a ForceAnalysis) -> Self {
         TrialJson {
             params: &e.params,
             score: &e.score,
+            forces,
             outcome: &e.outcome,
         }
     }
@@ -69,6 +79,13 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         .context("--at")?;
     let (kinds, values) = (&point.kinds, &point.values);
     let e = ev.evaluate(values)?;
+    let force_settings = ForceSettings {
+        object_mass: args.object_mass,
+        ..ForceSettings::default()
+    };
+    let grasp_forces = analyse_outcome(&e.outcome, &ev.object, &ev.score, &force_settings)
+        .context("force analysis")?;
+    let forces = force_analysis(&grasp_forces);
     let at: Vec<String> = kinds
         .iter()
         .zip(values)
@@ -93,7 +110,10 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
         &title,
     )?;
     match args.format {
-        TrialFormat::Json => outln!("{}", serde_json::to_string_pretty(&TrialJson::of(&e))?)?,
+        TrialFormat::Json => outln!(
+            "{}",
+            serde_json::to_string_pretty(&TrialJson::of(&e, &forces))?
+        )?,
         TrialFormat::Text => {
             outln!(
                 "object {}  hand {}  contacts {}  metric {}",
@@ -152,6 +172,15 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                 None => outln!("no contact: nothing to score")?,
             }
             outln!("score {:.6}", e.score.score)?;
+            outln!(
+                "forces ({} kg object): {}{}",
+                args.object_mass,
+                forces.describe(),
+                match &grasp_forces.resisting {
+                    Resisting::CannotResist { reason } => format!(": {reason}"),
+                    Resisting::Forces { .. } => String::new(),
+                }
+            )?;
         }
     }
     for path in written {

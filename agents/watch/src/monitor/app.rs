@@ -143,6 +143,9 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
                 "best: trial {} score {:.5} at {}{fc}",
                 b.trial_id, b.score, params
             ));
+            if let Some(f) = &s.best_forces {
+                out.push(format!("best's forces: {}", f.describe()));
+            }
         }
         None => out.push("best: none yet".into()),
     }
@@ -165,7 +168,7 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use graspopt_protocol::{BestTrial, ErrorCounts, RunId, WorkerStatus};
+    use graspopt_protocol::{BestTrial, ErrorCounts, ForceAnalysis, RunId, WorkerStatus};
 
     /// A run "demo" on a mug, 60 trials, `completed` done, two workers, a best trial.
     pub(crate) fn status(completed: u64) -> RunStatus {
@@ -203,6 +206,13 @@ pub(crate) mod tests {
             },
             stamp_ms: completed as i64,
             waiting: Vec::new(),
+            best_forces: Some(ForceAnalysis {
+                external: [0.0, 0.0, -4.905, 0.0, 0.0, 0.0],
+                resisting_norm: Some(6.25),
+                resisting_max: Some(3.5),
+                net_wrench: None,
+                slip_margins: Vec::new(),
+            }),
         }
     }
 

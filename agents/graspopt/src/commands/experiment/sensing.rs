@@ -1,0 +1,51 @@
+//! `graspopt experiment sensing`: the force-sensing round trip on the seven objects
+//! (`graspopt_experiment::sensing_study`), without noise and with the sensors' noise, as
+//! markdown tables.
+
+use anyhow::Result;
+use clap::Args;
+use graspopt_experiment::sensing_study::{SensingStudySettings, markdown_table, round_trip};
+use graspopt_sensing::SensorNoise;
+
+use crate::out::outln;
+
+#[derive(Args, Debug)]
+pub struct SensingArgs {
+    /// Random trials per object (approach distance and height).
+    #[arg(long, default_value_t = 200)]
+    trials: usize,
+    /// Seed of the trials and the noise.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Force resolution of the noisy run (N; default 1/320, an ATI Nano17's).
+    #[arg(long)]
+    force_resolution: Option<f64>,
+    /// Torque resolution of the noisy run (N m; default 1.5625e-5, 1/64 N mm).
+    #[arg(long)]
+    torque_resolution: Option<f64>,
+}
+
+pub fn sensing(args: &SensingArgs) -> Result<()> {
+    let mut noise = SensorNoise::default();
+    noise.force_resolution = args.force_resolution.unwrap_or(noise.force_resolution);
+    noise.torque_resolution = args.torque_resolution.unwrap_or(noise.torque_resolution);
+    noise.validate()?;
+    for (title, noise) in [("without noise", SensorNoise::NONE), ("with sensor noise", noise)] {
+        let settings = SensingStudySettings {
+            trials: args.trials,
+            seed: args.seed,
+            noise,
+            ..SensingStudySettings::default()
+        };
+        let rows = round_trip(&settings)?;
+        outln!(
+            "Force-sensing round trip {title} (force resolution {} N, torque resolution {} N m), barrett_ft, {} trials per object, seed {}:\n",
+            noise.force_resolution,
+            noise.torque_resolution,
+            args.trials,
+            args.seed
+        )?;
+        outln!("{}", markdown_table(&rows))?;
+    }
+    Ok(())
+}
