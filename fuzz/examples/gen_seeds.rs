@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use graspopt_protocol::keys::AgentKind;
 use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, alive_token};
 use graspopt_protocol::{
-    BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, MeshData, Message,
+    BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, FingertipSurface,
+    FingertipWrench, FingertipWrenches, MeshData, Message,
     MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
     SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
     WorkerStatus, decode, encode,
@@ -128,6 +129,35 @@ fn main() {
     clouds.min_gap = None;
     clouds.error = Some("unreachable pose".into());
     out.message("decode_clouds", "error", &clouds, Some(Topic::Clouds));
+
+    let mut wrenches = FingertipWrenches {
+        run_id: run.clone(),
+        trial_id: 42,
+        attempt: 2,
+        worker: "hand-1".into(),
+        hand: "barrett_ft".into(),
+        palm_pose: pose,
+        fingertips: vec![FingertipWrench {
+            finger: 0,
+            link: "f1_tip".into(),
+            sensor_pose: pose,
+            surface: FingertipSurface::Sphere {
+                center: [0.0, 0.0, 0.015],
+                radius: 0.012,
+                base_z: None,
+            },
+            force: [0.1, -0.2, -1.5],
+            torque: [0.004, 0.001, 0.0],
+            stamp_ms: 1_700_000_000_450,
+        }],
+        min_gap: None,
+        error: None,
+        executed_ms: 1_700_000_000_456,
+    };
+    out.message("decode_wrenches", "wrenches", &wrenches, Some(Topic::Wrenches));
+    wrenches.fingertips.clear();
+    wrenches.error = Some("sensor offline".into());
+    out.message("decode_wrenches", "error", &wrenches, Some(Topic::Wrenches));
 
     let mut result = TrialResult {
         run_id: run.clone(),

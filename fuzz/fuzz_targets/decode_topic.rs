@@ -1,13 +1,13 @@
 //! `decode_topic` (what `graspopt topic echo` shows) from untrusted bytes. The selector byte
-//! picks the encoding (bit 0: bincode or JSON) and the topic (the other bits, modulo 5).
+//! picks the encoding (bit 0: bincode or JSON) and the topic (the other bits, modulo 6).
 //!
 //! Checks: never panics; it agrees with the typed decoder of the topic's message (same
 //! error, or the message's JSON); what it shows is a JSON object without the wire version.
 #![no_main]
 
 use graspopt_protocol::{
-    ContactClouds, DecodeError, Encoding, Message, ObjectEstimate, RunStatus, Topic, TrialCommand,
-    TrialResult, decode, decode_topic,
+    ContactClouds, DecodeError, Encoding, FingertipWrenches, Message, ObjectEstimate, RunStatus,
+    Topic, TrialCommand, TrialResult, decode, decode_topic,
 };
 use libfuzzer_sys::fuzz_target;
 use serde_json::Value;
@@ -39,6 +39,7 @@ fuzz_target!(|data: &[u8]| {
         Topic::Clouds => typed::<ContactClouds>(topic, payload, encoding),
         Topic::Result => typed::<TrialResult>(topic, payload, encoding),
         Topic::Status => typed::<RunStatus>(topic, payload, encoding),
+        Topic::Wrenches => typed::<FingertipWrenches>(topic, payload, encoding),
     };
     assert_eq!(shown, expected, "{topic:?} {encoding:?}");
     if let Ok(value) = shown {

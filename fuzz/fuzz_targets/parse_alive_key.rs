@@ -7,7 +7,9 @@
 //! valid key chunk.
 #![no_main]
 
-use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, alive_token};
+use graspopt_protocol::keys::{
+    CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, WRENCHES, alive_token,
+};
 use graspopt_protocol::keys::{check_agent_id, parse_alive_key, sanitize_chunk};
 use graspopt_protocol::{Encoding, RunId, Topic};
 use libfuzzer_sys::fuzz_target;
@@ -32,6 +34,7 @@ fuzz_target!(|data: &[u8]| {
             Topic::Clouds => CLOUDS.key(Runs::One(&run)).to_string(),
             Topic::Result => RESULT.key(Runs::One(&run)).to_string(),
             Topic::Status => STATUS.key(Runs::One(&run)).to_string(),
+            Topic::Wrenches => WRENCHES.key(Runs::One(&run)).to_string(),
         };
         assert_eq!(rebuilt, key, "{topic:?}");
     }

@@ -75,7 +75,8 @@ impl SimulatedHand {
                 min_gap: clouds.min_gap,
             });
         }
-        let mut rng = ChaCha8Rng::seed_from_u64(command.trial_id ^ (u64::from(command.attempt) << 48));
+        let mut rng =
+            ChaCha8Rng::seed_from_u64(command.trial_id ^ (u64::from(command.attempt) << 48));
         let tips = simulate_readings(
             &outcome,
             self.hand.as_ref(),

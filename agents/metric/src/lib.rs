@@ -28,17 +28,18 @@ use graspopt_convert::{
 };
 use graspopt_protocol::keys::{OBJECT, RESULT, WRENCHES};
 use graspopt_protocol::{
-    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, FingertipWrenches, RunId,
-    TrialResult,
+    AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, FingertipWrenches, ForceAnalysis,
+    RunId, TrialResult,
 };
 use graspopt_quality::forces::ContactForces;
 use graspopt_sensing::SensingSettings;
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
-use graspopt_trial::fingertips::{fingertip_model, fingertip_score, sense};
-use graspopt_trial::forces::{ForceSettings, analyse_contacts, analyse_outcome};
+use graspopt_trial::fingertips::{FingertipContact, fingertip_model, fingertip_score, sense};
+use graspopt_trial::forces::{ForceSettings, GraspForces, analyse_contacts, analyse_outcome};
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use graspopt_trial::score::grasp_model;
+use graspopt_trial::{TrialError, TrialScore};
 use serde::{Deserialize, Serialize};
 
 /// Metric settings.
@@ -90,18 +91,14 @@ pub fn score_clouds(clouds: &ContactClouds, object: &Object, config: &MetricConf
         return result;
     }
     let measured = measured_from_clouds(clouds);
-    let scored = score_measured(&measured, object, &config.contacts, &config.score)
-        .and_then(|(s, outcome)| {
-            let forces = analyse_outcome(&outcome, object, &config.score, &config.forces)?;
-            Ok((s, forces))
-        });
-    match scored {
-        Ok((s, forces)) => {
+    match score_measured(&measured, object, &config.contacts, &config.score) {
+        Ok((s, outcome)) => {
             result.score = s.score;
             result.metrics = s.metrics.as_ref().map(metric_values);
             result.contacts = s.contacts as u32;
             result.fingers_in_contact = s.fingers_in_contact as u32;
-            result.forces = Some(force_analysis(&forces));
+            let forces = analyse_outcome(&outcome, object, &config.score, &config.forces);
+            result.forces = analysed(forces, &result);
         }
         Err(e) => result.error = Some(format!("scoring failed: {e}")),
     }
@@ -155,21 +152,40 @@ pub fn score_wrenches(
             result.metrics = s.metrics.as_ref().map(metric_values);
             result.contacts = s.contacts as u32;
             result.fingers_in_contact = s.fingers_in_contact as u32;
-            result.forces = Some(forces);
+            result.forces = analysed(forces, &result);
         }
         Err(e) => result.error = Some(format!("scoring failed: {e}")),
     }
     (result, refused)
 }
 
-/// The score of sensed fingertip contacts and the analysis of their measured forces.
+/// The force analysis for the result, or none when it failed (a solver that gives up on a
+/// degenerate grasp): the score stands without it, and the log says why.
+fn analysed(
+    forces: Result<GraspForces, TrialError>,
+    result: &TrialResult,
+) -> Option<ForceAnalysis> {
+    match forces {
+        Ok(f) => Some(force_analysis(&f)),
+        Err(e) => {
+            tracing::warn!(
+                "metric {}: trial {}: no force analysis: {e}",
+                result.scorer,
+                result.trial_id
+            );
+            None
+        }
+    }
+}
+
+/// The score of sensed fingertip contacts, and the analysis of their measured forces.
+#[allow(clippy::type_complexity)]
 fn score_sensed(
     measured: &MeasuredTrial,
-    contacts: &[(usize, String, graspopt_trial::fingertips::FingertipContact)],
+    contacts: &[(usize, String, FingertipContact)],
     object: &Object,
     config: &MetricConfig,
-) -> Result<(graspopt_trial::TrialScore, graspopt_protocol::ForceAnalysis), graspopt_trial::TrialError>
-{
+) -> Result<(TrialScore, Result<GraspForces, TrialError>), TrialError> {
     let score = fingertip_score(&config.score);
     let (s, outcome) = score_measured(measured, object, &config.contacts, &score)?;
     let reference = grasp_model(&outcome, object, &score)?.reference_point;
@@ -186,8 +202,8 @@ fn score_sensed(
         object,
         &config.forces,
         (!contacts.is_empty()).then_some(forces),
-    )?;
-    Ok((s, force_analysis(&analysis)))
+    );
+    Ok((s, analysis))
 }
 
 /// The failed result of an attempt whose clouds were invalid (a NaN, a normal that is not

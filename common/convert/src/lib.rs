@@ -4,15 +4,15 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 use graspopt_protocol::{
-    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData,
-    MetricValues, ObjectEstimate, Pose, RunId,
+    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData, MetricValues,
+    ObjectEstimate, Pose, RunId,
 };
 use graspopt_quality::forces::Resisting;
 use graspopt_quality::metrics::Metrics;
 use graspopt_sensing::Reading;
+use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::fingertips::SensorReading;
 use graspopt_trial::forces::GraspForces;
-use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::measured::{MeasuredFinger, MeasuredTrial};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 

@@ -11,6 +11,7 @@
 //! the fingertip contact model ([`graspopt_trial::fingertips::fingertip_score`]).
 
 use graspopt_sensing::{SensingSettings, SensorNoise};
+use graspopt_sim::ContactModelSettings;
 use graspopt_sim::{Object, ParamKind};
 use graspopt_trial::ScoreSettings;
 use graspopt_trial::fingertips::{
@@ -18,7 +19,6 @@ use graspopt_trial::fingertips::{
 };
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
-use graspopt_sim::ContactModelSettings;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -96,7 +96,9 @@ fn angle(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> f64 {
 }
 
 /// Runs the study.
-pub fn round_trip(settings: &SensingStudySettings) -> Result<Vec<ObjectRoundTrip>, ExperimentError> {
+pub fn round_trip(
+    settings: &SensingStudySettings,
+) -> Result<Vec<ObjectRoundTrip>, ExperimentError> {
     let tips_settings = FingertipSettings {
         noise: settings.noise,
         kind: settings.sensing.kind,
@@ -111,7 +113,11 @@ pub fn round_trip(settings: &SensingStudySettings) -> Result<Vec<ObjectRoundTrip
     let mut noise_rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x5EED_0F_F0);
     let mut rows = Vec::new();
     for name in &settings.objects {
-        let ev = evaluator("barrett_ft", name, &[ParamKind::Approach, ParamKind::Vertical])?;
+        let ev = evaluator(
+            "barrett_ft",
+            name,
+            &[ParamKind::Approach, ParamKind::Vertical],
+        )?;
         let mut row = ObjectRoundTrip {
             object: name.clone(),
             trials: settings.trials,

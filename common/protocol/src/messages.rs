@@ -436,7 +436,9 @@ impl ForceAnalysis {
                 "holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least (largest {max:.3} N)"
             ),
             (Some(norm), None) => {
-                format!("holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least")
+                format!(
+                    "holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least"
+                )
             }
             (None, _) => format!("cannot hold the load ({load:.3} N)"),
         };
@@ -794,7 +796,6 @@ pub struct RunStatus {
     #[serde(default)]
     pub best_forces: Option<ForceAnalysis>,
 }
-
 
 /// [`RunStatus`] as wire version 3 first had it, before `waiting`.
 #[derive(Deserialize)]

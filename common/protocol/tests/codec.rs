@@ -271,9 +271,11 @@ fn a_status_from_before_waiting_still_decodes() {
     let json: serde_json::Value =
         serde_json::from_slice(&encode(&s, Encoding::Json).unwrap()).unwrap();
     assert_eq!(json["waiting"][1]["reason"], "planner");
-    // The old bincode layout ends where `waiting` begins: an empty list is one 0 byte.
+    // The old bincode layout ends where `waiting` begins: an empty list is one 0 byte (after
+    // it, `best_forces`, appended later, is one more when `None`).
     let empty = status(vec![]);
     let mut old = encode(&empty, Encoding::Bincode).unwrap();
+    assert_eq!(old.pop(), Some(0));
     assert_eq!(old.pop(), Some(0));
     assert_eq!(decode::<RunStatus>(&old, Encoding::Bincode).unwrap(), empty);
     let mut old_json: serde_json::Value =
@@ -336,4 +338,103 @@ fn a_result_from_before_forces_still_decodes() {
     let err = decode::<TrialResult>(&encode(&bad, Encoding::Bincode).unwrap(), Encoding::Bincode)
         .unwrap_err();
     assert!(err.to_string().contains("forces.slip_margins[1]"), "{err}");
+}
+
+/// `RunStatus.best_forces` was appended after `waiting`: a status written before it still
+/// decodes (bincode), as does one from before `waiting`.
+#[test]
+fn a_status_from_before_best_forces_still_decodes() {
+    let mut s = status(vec![Waiting {
+        reason: WaitReason::Hand,
+        since_ms: 1_700_000_004_000,
+    }]);
+    s.best_forces = Some(ForceAnalysis {
+        external: [0.0, 0.0, -4.905, 0.0, 0.0, 0.0],
+        resisting_norm: None,
+        resisting_max: None,
+        net_wrench: Some([0.1, 0.0, 4.8, 0.0, 0.01, 0.0]),
+        slip_margins: vec![-0.5],
+    });
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        assert_eq!(
+            decode::<RunStatus>(&encode(&s, enc).unwrap(), enc).unwrap(),
+            s
+        );
+    }
+    // Before best_forces: the layout ends after `waiting` (`None` is one 0 byte).
+    s.best_forces = None;
+    let mut old = encode(&s, Encoding::Bincode).unwrap();
+    assert_eq!(old.pop(), Some(0));
+    assert_eq!(decode::<RunStatus>(&old, Encoding::Bincode).unwrap(), s);
+}
+
+fn wrenches() -> FingertipWrenches {
+    FingertipWrenches {
+        run_id: run(),
+        trial_id: 7,
+        attempt: 1,
+        worker: "ft-hand".into(),
+        hand: "barrett_ft".into(),
+        palm_pose: Pose::IDENTITY,
+        fingertips: vec![FingertipWrench {
+            finger: 1,
+            link: "f2_tip".into(),
+            sensor_pose: Pose::IDENTITY,
+            surface: FingertipSurface::Capsule {
+                center: [0.0, 0.0, 0.02],
+                half_length: 0.01,
+                radius: 0.008,
+                base_z: Some(0.0),
+            },
+            force: [0.25, 0.0, -2.0],
+            torque: [0.0, 0.03, 0.0],
+            stamp_ms: 1_700_000_000_000,
+        }],
+        min_gap: None,
+        error: None,
+        executed_ms: 1_700_000_000_001,
+    }
+}
+
+#[test]
+fn fingertip_wrenches_round_trip_and_bad_readings_are_refused_by_field() {
+    let w = wrenches();
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        assert_eq!(
+            decode::<FingertipWrenches>(&encode(&w, enc).unwrap(), enc).unwrap(),
+            w
+        );
+    }
+    // The surface as a Python hand writes it.
+    let json: serde_json::Value =
+        serde_json::from_slice(&encode(&w, Encoding::Json).unwrap()).unwrap();
+    assert_eq!(json["fingertips"][0]["surface"]["shape"], "capsule");
+    assert_eq!(json["fingertips"][0]["surface"]["half_length"], 0.01);
+    let refused = |w: &FingertipWrenches| {
+        let e =
+            decode::<FingertipWrenches>(&encode(w, Encoding::Bincode).unwrap(), Encoding::Bincode)
+                .unwrap_err();
+        assert!(
+            matches!(e, DecodeError::Invalid { about: Some(_), .. }),
+            "{e}"
+        );
+        e.to_string()
+    };
+    let mut nan = w.clone();
+    nan.fingertips[0].torque[2] = f64::NAN;
+    assert!(refused(&nan).contains("fingertips[0].torque[2]"));
+    let mut flat = w.clone();
+    flat.fingertips[0].surface = FingertipSurface::Sphere {
+        center: [0.0; 3],
+        radius: 0.0,
+        base_z: None,
+    };
+    let e = refused(&flat);
+    assert!(
+        e.contains("fingertips[0].surface") && e.contains("radius"),
+        "{e}"
+    );
+    let mut turned = w.clone();
+    turned.fingertips[0].sensor_pose.rotation = [1.0, 1.0, 0.0, 0.0];
+    assert!(refused(&turned).contains("fingertips[0].sensor_pose.rotation"));
 }

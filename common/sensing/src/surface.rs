@@ -2,7 +2,6 @@
 //! the smooth pieces ([`Piece`]) the contact solver works on.
 
 use nalgebra::{Point3, Unit, Vector3};
-use serde::{Deserialize, Serialize};
 
 use crate::error::{SensingError, check, finite};
 
@@ -21,21 +20,23 @@ pub const MIN_SIZE: f64 = 1.0e-6;
 /// whose only pushing contact point lies there is refused
 /// ([`NoContact::OnMount`](crate::NoContact::OnMount) or
 /// [`NoContact::Pulling`](crate::NoContact::Pulling)). JSON leaves it out when absent.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+///
+/// Serde: in human-readable formats (JSON, TOML) a surface is tagged by its shape,
+/// `{"shape": "sphere", "center": [0, 0, 0.015], "radius": 0.012}`; in the others (bincode,
+/// which cannot read an internally tagged enum) it is serde's default enum form with every
+/// field.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FingertipSurface {
     /// A sphere of `radius` about `center`.
     Sphere {
         center: [f64; 3],
         radius: f64,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
         base_z: Option<f64>,
     },
     /// Semi-axes along the sensor frame's x, y, z.
     Ellipsoid {
         center: [f64; 3],
         semi_axes: [f64; 3],
-        #[serde(default, skip_serializing_if = "Option::is_none")]
         base_z: Option<f64>,
     },
     /// A cylinder of `radius` along the sensor z axis from center - half_length z to
@@ -44,9 +45,108 @@ pub enum FingertipSurface {
         center: [f64; 3],
         half_length: f64,
         radius: f64,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
         base_z: Option<f64>,
     },
+}
+
+/// The two serde forms of [`FingertipSurface`] (see its documentation).
+mod wire {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use super::FingertipSurface;
+
+    /// Declares one serde mirror of the surface's variants, with conversions both ways.
+    macro_rules! mirror {
+        ($(#[$attr:meta])* $name:ident, $(#[$opt:meta])*) => {
+            $(#[$attr])*
+            pub(super) enum $name {
+                Sphere {
+                    center: [f64; 3],
+                    radius: f64,
+                    $(#[$opt])*
+                    base_z: Option<f64>,
+                },
+                Ellipsoid {
+                    center: [f64; 3],
+                    semi_axes: [f64; 3],
+                    $(#[$opt])*
+                    base_z: Option<f64>,
+                },
+                Capsule {
+                    center: [f64; 3],
+                    half_length: f64,
+                    radius: f64,
+                    $(#[$opt])*
+                    base_z: Option<f64>,
+                },
+            }
+
+            impl From<FingertipSurface> for $name {
+                fn from(s: FingertipSurface) -> Self {
+                    match s {
+                        FingertipSurface::Sphere { center, radius, base_z } => {
+                            $name::Sphere { center, radius, base_z }
+                        }
+                        FingertipSurface::Ellipsoid { center, semi_axes, base_z } => {
+                            $name::Ellipsoid { center, semi_axes, base_z }
+                        }
+                        FingertipSurface::Capsule { center, half_length, radius, base_z } => {
+                            $name::Capsule { center, half_length, radius, base_z }
+                        }
+                    }
+                }
+            }
+
+            impl From<$name> for FingertipSurface {
+                fn from(s: $name) -> Self {
+                    match s {
+                        $name::Sphere { center, radius, base_z } => {
+                            FingertipSurface::Sphere { center, radius, base_z }
+                        }
+                        $name::Ellipsoid { center, semi_axes, base_z } => {
+                            FingertipSurface::Ellipsoid { center, semi_axes, base_z }
+                        }
+                        $name::Capsule { center, half_length, radius, base_z } => {
+                            FingertipSurface::Capsule { center, half_length, radius, base_z }
+                        }
+                    }
+                }
+            }
+        };
+    }
+
+    mirror!(
+        /// Human-readable: tagged by `shape`, `base_z` left out when absent.
+        #[derive(Serialize, Deserialize)]
+        #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+        Tagged,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+    );
+    mirror!(
+        /// Compact: serde's default enum form, every field.
+        #[derive(Serialize, Deserialize)]
+        Compact,
+    );
+
+    impl Serialize for FingertipSurface {
+        fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+            if s.is_human_readable() {
+                Tagged::from(*self).serialize(s)
+            } else {
+                Compact::from(*self).serialize(s)
+            }
+        }
+    }
+
+    impl<'de> Deserialize<'de> for FingertipSurface {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            if d.is_human_readable() {
+                Tagged::deserialize(d).map(FingertipSurface::from)
+            } else {
+                Compact::deserialize(d).map(FingertipSurface::from)
+            }
+        }
+    }
 }
 
 const CENTER: [&str; 3] = ["center[0]", "center[1]", "center[2]"];

@@ -13,8 +13,9 @@
 //! the object (the simulator leaves a gap of at most 0.2 mm), the normal that direction (into
 //! the object). The forces are the least-norm forces in the friction cones that hold the
 //! object's weight ([`crate::forces`]); when the fingertips alone cannot (the palm or the
-//! phalanges carry the object, or only one tip touches), each touching tip presses
-//! [`FingertipSettings::squeeze`] newtons along its normal, as a closed hand does.
+//! phalanges carry the object, or only one tip touches, or the solver gives up on a degenerate
+//! grasp), each touching tip presses [`FingertipSettings::squeeze`] newtons along its normal,
+//! as a closed hand does.
 
 use graspopt_quality::forces::{ContactForces, Resisting};
 use graspopt_quality::{Contact, FrictionModel};
@@ -208,16 +209,19 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         .collect();
     let model = fingertip_model(settings.kind, &score.model);
     let reference = grasp_model(outcome, object, score)?.reference_point;
-    let applied =
-        match analyse_contacts(&contacts, &model, &reference, object, forces, None)?.resisting {
-            Resisting::Forces { forces, .. } if !contacts.is_empty() => forces,
-            _ => ContactForces::without_torsion(
-                contacts
-                    .iter()
-                    .map(|c| c.normal * settings.squeeze)
-                    .collect(),
-            ),
-        };
+    // A solver that fails on a degenerate grasp counts as "cannot resist": the tips squeeze.
+    forces.validate()?;
+    let resisting =
+        analyse_contacts(&contacts, &model, &reference, object, forces, None).map(|g| g.resisting);
+    let applied = match resisting {
+        Ok(Resisting::Forces { forces, .. }) if !contacts.is_empty() => forces,
+        _ => ContactForces::without_torsion(
+            contacts
+                .iter()
+                .map(|c| c.normal * settings.squeeze)
+                .collect(),
+        ),
+    };
     let mut out = Vec::with_capacity(touching.len());
     for (i, (tip, sensor_pose, point, normal)) in touching.into_iter().enumerate() {
         let truth = FingertipContact {

@@ -5,8 +5,8 @@ use std::marker::PhantomData;
 
 use super::{AgentKind, Claim, ROOT, RunId, check_agent_id};
 use crate::messages::{
-    ContactClouds, FingertipWrenches, Message, ObjectEstimate, RunStatus, SuggestReply, SuggestRequest, TrialCommand,
-    TrialResult,
+    ContactClouds, FingertipWrenches, Message, ObjectEstimate, RunStatus, SuggestReply,
+    SuggestRequest, TrialCommand, TrialResult,
 };
 
 /// Which runs a key names: one, or every run (`*`, for tools that watch them all).
@@ -394,13 +394,14 @@ pub enum Topic {
 }
 
 impl Topic {
+    /// Every topic (`Wrenches`, added last, keeps the others' positions).
     pub const ALL: [Topic; 6] = [
         Topic::Object,
         Topic::Command,
         Topic::Clouds,
-        Topic::Wrenches,
         Topic::Result,
         Topic::Status,
+        Topic::Wrenches,
     ];
 
     /// Its row of the table.

@@ -117,6 +117,12 @@ fn the_table_builds_every_documented_key() {
             AgentKind::Hand,
         ),
         (
+            "wrenches",
+            "graspopt/r1/wrenches",
+            "FingertipWrenches",
+            AgentKind::Hand,
+        ),
+        (
             "result",
             "graspopt/r1/result",
             "TrialResult",

@@ -30,7 +30,10 @@ pub fn sensing(args: &SensingArgs) -> Result<()> {
     noise.force_resolution = args.force_resolution.unwrap_or(noise.force_resolution);
     noise.torque_resolution = args.torque_resolution.unwrap_or(noise.torque_resolution);
     noise.validate()?;
-    for (title, noise) in [("without noise", SensorNoise::NONE), ("with sensor noise", noise)] {
+    for (title, noise) in [
+        ("without noise", SensorNoise::NONE),
+        ("with sensor noise", noise),
+    ] {
         let settings = SensingStudySettings {
             trials: args.trials,
             seed: args.seed,
