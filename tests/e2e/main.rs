@@ -5,7 +5,9 @@
 //!
 //! The slow suites of fault injection and malformed traffic (`faults`, `fuzz`, `reliability`)
 //! are ignored by `cargo test --workspace`; `.ci/run` runs them as their own step:
-//! `cargo test -p graspopt --test e2e -- --ignored faults:: fuzz:: reliability::`.
+//! `cargo test -p graspopt --test e2e -- --ignored faults:: fuzz:: reliability::`. The
+//! multi-machine test (`netns`, network namespaces) needs root: `.ci/run` runs it alone with
+//! `GRASPOPT_REQUIRE_NETNS=1`, which makes a skip a failure.
 
 mod connect;
 mod equivalence;
@@ -14,6 +16,7 @@ mod fuzz;
 mod launch;
 mod lifecycle;
 mod monitor;
+mod netns;
 mod pipeline;
 mod reliability;
 mod replay;
