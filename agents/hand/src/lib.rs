@@ -120,6 +120,16 @@ impl Default for HandConfig {
     }
 }
 
+/// Checks what `config` asks for before anything joins the bus: the hand exists, and with
+/// `sensing = "ft"` it has spherical fingertips and the sensor settings are valid (a replay
+/// hand's recording is checked when it loads).
+pub fn check(config: &HandConfig) -> anyhow::Result<()> {
+    if config.replay.is_none() {
+        SimulatedHand::new(config)?;
+    }
+    Ok(())
+}
+
 /// Serves trial commands with the hand `config` describes (the replay hand when `replay`
 /// is set, else the simulated one, measuring clouds or fingertip forces per `sensing`) until
 /// the task is cancelled.

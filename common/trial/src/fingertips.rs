@@ -11,11 +11,14 @@
 //!
 //! The contact of a touching fingertip is the point of its sphere towards the nearest point of
 //! the object (the simulator leaves a gap of at most 0.2 mm), the normal that direction (into
-//! the object). The forces are the least-norm forces in the friction cones that hold the
-//! object's weight ([`crate::forces`]); when the fingertips alone cannot (the palm or the
-//! phalanges carry the object, or only one tip touches, or the solver gives up on a degenerate
-//! grasp), each touching tip presses [`FingertipSettings::squeeze`] newtons along its normal,
-//! as a closed hand does.
+//! the object). The forces are the least-norm forces that hold the object's weight
+//! ([`crate::forces`]) inside friction cones narrowed by [`FingertipSettings::grip`]: a hand
+//! grips harder than the least it needs, so its forces stay well inside the true cones (a
+//! grip of 3 asks for a third of the friction, about three times the normal force). Where the
+//! narrowed cones cannot hold the weight the true ones are used; where those cannot either
+//! (the palm or the phalanges carry the object, only one tip touches, or the solver gives up
+//! on a degenerate grasp), each touching tip presses [`FingertipSettings::squeeze`] newtons
+//! along its normal, as a closed hand does.
 
 use graspopt_quality::forces::{ContactForces, Resisting};
 use graspopt_quality::{Contact, FrictionModel};
@@ -45,6 +48,9 @@ pub struct FingertipSettings {
     /// The normal force each touching tip applies when the tips alone cannot hold the
     /// object (N). Default 2 N.
     pub squeeze: f64,
+    /// How much harder than the least it needs the hand grips: the forces hold the weight
+    /// with the friction coefficient divided by this (>= 1). Default 3.
+    pub grip: f64,
 }
 
 impl Default for FingertipSettings {
@@ -54,6 +60,7 @@ impl Default for FingertipSettings {
             noise: SensorNoise::default(),
             sensor_depth: 0.015,
             squeeze: 2.0,
+            grip: 3.0,
         }
     }
 }
@@ -162,6 +169,22 @@ pub fn fingertip_score(score: &ScoreSettings) -> ScoreSettings {
     }
 }
 
+/// `model` with its friction coefficient (and torsional coefficient) divided by `grip`.
+fn narrowed(model: &FrictionModel, grip: f64) -> FrictionModel {
+    match *model {
+        FrictionModel::Frictionless => FrictionModel::Frictionless,
+        FrictionModel::PointFriction { mu, edges } => FrictionModel::PointFriction {
+            mu: mu / grip,
+            edges,
+        },
+        FrictionModel::SoftFinger { mu, edges, gamma } => FrictionModel::SoftFinger {
+            mu: mu / grip,
+            edges,
+            gamma: gamma / grip,
+        },
+    }
+}
+
 /// The sensor readings of the touching fingertips of a simulated trial (see the module
 /// documentation), with noise from `rng`.
 pub fn simulate_readings<R: rand::Rng + ?Sized>(
@@ -176,11 +199,13 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
     settings.noise.validate().map_err(sensing_settings)?;
     if !(settings.sensor_depth.is_finite()
         && settings.squeeze.is_finite()
-        && settings.squeeze > 0.0)
+        && settings.squeeze > 0.0
+        && settings.grip.is_finite()
+        && settings.grip >= 1.0)
     {
         return Err(TrialError::Settings(format!(
-            "sensor_depth must be finite and squeeze finite and > 0, got {} and {}",
-            settings.sensor_depth, settings.squeeze
+            "sensor_depth must be finite, squeeze finite and > 0 and grip finite and >= 1, got {}, {} and {}",
+            settings.sensor_depth, settings.squeeze, settings.grip
         )));
     }
     let grasp = &outcome.grasp;
@@ -209,19 +234,28 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         .collect();
     let model = fingertip_model(settings.kind, &score.model);
     let reference = grasp_model(outcome, object, score)?.reference_point;
-    // A solver that fails on a degenerate grasp counts as "cannot resist": the tips squeeze.
+    // The narrowed cones, then the true ones; a solver that fails on a degenerate grasp
+    // counts as "cannot resist": the tips squeeze.
     forces.validate()?;
-    let resisting =
-        analyse_contacts(&contacts, &model, &reference, object, forces, None).map(|g| g.resisting);
-    let applied = match resisting {
-        Ok(Resisting::Forces { forces, .. }) if !contacts.is_empty() => forces,
-        _ => ContactForces::without_torsion(
-            contacts
-                .iter()
-                .map(|c| c.normal * settings.squeeze)
-                .collect(),
-        ),
+    let held = |m: &FrictionModel| match analyse_contacts(
+        &contacts, m, &reference, object, forces, None,
+    ) {
+        Ok(g) => match g.resisting {
+            Resisting::Forces { forces, .. } if !contacts.is_empty() => Some(forces),
+            _ => None,
+        },
+        Err(_) => None,
     };
+    let applied = held(&narrowed(&model, settings.grip))
+        .or_else(|| held(&model))
+        .unwrap_or_else(|| {
+            ContactForces::without_torsion(
+                contacts
+                    .iter()
+                    .map(|c| c.normal * settings.squeeze)
+                    .collect(),
+            )
+        });
     let mut out = Vec::with_capacity(touching.len());
     for (i, (tip, sensor_pose, point, normal)) in touching.into_iter().enumerate() {
         let truth = FingertipContact {

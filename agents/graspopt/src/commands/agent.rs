@@ -205,6 +205,7 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             let noise = &mut c.fingertips.noise;
             noise.force_resolution = force_resolution.unwrap_or(noise.force_resolution);
             noise.torque_resolution = torque_resolution.unwrap_or(noise.torque_resolution);
+            graspopt_hand::check(&c)?;
             let (bus, run) = join(common).await?;
             until_signal(graspopt_hand::run(&bus, &run, &c)).await?;
             Ok(ExitCode::SUCCESS)

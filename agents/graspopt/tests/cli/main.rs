@@ -3,6 +3,7 @@
 //! A new file here needs a `mod` line below.
 
 mod cli_bad_input;
+mod forces_cli;
 mod pipe_cli;
 mod quality_cli;
 mod render_cli;
