@@ -35,7 +35,9 @@ use graspopt_quality::forces::ContactForces;
 use graspopt_sensing::SensingSettings;
 use graspopt_sim::{ContactModelSettings, Object};
 use graspopt_trial::ScoreSettings;
-use graspopt_trial::fingertips::{FingertipContact, fingertip_model, fingertip_score, sense};
+use graspopt_trial::fingertips::{
+    FingertipContact, fingertip_model, fingertip_score, sense, soft_finger_sensing,
+};
 use graspopt_trial::forces::{ForceSettings, GraspForces, analyse_contacts, analyse_outcome};
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use graspopt_trial::score::grasp_model;
@@ -51,7 +53,8 @@ pub struct MetricConfig {
     pub contacts: ContactModelSettings,
     /// Contact model, frame, torque scale and metric of the score.
     pub score: ScoreSettings,
-    /// How fingertip force/torque readings are turned into contacts.
+    /// How fingertip force/torque readings are turned into contacts (soft fingers by
+    /// default, as the score's contact model).
     pub sensing: SensingSettings,
     /// What the force analysis holds the grasp against (the object's weight).
     pub forces: ForceSettings,
@@ -63,7 +66,7 @@ impl Default for MetricConfig {
             id: "metric".into(),
             contacts: ContactModelSettings::default(),
             score: ScoreSettings::default(),
-            sensing: SensingSettings::default(),
+            sensing: soft_finger_sensing(),
             forces: ForceSettings::default(),
         }
     }

@@ -50,7 +50,7 @@ impl Default for SensingStudySettings {
             trials: 200,
             seed: 0,
             noise: SensorNoise::default(),
-            sensing: SensingSettings::default(),
+            sensing: graspopt_trial::fingertips::soft_finger_sensing(),
         }
     }
 }
@@ -110,7 +110,7 @@ pub fn round_trip(
     // Trials and noise from generators of their own: runs that differ in noise only see the
     // same trials.
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-    let mut noise_rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x5EED_0F_F0);
+    let mut noise_rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x5EED_0FF0);
     let mut rows = Vec::new();
     for name in &settings.objects {
         let ev = evaluator(

@@ -12,13 +12,14 @@
 //! The contact of a touching fingertip is the point of its sphere towards the nearest point of
 //! the object (the simulator leaves a gap of at most 0.2 mm), the normal that direction (into
 //! the object). The forces are the least-norm forces that hold the object's weight
-//! ([`crate::forces`]) inside friction cones narrowed by [`FingertipSettings::grip`]: a hand
-//! grips harder than the least it needs, so its forces stay well inside the true cones (a
-//! grip of 3 asks for a third of the friction, about three times the normal force). Where the
-//! narrowed cones cannot hold the weight the true ones are used; where those cannot either
-//! (the palm or the phalanges carry the object, only one tip touches, or the solver gives up
-//! on a degenerate grasp), each touching tip presses [`FingertipSettings::squeeze`] newtons
-//! along its normal, as a closed hand does.
+//! ([`crate::forces`]) plus a grip: a hand squeezes harder than the least it needs. The grip is
+//! [`FingertipSettings::grip`] newtons along each normal, projected onto the internal forces
+//! (those with no net wrench, the null space of the contacts' force map), so the forces still
+//! hold exactly the weight; it is halved until every force is inside its friction cone.
+//! Where the fingertips alone cannot hold the weight (the palm or the phalanges carry the
+//! object, only one tip touches, or the solver gives up on a degenerate grasp), each touching
+//! tip presses [`FingertipSettings::squeeze`] newtons along its normal, as a closed hand
+//! does.
 
 use graspopt_quality::forces::{ContactForces, Resisting};
 use graspopt_quality::{Contact, FrictionModel};
@@ -38,30 +39,40 @@ use crate::score::{ScoreSettings, grasp_model};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FingertipSettings {
-    /// What a fingertip transmits: a point contact with friction (no torsion) or a soft
-    /// finger (a moment about the normal too).
+    /// What a fingertip transmits: a soft finger (a force and a moment about the normal, the
+    /// thesis's contact model and the default) or a point contact with friction.
     pub kind: ContactKind,
     /// The sensor noise (Nano17 by default; [`SensorNoise::NONE`] for exact readings).
     pub noise: SensorNoise,
     /// How far below the sphere's centre the sensor's origin is (m). Default 15 mm.
     pub sensor_depth: f64,
     /// The normal force each touching tip applies when the tips alone cannot hold the
-    /// object (N). Default 2 N.
+    /// object (N). Default 10 N.
     pub squeeze: f64,
-    /// How much harder than the least it needs the hand grips: the forces hold the weight
-    /// with the friction coefficient divided by this (>= 1). Default 3.
+    /// The grip (N) each tip adds along its normal, as internal forces, to the least forces
+    /// that hold the weight. Default 10 N (a BH8 fingertip presses up to about 20 N).
     pub grip: f64,
 }
 
 impl Default for FingertipSettings {
     fn default() -> Self {
         FingertipSettings {
-            kind: ContactKind::Point,
+            kind: ContactKind::SoftFinger,
             noise: SensorNoise::default(),
             sensor_depth: 0.015,
-            squeeze: 2.0,
-            grip: 3.0,
+            squeeze: 10.0,
+            grip: 10.0,
         }
+    }
+}
+
+/// How readings are turned into contacts for a hand whose fingertips transmit soft-finger
+/// contacts (the default [`FingertipSettings`], and the thesis's contact model): the sensing
+/// library's defaults with the soft-finger model.
+pub fn soft_finger_sensing() -> SensingSettings {
+    SensingSettings {
+        kind: ContactKind::SoftFinger,
+        ..SensingSettings::default()
     }
 }
 
@@ -169,20 +180,59 @@ pub fn fingertip_score(score: &ScoreSettings) -> ScoreSettings {
     }
 }
 
-/// `model` with its friction coefficient (and torsional coefficient) divided by `grip`.
-fn narrowed(model: &FrictionModel, grip: f64) -> FrictionModel {
-    match *model {
-        FrictionModel::Frictionless => FrictionModel::Frictionless,
-        FrictionModel::PointFriction { mu, edges } => FrictionModel::PointFriction {
-            mu: mu / grip,
-            edges,
-        },
-        FrictionModel::SoftFinger { mu, edges, gamma } => FrictionModel::SoftFinger {
-            mu: mu / grip,
-            edges,
-            gamma: gamma / grip,
-        },
+/// `forces` (in equilibrium with the load) plus the grip: `grip` N along each contact's
+/// normal projected onto the internal forces (no net wrench about `reference`), halved until
+/// every force is inside its friction cone under `model` (at most 20 times, then no grip).
+fn with_grip(
+    contacts: &[Contact],
+    forces: ContactForces,
+    model: &FrictionModel,
+    reference: &Vector3<f64>,
+    grip: f64,
+) -> ContactForces {
+    let m = contacts.len();
+    if m < 2 || grip == 0.0 {
+        return forces;
     }
+    // The force map: column block i maps contact i's force to its wrench.
+    let mut g = nalgebra::DMatrix::<f64>::zeros(6, 3 * m);
+    for (i, c) in contacts.iter().enumerate() {
+        let r = c.position - reference;
+        for k in 0..3 {
+            let e = Vector3::ith(k, 1.0);
+            let t = r.cross(&e);
+            for row in 0..3 {
+                g[(row, 3 * i + k)] = e[row];
+                g[(3 + row, 3 * i + k)] = t[row];
+            }
+        }
+    }
+    let squeeze = nalgebra::DVector::from_iterator(
+        3 * m,
+        contacts
+            .iter()
+            .flat_map(|c| (c.normal * grip).iter().copied().collect::<Vec<_>>()),
+    );
+    let Ok(pinv) = g.clone().pseudo_inverse(1e-12) else {
+        return forces;
+    };
+    let internal = &squeeze - &pinv * (&g * &squeeze);
+    let mut scale = 1.0;
+    for _ in 0..20 {
+        let gripped = ContactForces::new(
+            (0..m)
+                .map(|i| forces.forces[i] + internal.fixed_rows::<3>(3 * i) * scale)
+                .collect(),
+            forces.torsions.clone(),
+        );
+        let inside = graspopt_quality::forces::slip_margins(contacts, model, &gripped)
+            .is_ok_and(|margins| margins.iter().all(|s| s.holds(0.0)));
+        if inside {
+            return gripped;
+        }
+        scale *= 0.5;
+    }
+    forces
 }
 
 /// The sensor readings of the touching fingertips of a simulated trial (see the module
@@ -201,10 +251,10 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         && settings.squeeze.is_finite()
         && settings.squeeze > 0.0
         && settings.grip.is_finite()
-        && settings.grip >= 1.0)
+        && settings.grip >= 0.0)
     {
         return Err(TrialError::Settings(format!(
-            "sensor_depth must be finite, squeeze finite and > 0 and grip finite and >= 1, got {}, {} and {}",
+            "sensor_depth must be finite, squeeze finite and > 0 and grip finite and >= 0, got {}, {} and {}",
             settings.sensor_depth, settings.squeeze, settings.grip
         )));
     }
@@ -234,28 +284,24 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         .collect();
     let model = fingertip_model(settings.kind, &score.model);
     let reference = grasp_model(outcome, object, score)?.reference_point;
-    // The narrowed cones, then the true ones; a solver that fails on a degenerate grasp
-    // counts as "cannot resist": the tips squeeze.
+    // A solver that fails on a degenerate grasp counts as "cannot resist": the tips squeeze.
     forces.validate()?;
-    let held = |m: &FrictionModel| match analyse_contacts(
-        &contacts, m, &reference, object, forces, None,
-    ) {
+    let held = match analyse_contacts(&contacts, &model, &reference, object, forces, None) {
         Ok(g) => match g.resisting {
             Resisting::Forces { forces, .. } if !contacts.is_empty() => Some(forces),
             _ => None,
         },
         Err(_) => None,
     };
-    let applied = held(&narrowed(&model, settings.grip))
-        .or_else(|| held(&model))
-        .unwrap_or_else(|| {
-            ContactForces::without_torsion(
-                contacts
-                    .iter()
-                    .map(|c| c.normal * settings.squeeze)
-                    .collect(),
-            )
-        });
+    let applied = match held {
+        Some(least) => with_grip(&contacts, least, &model, &reference, settings.grip),
+        None => ContactForces::without_torsion(
+            contacts
+                .iter()
+                .map(|c| c.normal * settings.squeeze)
+                .collect(),
+        ),
+    };
     let mut out = Vec::with_capacity(touching.len());
     for (i, (tip, sensor_pose, point, normal)) in touching.into_iter().enumerate() {
         let truth = FingertipContact {
