@@ -76,6 +76,21 @@ pub struct ObjectRoundTrip {
 }
 
 impl ObjectRoundTrip {
+    /// No figures yet for `object` and its `trials`.
+    fn empty(object: &str, trials: usize) -> Self {
+        ObjectRoundTrip {
+            object: object.to_string(),
+            trials,
+            tips: 0,
+            refused: 0,
+            position_errors: Vec::new(),
+            normal_errors: Vec::new(),
+            force_closure: 0,
+            bw_agree: 0,
+            bw_worst: 0.0,
+        }
+    }
+
     pub fn median_position(&self) -> Option<f64> {
         median(&self.position_errors)
     }
@@ -118,17 +133,7 @@ pub fn round_trip(
             name,
             &[ParamKind::Approach, ParamKind::Vertical],
         )?;
-        let mut row = ObjectRoundTrip {
-            object: name.clone(),
-            trials: settings.trials,
-            tips: 0,
-            refused: 0,
-            position_errors: Vec::new(),
-            normal_errors: Vec::new(),
-            force_closure: 0,
-            bw_agree: 0,
-            bw_worst: 0.0,
-        };
+        let mut row = ObjectRoundTrip::empty(name, settings.trials);
         for _ in 0..settings.trials {
             let u: Vec<f64> = (0..ev.space.dim()).map(|_| rng.random::<f64>()).collect();
             let params = ev.space.from_unit(&u)?;
@@ -193,17 +198,7 @@ pub fn markdown_table(rows: &[ObjectRoundTrip]) -> String {
     );
     let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.3e}", v * 1e3));
     let deg = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.3e}", v.to_degrees()));
-    let mut all = ObjectRoundTrip {
-        object: "all".into(),
-        trials: 0,
-        tips: 0,
-        refused: 0,
-        position_errors: Vec::new(),
-        normal_errors: Vec::new(),
-        force_closure: 0,
-        bw_agree: 0,
-        bw_worst: 0.0,
-    };
+    let mut all = ObjectRoundTrip::empty("all", 0);
     for r in rows {
         all.trials += r.trials;
         all.tips += r.tips;
