@@ -278,6 +278,7 @@ pub struct FingertipWrench {
     /// The sensor frame in the world when it read.
     pub sensor_pose: Pose,
     /// The fingertip's surface, in the sensor frame.
+    #[serde(with = "surface_wire")]
     pub surface: FingertipSurface,
     /// The force the object applies to the fingertip, sensor frame (N).
     pub force: [f64; 3],
@@ -285,6 +286,109 @@ pub struct FingertipWrench {
     pub torque: [f64; 3],
     /// When the sensor read (milliseconds since the Unix epoch).
     pub stamp_ms: i64,
+}
+
+/// A [`FingertipSurface`] on the wire: in JSON its own form (`{"shape": "sphere", ...}`);
+/// in bincode, which cannot decode an internally tagged enum (nor a field left out when
+/// absent), an externally tagged copy with every field.
+mod surface_wire {
+    use graspopt_sensing::FingertipSurface;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    enum Bin {
+        Sphere {
+            center: [f64; 3],
+            radius: f64,
+            base_z: Option<f64>,
+        },
+        Ellipsoid {
+            center: [f64; 3],
+            semi_axes: [f64; 3],
+            base_z: Option<f64>,
+        },
+        Capsule {
+            center: [f64; 3],
+            half_length: f64,
+            radius: f64,
+            base_z: Option<f64>,
+        },
+    }
+
+    pub fn serialize<S: Serializer>(s: &FingertipSurface, ser: S) -> Result<S::Ok, S::Error> {
+        if ser.is_human_readable() {
+            return s.serialize(ser);
+        }
+        match *s {
+            FingertipSurface::Sphere {
+                center,
+                radius,
+                base_z,
+            } => Bin::Sphere {
+                center,
+                radius,
+                base_z,
+            },
+            FingertipSurface::Ellipsoid {
+                center,
+                semi_axes,
+                base_z,
+            } => Bin::Ellipsoid {
+                center,
+                semi_axes,
+                base_z,
+            },
+            FingertipSurface::Capsule {
+                center,
+                half_length,
+                radius,
+                base_z,
+            } => Bin::Capsule {
+                center,
+                half_length,
+                radius,
+                base_z,
+            },
+        }
+        .serialize(ser)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(de: D) -> Result<FingertipSurface, D::Error> {
+        if de.is_human_readable() {
+            return FingertipSurface::deserialize(de);
+        }
+        Ok(match Bin::deserialize(de)? {
+            Bin::Sphere {
+                center,
+                radius,
+                base_z,
+            } => FingertipSurface::Sphere {
+                center,
+                radius,
+                base_z,
+            },
+            Bin::Ellipsoid {
+                center,
+                semi_axes,
+                base_z,
+            } => FingertipSurface::Ellipsoid {
+                center,
+                semi_axes,
+                base_z,
+            },
+            Bin::Capsule {
+                center,
+                half_length,
+                radius,
+                base_z,
+            } => FingertipSurface::Capsule {
+                center,
+                half_length,
+                radius,
+                base_z,
+            },
+        })
+    }
 }
 
 /// hand -> metric: what a hand's fingertip force/torque sensors read in one trial (a hand that
