@@ -5,6 +5,7 @@ It stands where a real robot's driver would: it declares itself alive, receives 
 "executes" each one and publishes the contact clouds its fingertip sensors measured. Here the
 measurements come from a recording (JSON lines, as written by `graspopt record`): each command is
 answered with the recorded grasp nearest to its parameters. Replace `measure()` with your robot.
+A hand with force/torque sensors in its fingertips: ft_hand_agent.py, built on this file.
 
     pip install eclipse-zenoh~=1.10.0
     python3 hand_agent.py --connect tcp/127.0.0.1:7447 --run mug --id py-hand-1 \
@@ -26,16 +27,21 @@ import zenoh
 WIRE_VERSION = 3  # every payload carries it; a mismatch is refused
 
 
-def load_recording(path):
-    """The recorded grasps: dicts with params, hand, palm_pose, fingers, min_gap."""
+def load_recording(path, check=None):
+    """The recorded grasps: dicts with params, hand, palm_pose, fingers (or fingertips), min_gap.
+    `check(grasp)`, if given, returns what is wrong with a grasp (None: nothing)."""
     grasps = []
     with open(path, encoding="utf-8") as f:
         for n, line in enumerate(f, 1):
             if line.strip():
                 try:
-                    grasps.append(json.loads(line))
+                    grasp = json.loads(line)
                 except json.JSONDecodeError as e:
                     sys.exit(f"recording {path}, line {n}: {e}")
+                problem = check(grasp) if check else None
+                if problem:
+                    sys.exit(f"recording {path}, line {n}: {problem}")
+                grasps.append(grasp)
     if not grasps:
         sys.exit(f"recording {path} holds no grasps")
     return grasps
@@ -113,16 +119,40 @@ def take_place(session, prefix, hand_id, wait_s=5.0):
                      "same moment: this one gives way (give it another --id)")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def clouds_of(grasps, command, worker):
+    """The answer to `command`: the topic (below the run's prefix) and the ContactClouds message
+    of the nearest recorded grasp, or none and the reason in `error`."""
+    grasp, error = measure(grasps, command)
+    return "clouds", {
+        "wire": WIRE_VERSION,
+        "run_id": command["run_id"],
+        "trial_id": command["trial_id"],
+        "attempt": command["attempt"],
+        "worker": worker,
+        "hand": command["hand"],
+        "palm_pose": grasp["palm_pose"] if grasp else command["palm_pose"],
+        "fingers": grasp.get("fingers", []) if grasp else [],
+        "min_gap": grasp.get("min_gap") if grasp else None,
+        "error": error,
+        "executed_ms": int(time.time() * 1000),
+    }
+
+
+def argument_parser(description):
+    """The flags every hand agent here takes."""
+    ap = argparse.ArgumentParser(description=description.splitlines()[0])
     ap.add_argument("--connect", required=True, help="router or peer endpoint, e.g. tcp/10.0.0.5:7447")
     ap.add_argument("--run", required=True, help="the run to join")
     ap.add_argument("--id", default="py-hand-1", help="this worker's id (unique in the run)")
     ap.add_argument("--recording", required=True, help="JSON lines of recorded grasps")
     ap.add_argument("--trial-cost-ms", type=int, default=0, help="minimum duration of a trial")
-    args = ap.parse_args()
+    return ap
 
-    grasps = load_recording(args.recording)
+
+def serve(args, grasps, answer):
+    """Joins the run as hand `args.id` and answers each trial command sent to it with
+    `answer(grasps, command, worker)`, which returns the topic (below `graspopt/<run>/`) and
+    the JSON message to put there, until interrupted."""
     conf = zenoh.Config()
     conf.insert_json5("mode", '"peer"')
     conf.insert_json5("connect/endpoints", json.dumps([args.connect]))
@@ -157,24 +187,11 @@ def main():
                 bad += 1
                 print(f"{args.id}: bad command ({bad} bad messages): {e}", file=sys.stderr, flush=True)
                 continue
-            grasp, error = measure(grasps, command)
-            clouds = {
-                "wire": WIRE_VERSION,
-                "run_id": command["run_id"],
-                "trial_id": command["trial_id"],
-                "attempt": command["attempt"],
-                "worker": args.id,
-                "hand": command["hand"],
-                "palm_pose": grasp["palm_pose"] if grasp else command["palm_pose"],
-                "fingers": grasp["fingers"] if grasp else [],
-                "min_gap": grasp.get("min_gap") if grasp else None,
-                "error": error,
-                "executed_ms": int(time.time() * 1000),
-            }
+            topic, message = answer(grasps, command, args.id)
             rest = args.trial_cost_ms / 1000 - (time.monotonic() - started)
             if rest > 0:
                 time.sleep(rest)
-            session.put(f"{prefix}/clouds", json.dumps(clouds).encode(),
+            session.put(f"{prefix}/{topic}", json.dumps(message).encode(),
                         encoding=zenoh.Encoding.APPLICATION_JSON,
                         congestion_control=zenoh.CongestionControl.BLOCK)
     except KeyboardInterrupt:
@@ -183,6 +200,11 @@ def main():
         token.undeclare()
         place.undeclare()
         session.close()
+
+
+def main():
+    args = argument_parser(__doc__).parse_args()
+    serve(args, load_recording(args.recording), clouds_of)
 
 
 def queue_of(session, key):

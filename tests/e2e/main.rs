@@ -12,6 +12,7 @@
 mod connect;
 mod equivalence;
 mod faults;
+mod ft;
 mod fuzz;
 mod launch;
 mod lifecycle;

@@ -4,8 +4,8 @@
 //! trial and attempt, so a trial reads the same each time it is executed.
 
 use anyhow::Context;
-use graspopt_convert::{TrialTag, clouds_from_outcome, isometry, pose};
-use graspopt_protocol::{FingertipWrench, ObjectEstimate, TrialCommand};
+use graspopt_convert::{TrialTag, clouds_from_outcome, fingertip_wrench, isometry};
+use graspopt_protocol::{ObjectEstimate, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
 use graspopt_trial::ScoreSettings;
 use graspopt_trial::fingertips::{fingertips, simulate_readings};
@@ -92,16 +92,8 @@ impl SimulatedHand {
             palm_pose: clouds.palm_pose,
             fingers: Vec::new(),
             fingertips: tips
-                .into_iter()
-                .map(|t| FingertipWrench {
-                    finger: t.sensor.finger as u32,
-                    link: t.sensor.link,
-                    sensor_pose: pose(&t.sensor.sensor_pose),
-                    surface: t.sensor.surface,
-                    force: t.sensor.reading.force.into(),
-                    torque: t.sensor.reading.torque.into(),
-                    stamp_ms,
-                })
+                .iter()
+                .map(|t| fingertip_wrench(&t.sensor, stamp_ms))
                 .collect(),
             min_gap: clouds.min_gap,
         })

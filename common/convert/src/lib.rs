@@ -144,6 +144,20 @@ pub fn sensor_reading(w: &FingertipWrench) -> SensorReading {
     }
 }
 
+/// A fingertip sensor's reading as a message, read at `stamp_ms` (the inverse of
+/// [`sensor_reading`]).
+pub fn fingertip_wrench(sensor: &SensorReading, stamp_ms: i64) -> FingertipWrench {
+    FingertipWrench {
+        finger: sensor.finger as u32,
+        link: sensor.link.clone(),
+        sensor_pose: pose(&sensor.sensor_pose),
+        surface: sensor.surface,
+        force: sensor.reading.force.into(),
+        torque: sensor.reading.torque.into(),
+        stamp_ms,
+    }
+}
+
 /// A trial's force analysis on the wire.
 pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
     let (resisting_norm, resisting_max) = match &g.resisting {
@@ -188,6 +202,40 @@ mod tests {
         let back = isometry(&pose(&iso));
         assert!((back.to_homogeneous() - iso.to_homogeneous()).norm() < 1e-12);
         assert!(pose(&iso).validate("pose").is_ok());
+    }
+
+    #[test]
+    fn fingertip_readings_round_trip_through_their_message() {
+        let sensor = SensorReading {
+            finger: 2,
+            link: "tip2".into(),
+            sensor_pose: Isometry3::from_parts(
+                Translation3::new(0.1, 0.0, 0.2),
+                UnitQuaternion::from_euler_angles(0.1, 0.2, 0.3),
+            ),
+            surface: graspopt_sensing::FingertipSurface::Sphere {
+                center: [0.0, 0.0, 0.015],
+                radius: 0.012,
+                base_z: None,
+            },
+            reading: Reading {
+                force: Vector3::new(0.5, -1.0, -2.0),
+                torque: Vector3::new(1e-3, 2e-3, 0.0),
+            },
+        };
+        let w = fingertip_wrench(&sensor, 42);
+        assert_eq!(
+            (w.finger, w.link.as_str(), w.force, w.torque, w.stamp_ms),
+            (2, "tip2", [0.5, -1.0, -2.0], [1e-3, 2e-3, 0.0], 42)
+        );
+        let back = sensor_reading(&w);
+        assert_eq!(
+            (back.finger, &back.link, back.surface),
+            (2, &sensor.link, sensor.surface)
+        );
+        assert_eq!(back.reading, sensor.reading);
+        let d = back.sensor_pose.to_homogeneous() - sensor.sensor_pose.to_homogeneous();
+        assert!(d.norm() < 1e-12);
     }
 
     #[test]

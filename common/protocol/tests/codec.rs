@@ -438,3 +438,58 @@ fn fingertip_wrenches_round_trip_and_bad_readings_are_refused_by_field() {
     turned.fingertips[0].sensor_pose.rotation = [1.0, 1.0, 0.0, 0.0];
     assert!(refused(&turned).contains("fingertips[0].sensor_pose.rotation"));
 }
+
+/// Fingertip readings with each fingertip shape, with and without a base height: the
+/// surface, an internally tagged enum in JSON, must round-trip in bincode too.
+#[test]
+fn fingertip_readings_round_trip_in_both_encodings() {
+    let tip = |surface| FingertipWrench {
+        finger: 1,
+        link: "tip".into(),
+        sensor_pose: Pose::IDENTITY,
+        surface,
+        force: [0.1, -0.2, -2.0],
+        torque: [1e-4, 0.0, -3e-5],
+        stamp_ms: 12,
+    };
+    let w = FingertipWrenches {
+        run_id: run(),
+        trial_id: 4,
+        attempt: 2,
+        worker: "hand-1".into(),
+        hand: "barrett_ft".into(),
+        palm_pose: Pose::IDENTITY,
+        fingertips: vec![
+            tip(FingertipSurface::Sphere {
+                center: [0.0, 0.0, 0.015],
+                radius: 0.012,
+                base_z: None,
+            }),
+            tip(FingertipSurface::Ellipsoid {
+                center: [0.0, 0.0, 0.01],
+                semi_axes: [0.01, 0.012, 0.015],
+                base_z: Some(0.0),
+            }),
+            tip(FingertipSurface::Capsule {
+                center: [0.0, 0.0, 0.02],
+                half_length: 0.01,
+                radius: 0.008,
+                base_z: Some(0.005),
+            }),
+        ],
+        min_gap: None,
+        error: None,
+        executed_ms: 13,
+    };
+    for enc in [Encoding::Bincode, Encoding::Json] {
+        let back = decode::<FingertipWrenches>(&encode(&w, enc).unwrap(), enc);
+        assert_eq!(back.as_ref().ok(), Some(&w), "{enc:?}: {back:?}");
+    }
+    // JSON keeps the documented surface form (keys in sorted order), without an absent
+    // base_z.
+    let json = String::from_utf8(encode(&w, Encoding::Json).unwrap()).unwrap();
+    assert!(
+        json.contains(r#""surface":{"center":[0.0,0.0,0.015],"radius":0.012,"shape":"sphere"}"#),
+        "{json}"
+    );
+}
