@@ -209,10 +209,12 @@ fn score_sensed(
     Ok((s, analysis))
 }
 
-/// The failed result of an attempt whose clouds were invalid (a NaN, a normal that is not
-/// unit length): the error names the field.
-pub fn invalid_clouds_result(
+/// The failed result of an attempt whose clouds (`what`: "contact clouds") or fingertip
+/// readings ("fingertip readings") were invalid (a NaN, a normal that is not unit length, a
+/// surface of radius 0): the error names the field.
+pub fn invalid_measurement_result(
     about: &AttemptRef,
+    what: &str,
     detail: &str,
     scorer: &str,
     transport: &str,
@@ -229,7 +231,7 @@ pub fn invalid_clouds_result(
         fingers_in_contact: 0,
         cloud_points: 0,
         cloud_transport: transport.to_string(),
-        error: Some(format!("invalid contact clouds: {detail}")),
+        error: Some(format!("invalid {what}: {detail}")),
         forces: None,
     }
 }
@@ -290,7 +292,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                     if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
                         && a.run_id == *run
                     {
-                        let failed = invalid_clouds_result(a, detail, &config.id, r.path.as_str());
+                        let failed = invalid_measurement_result(a, "contact clouds", detail, &config.id, r.path.as_str());
                         if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
                             tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
                         }
@@ -309,7 +311,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                     if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
                         && a.run_id == *run
                     {
-                        let failed = invalid_clouds_result(a, detail, &config.id, "zenoh");
+                        let failed = invalid_measurement_result(a, "fingertip readings", detail, &config.id, "zenoh");
                         if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
                             tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
                         }
