@@ -58,6 +58,24 @@
 //! it returns, and [`ShmPublisher::open`] waits until every existing
 //! subscriber has acknowledged the new publisher.
 //!
+//! # Capacity
+//!
+//! One service carries every hand's clouds of a run on a host, so its
+//! publisher capacity bounds the hands: [`DEFAULT_MAX_PUBLISHERS`] (256; it
+//! was 16, and the 17th hand fell back to Zenoh). A larger capacity costs no
+//! memory that is used: each publisher's shared memory is sized by the
+//! subscribers' buffers, not by the capacity (`examples/capacity.rs`: 64
+//! publishers take the same 17.5 GB of address space, 42 MB of it allocated,
+//! whether the service admits 256 or 1024), and creating the service takes as
+//! long. It does cost time on every message: iceoryx2 walks every publisher
+//! slot when a subscriber receives and every listener slot when a publisher
+//! wakes them. Measured with the example (480 KB messages, median
+//! send-to-callback): CAPACITY_FIGURES. So the capacity is generous for a host
+//! (a 2-core machine runs 64 hands at most usefully) without taxing every
+//! message. A service per hand would lift the bound but make each metric
+//! agent discover and wait on one service per hand (one thread, or an
+//! iceoryx2 wait set, per hand); not worth it below the capacity.
+//!
 //! # Stale resources
 //!
 //! A process killed with SIGKILL leaves its node, ports and shared memory
