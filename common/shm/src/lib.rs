@@ -61,20 +61,20 @@
 //! # Capacity
 //!
 //! One service carries every hand's clouds of a run on a host, so its
-//! publisher capacity bounds the hands: [`DEFAULT_MAX_PUBLISHERS`] (256; it
-//! was 16, and the 17th hand fell back to Zenoh). A larger capacity costs no
-//! memory that is used: each publisher's shared memory is sized by the
-//! subscribers' buffers, not by the capacity (`examples/capacity.rs`: 64
-//! publishers take the same 17.5 GB of address space, 42 MB of it allocated,
-//! whether the service admits 256 or 1024), and creating the service takes as
-//! long. It does cost time on every message: iceoryx2 walks every publisher
-//! slot when a subscriber receives and every listener slot when a publisher
-//! wakes them. Measured with the example (480 KB messages, median
-//! send-to-callback): CAPACITY_FIGURES. So the capacity is generous for a host
-//! (a 2-core machine runs 64 hands at most usefully) without taxing every
-//! message. A service per hand would lift the bound but make each metric
-//! agent discover and wait on one service per hand (one thread, or an
-//! iceoryx2 wait set, per hand); not worth it below the capacity.
+//! publisher capacity bounds the hands: [`DEFAULT_MAX_PUBLISHERS`] (1024; it
+//! was 16, and the 17th hand fell back to Zenoh). Measured with
+//! `examples/capacity.rs` (release build, 64 publishers, 2-core machine under
+//! load): the capacity costs no memory that is used, since each publisher's
+//! shared memory is sized by the subscribers' buffers (64 publishers map
+//! 17.5 GB of address space, 42 MB of it allocated, whether the service
+//! admits 256, 1024 or 4096); creating the service takes 35-180 ms at any
+//! capacity; the median send-to-callback of 480 KB was 160-280 µs at 256,
+//! 1024 and 4096 alike (noise; 92-127 µs with 16 publishers present).
+//! iceoryx2 does walk every publisher and listener slot per message: at
+//! opt-level 1, 4096 cost 2.7 ms a message against 0.3 ms at 1024. So 1024:
+//! far more hands than a host runs, at no measurable cost. A service per hand
+//! would lift the bound but make each metric agent discover and wait on one
+//! service per hand (a thread, or an iceoryx2 wait set, per hand).
 //!
 //! # Stale resources
 //!
@@ -123,7 +123,7 @@ pub const MAX_PREFIX_LEN: usize = 32;
 
 /// Publishers a service admits unless configured otherwise: one per hand of a run on one
 /// host. See "Capacity" in the crate documentation for why this number.
-pub const DEFAULT_MAX_PUBLISHERS: usize = 256;
+pub const DEFAULT_MAX_PUBLISHERS: usize = 1024;
 
 /// Text every prefix made by [`run_prefix`] starts with.
 pub const PREFIX_BASE: &str = "graspopt_";
