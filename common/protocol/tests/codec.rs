@@ -355,7 +355,8 @@ fn clouds_round_trip_through_the_shm_layout() {
 /// bincode.
 #[test]
 fn the_shm_layout_refuses_bad_points_as_validate_does() {
-    let cases: [(&str, fn(&mut CloudPoint)); 4] = [
+    type Spoil = fn(&mut CloudPoint);
+    let cases: [(&str, Spoil); 4] = [
         ("fingers[1].points[2].p[1] is not finite (NaN)", |p| {
             p.p[1] = f64::NAN
         }),
