@@ -13,7 +13,7 @@ use graspopt_protocol::{
     FingertipWrench, FingertipWrenches, MeshData, Message,
     MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
     SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
-    WorkerStatus, decode, encode,
+    WorkerStatus, decode, encode, layout,
 };
 
 struct Out(PathBuf);
@@ -52,6 +52,18 @@ impl Out {
                 );
             }
         }
+    }
+}
+
+impl Out {
+    /// Clouds in the shared-memory layout, for `decode_clouds_layout` (no selector byte).
+    fn layout(&self, name: &str, clouds: &ContactClouds) {
+        let mut bytes = vec![0; layout::clouds_len(clouds).expect("a seed has a length")];
+        layout::write_clouds(clouds, &mut bytes).expect("a seed writes");
+        if let Err(e) = layout::read_clouds(&bytes) {
+            panic!("the decode_clouds_layout seed {name} does not read back: {e}");
+        }
+        self.write("decode_clouds_layout", name, &bytes);
     }
 }
 
@@ -125,10 +137,12 @@ fn main() {
         executed_ms: 1_700_000_000_456,
     };
     out.message("decode_clouds", "clouds", &clouds, Some(Topic::Clouds));
+    out.layout("clouds", &clouds);
     clouds.fingers.clear();
     clouds.min_gap = None;
     clouds.error = Some("unreachable pose".into());
     out.message("decode_clouds", "error", &clouds, Some(Topic::Clouds));
+    out.layout("error", &clouds);
 
     let mut wrenches = FingertipWrenches {
         run_id: run.clone(),

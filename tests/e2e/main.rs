@@ -24,6 +24,7 @@ mod replay;
 mod resume;
 mod scratch;
 mod security;
+mod shm;
 mod support;
 mod topic;
 mod waiting;

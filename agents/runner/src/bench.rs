@@ -7,7 +7,8 @@
 //!   (median cycle time of a one-worker run minus the median time of the same trial executed
 //!   and scored directly).
 //! - [`clouds`]: latency of one contact-clouds message from a hand's sender to a metric's
-//!   receiver in another session on this host, over iceoryx2 shared memory and over Zenoh.
+//!   receiver in another session on this host, over iceoryx2 shared memory (the fixed layout
+//!   written into the sample) and over Zenoh (bincode), in the same run.
 
 use std::fmt;
 use std::path::Path;
@@ -318,34 +319,63 @@ pub struct PathLatency {
 pub struct CloudsReport {
     pub points: usize,
     pub messages: usize,
-    /// Bytes of one message encoded with bincode.
+    /// Bytes of one message encoded with bincode (the Zenoh path's payload).
     pub encoded_bytes: usize,
-    /// Median encoding (bincode) and decoding with validation times (microseconds).
+    /// Bytes of one message in the shared-memory layout.
+    pub layout_bytes: usize,
+    /// Median bincode encoding and decoding with validation times (microseconds).
     pub encode_us: f64,
     pub decode_us: f64,
+    /// Median times to write the layout into a buffer and read it back with validation
+    /// (microseconds).
+    pub write_us: f64,
+    pub read_us: f64,
     /// Shared memory first, then Zenoh.
     pub paths: Vec<PathLatency>,
 }
 
-/// Cloud latency hand -> metric over shared memory and over Zenoh, and the codec's share.
+fn time_us(f: impl FnOnce() -> Result<()>) -> Result<f64> {
+    let t = Instant::now();
+    f()?;
+    Ok(t.elapsed().as_secs_f64() * 1e6)
+}
+
+/// Cloud latency hand -> metric over shared memory and over Zenoh, in the same run, and the
+/// codecs' share: bincode on the Zenoh path, the fixed layout on the shared-memory path.
 pub async fn clouds(points: usize, messages: usize) -> Result<CloudsReport> {
-    // What both paths share: encoding on the hand's side, decoding (with validation) on the
-    // metric's.
+    use graspopt_protocol::layout;
     let msg = cloud_message(&RunId::new("bench-clouds")?, 0, points);
     let encoded_bytes = graspopt_protocol::encode(&msg, Encoding::Bincode)?.len();
-    let (mut enc, mut dec) = (Vec::new(), Vec::new());
+    let layout_bytes = layout::clouds_len(&msg)?;
+    let (mut enc, mut dec, mut write, mut read) = (vec![], vec![], vec![], vec![]);
+    let mut bytes = Vec::new();
+    let mut buf = vec![0u8; layout_bytes];
     for _ in 0..messages {
-        let t = Instant::now();
-        let bytes = graspopt_protocol::encode(&msg, Encoding::Bincode)?;
-        enc.push(t.elapsed().as_secs_f64() * 1e6);
-        let t = Instant::now();
-        let back: ContactClouds = graspopt_protocol::decode(&bytes, Encoding::Bincode)?;
-        dec.push(t.elapsed().as_secs_f64() * 1e6);
-        anyhow::ensure!(back.point_count() == points, "decode lost points");
+        enc.push(time_us(|| {
+            bytes = graspopt_protocol::encode(&msg, Encoding::Bincode)?;
+            Ok(())
+        })?);
+        dec.push(time_us(|| {
+            let back: ContactClouds = graspopt_protocol::decode(&bytes, Encoding::Bincode)?;
+            anyhow::ensure!(back.point_count() == points, "decode lost points");
+            Ok(())
+        })?);
+        write.push(time_us(|| Ok(layout::write_clouds(&msg, &mut buf)?))?);
+        let mut back = None;
+        read.push(time_us(|| {
+            back = Some(layout::read_clouds(&buf)?);
+            Ok(())
+        })?);
+        anyhow::ensure!(back.as_ref() == Some(&msg), "the layout changed the clouds");
     }
     let mut paths = Vec::new();
     for shm in [true, false] {
         let (path, mut lat) = cloud_latency(shm, points, messages).await?;
+        anyhow::ensure!(
+            (path == CloudPath::SharedMemory) == shm,
+            "the clouds took the {} path, not the one measured",
+            path.as_str()
+        );
         lat.sort_by(f64::total_cmp);
         let p90 = lat
             .get((lat.len() * 9 / 10).min(lat.len().saturating_sub(1)))
@@ -357,12 +387,16 @@ pub async fn clouds(points: usize, messages: usize) -> Result<CloudsReport> {
             p90_us: p90,
         });
     }
+    let m = |v: &[f64]| median(v).unwrap_or(f64::NAN);
     Ok(CloudsReport {
         points,
         messages,
         encoded_bytes,
-        encode_us: median(&enc).unwrap_or(f64::NAN),
-        decode_us: median(&dec).unwrap_or(f64::NAN),
+        layout_bytes,
+        encode_us: m(&enc),
+        decode_us: m(&dec),
+        write_us: m(&write),
+        read_us: m(&read),
         paths,
     })
 }
@@ -371,23 +405,33 @@ impl fmt::Display for CloudsReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "## Contact clouds, hand -> metric on one host: {} points ({} bytes encoded), {} messages",
-            self.points, self.encoded_bytes, self.messages
+            "## Contact clouds, hand -> metric on one host: {} points, {} messages per path",
+            self.points, self.messages
         )?;
         writeln!(f)?;
-        let (enc, dec) = (self.encode_us, self.decode_us);
         writeln!(
             f,
-            "Encoding (bincode) median {enc:.0} µs, decoding with validation median {dec:.0} µs."
+            "Zenoh carries bincode ({} bytes; encoding median {:.0} µs, decoding with validation {:.0} µs); \
+             shared memory the fixed layout ({} bytes; writing median {:.0} µs, reading with validation {:.0} µs, \
+             both here into and from a heap buffer).",
+            self.encoded_bytes,
+            self.encode_us,
+            self.decode_us,
+            self.layout_bytes,
+            self.write_us,
+            self.read_us
         )?;
         writeln!(f)?;
-        let codec = enc + dec;
         writeln!(
             f,
-            "| path | median (µs) | p90 (µs) | median minus encode + decode ({codec:.0} µs) |"
+            "| path | median (µs) | p90 (µs) | median minus the path's codec (µs) |"
         )?;
         writeln!(f, "|---|---|---|---|")?;
         for p in &self.paths {
+            let codec = match p.path {
+                CloudPath::SharedMemory => self.write_us + self.read_us,
+                CloudPath::Zenoh => self.encode_us + self.decode_us,
+            };
             writeln!(
                 f,
                 "| {} | {:.0} | {:.0} | {:.0} |",

@@ -3,11 +3,12 @@
 //! A hand sends each trial's clouds through iceoryx2 shared memory when a metric agent of the
 //! same run listens on the same host (the shared-memory service has a subscriber), and over
 //! Zenoh otherwise; the choice is made per message, so a metric agent that starts or stops is
-//! followed. A metric agent listens on both paths at once. Both carry the same bincode
-//! payload.
+//! followed. A metric agent listens on both paths at once. Zenoh carries the portable bincode
+//! encoding; shared memory the fixed layout of [`graspopt_protocol::layout`], written straight
+//! into the loaned sample and read back with validation in one pass.
 
 use graspopt_protocol::keys::{CLOUDS, Key, shm_clouds_service};
-use graspopt_protocol::{ContactClouds, DecodeError, Encoding, RunId, decode, encode};
+use graspopt_protocol::{ContactClouds, DecodeError, Encoding, RunId, layout};
 use graspopt_shm::{ShmPublisher, ShmSubscriber};
 use tokio::sync::mpsc;
 
@@ -62,8 +63,11 @@ impl CloudSender {
         if let Some(shm) = &self.shm
             && shm.subscriber_count().unwrap_or(0) > 0
         {
-            let bytes = encode(clouds, Encoding::Bincode)?;
-            match shm.send(&bytes) {
+            let len = layout::clouds_len(clouds)?;
+            let sent = shm.send_with(len, |buf| {
+                layout::write_clouds(clouds, buf).map_err(BusError::from)
+            });
+            match sent {
                 Ok(()) => return Ok(CloudPath::SharedMemory),
                 Err(e) => tracing::warn!("shared-memory send failed, using Zenoh: {e}"),
             }
@@ -105,7 +109,7 @@ impl CloudReceiver {
                     let received = ReceivedClouds {
                         path: CloudPath::SharedMemory,
                         size: bytes.len(),
-                        message: decode::<ContactClouds>(bytes, Encoding::Bincode),
+                        message: layout::read_clouds(bytes),
                     };
                     // The receiver gone means the agent is stopping: nothing to do.
                     let _ = tx.blocking_send(received);

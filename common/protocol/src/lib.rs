@@ -6,6 +6,8 @@
 //!   type of its messages ([`keys::TABLE`], [`Key`]). Every key starts with `graspopt/<run>/`.
 //! - [`codec`]: bincode 2 (the default) and JSON (for agents written in other languages), each
 //!   payload prefixed by the [`WIRE_VERSION`].
+//! - [`layout`]: the fixed little-endian layout of contact clouds written straight into a
+//!   shared-memory sample (hand to metric agent on one host).
 //!
 //! This crate knows the shape of the conversation, not the network: it has no Zenoh, no
 //! sockets, no files. `docs/protocol.md` describes the same scheme for agent writers.
@@ -13,6 +15,7 @@
 
 pub mod codec;
 pub mod keys;
+pub mod layout;
 pub mod messages;
 
 pub use codec::{DecodeError, Encoding, Request, decode, decode_topic, encode};

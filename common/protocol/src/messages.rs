@@ -213,6 +213,13 @@ impl ContactClouds {
     pub fn point_count(&self) -> usize {
         self.fingers.iter().map(|f| f.points.len()).sum()
     }
+
+    /// What [`Message::validate`] checks except the points: the worker id, the palm pose and
+    /// `min_gap`. Decoders that check each point as they read it (the shared-memory layout)
+    /// call this and [`CloudPoint::validate`].
+    pub fn validate_header(&self) -> Result<(), String> {
+        validate_measurement_header(&self.worker, &self.palm_pose, self.min_gap)
+    }
 }
 
 impl Message for ContactClouds {
@@ -229,35 +236,10 @@ impl Message for ContactClouds {
         })
     }
     fn validate(&self) -> Result<(), String> {
-        crate::keys::check_agent_id(&self.worker).map_err(|e| format!("worker: {e}"))?;
-        self.palm_pose.validate("palm_pose")?;
-        if let Some(g) = self.min_gap
-            && !(g.is_finite() && g >= 0.0)
-        {
-            return Err(format!("min_gap must be finite and >= 0, got {g}"));
-        }
+        self.validate_header()?;
         for (f, finger) in self.fingers.iter().enumerate() {
             for (i, pt) in finger.points.iter().enumerate() {
-                // Field names are formatted only for the error: this runs on every point.
-                let ok = pt.p.iter().chain(&pt.n).all(|v| v.is_finite());
-                if !ok {
-                    finite(&format!("fingers[{f}].points[{i}].p"), &pt.p)?;
-                    finite(&format!("fingers[{f}].points[{i}].n"), &pt.n)?;
-                }
-                if !(pt.w.is_finite() && pt.w > 0.0) {
-                    return Err(format!(
-                        "fingers[{f}].points[{i}].w must be finite and > 0, got {}",
-                        pt.w
-                    ));
-                }
-                let n2 = pt.n.iter().map(|v| v * v).sum::<f64>();
-                // |n| within 1e-3 of 1 (compared squared, without a square root).
-                if !((1.0 - 1e-3) * (1.0 - 1e-3)..=(1.0 + 1e-3) * (1.0 + 1e-3)).contains(&n2) {
-                    return Err(format!(
-                        "fingers[{f}].points[{i}].n is not a unit normal (norm {})",
-                        n2.sqrt()
-                    ));
-                }
+                pt.validate(f, i)?;
             }
         }
         Ok(())
@@ -324,13 +306,7 @@ impl Message for FingertipWrenches {
         })
     }
     fn validate(&self) -> Result<(), String> {
-        crate::keys::check_agent_id(&self.worker).map_err(|e| format!("worker: {e}"))?;
-        self.palm_pose.validate("palm_pose")?;
-        if let Some(g) = self.min_gap
-            && !(g.is_finite() && g >= 0.0)
-        {
-            return Err(format!("min_gap must be finite and >= 0, got {g}"));
-        }
+        validate_measurement_header(&self.worker, &self.palm_pose, self.min_gap)?;
         for (i, tip) in self.fingertips.iter().enumerate() {
             tip.sensor_pose
                 .validate(&format!("fingertips[{i}].sensor_pose"))?;
@@ -339,6 +315,53 @@ impl Message for FingertipWrenches {
                 .map_err(|e| format!("fingertips[{i}].surface: {e}"))?;
             finite(&format!("fingertips[{i}].force"), &tip.force)?;
             finite(&format!("fingertips[{i}].torque"), &tip.torque)?;
+        }
+        Ok(())
+    }
+}
+
+/// What a hand's measurement of one trial (clouds or fingertip readings) must hold besides the
+/// measurement: a valid worker id, a valid palm pose, and `min_gap` finite and >= 0.
+fn validate_measurement_header(
+    worker: &str,
+    palm_pose: &Pose,
+    min_gap: Option<f64>,
+) -> Result<(), String> {
+    crate::keys::check_agent_id(worker).map_err(|e| format!("worker: {e}"))?;
+    palm_pose.validate("palm_pose")?;
+    if let Some(g) = min_gap
+        && !(g.is_finite() && g >= 0.0)
+    {
+        return Err(format!("min_gap must be finite and >= 0, got {g}"));
+    }
+    Ok(())
+}
+
+impl CloudPoint {
+    /// Finite `p` and `n`, `n` of norm 1 within 1e-3, `w` finite and > 0. The error names
+    /// the point as `fingers[finger].points[index]`.
+    #[inline]
+    pub fn validate(&self, finger: usize, index: usize) -> Result<(), String> {
+        let (f, i) = (finger, index);
+        // Field names are formatted only for the error: this runs on every point.
+        let ok = self.p.iter().chain(&self.n).all(|v| v.is_finite());
+        if !ok {
+            finite(&format!("fingers[{f}].points[{i}].p"), &self.p)?;
+            finite(&format!("fingers[{f}].points[{i}].n"), &self.n)?;
+        }
+        if !(self.w.is_finite() && self.w > 0.0) {
+            return Err(format!(
+                "fingers[{f}].points[{i}].w must be finite and > 0, got {}",
+                self.w
+            ));
+        }
+        let n2 = self.n.iter().map(|v| v * v).sum::<f64>();
+        // |n| within 1e-3 of 1 (compared squared, without a square root).
+        if !((1.0 - 1e-3) * (1.0 - 1e-3)..=(1.0 + 1e-3) * (1.0 + 1e-3)).contains(&n2) {
+            return Err(format!(
+                "fingers[{f}].points[{i}].n is not a unit normal (norm {})",
+                n2.sqrt()
+            ));
         }
         Ok(())
     }

@@ -5,9 +5,9 @@
 //!
 //! - [`ShmConfig`]: the iceoryx2 prefix that isolates one run (or one test)
 //!   from every other, and the capacities of each service.
-//! - [`ShmPublisher`]: copies a byte slice into a loaned shared-memory slice,
-//!   sends it, then wakes the subscribers through an iceoryx2 event service of
-//!   the same name.
+//! - [`ShmPublisher`]: copies a byte slice into a loaned shared-memory slice
+//!   (or lets the caller write the message straight into it), sends it, then
+//!   wakes the subscribers through an iceoryx2 event service of the same name.
 //! - [`ShmSubscriber`]: a dedicated thread that sleeps on that event service,
 //!   drains the samples and hands each payload to a callback.
 //! - The small protocol on that event service: wake-ups from publishers to
@@ -58,6 +58,24 @@
 //! it returns, and [`ShmPublisher::open`] waits until every existing
 //! subscriber has acknowledged the new publisher.
 //!
+//! # Capacity
+//!
+//! One service carries every hand's clouds of a run on a host, so its
+//! publisher capacity bounds the hands: [`DEFAULT_MAX_PUBLISHERS`] (1024; it
+//! was 16, and the 17th hand fell back to Zenoh). Measured with
+//! `examples/capacity.rs` (release build, 64 publishers, 2-core machine under
+//! load): the capacity costs no memory that is used, since each publisher's
+//! shared memory is sized by the subscribers' buffers (64 publishers map
+//! 17.5 GB of address space, 42 MB of it allocated, whether the service
+//! admits 256, 1024 or 4096); creating the service takes 35-180 ms at any
+//! capacity; the median send-to-callback of 480 KB was 160-280 µs at 256,
+//! 1024 and 4096 alike (noise; 92-127 µs with 16 publishers present).
+//! iceoryx2 does walk every publisher and listener slot per message: at
+//! opt-level 1, 4096 cost 2.7 ms a message against 0.3 ms at 1024. So 1024:
+//! far more hands than a host runs, at no measurable cost. A service per hand
+//! would lift the bound but make each metric agent discover and wait on one
+//! service per hand (a thread, or an iceoryx2 wait set, per hand).
+//!
 //! # Stale resources
 //!
 //! A process killed with SIGKILL leaves its node, ports and shared memory
@@ -102,6 +120,10 @@ pub use subscriber::ShmSubscriber;
 /// socket path of each event listener (`/tmp/iceoryx2/<prefix><39
 /// digits>.event`), which must fit in the 108 bytes of `sun_path`.
 pub const MAX_PREFIX_LEN: usize = 32;
+
+/// Publishers a service admits unless configured otherwise: one per hand of a run on one
+/// host. See "Capacity" in the crate documentation for why this number.
+pub const DEFAULT_MAX_PUBLISHERS: usize = 1024;
 
 /// Text every prefix made by [`run_prefix`] starts with.
 pub const PREFIX_BASE: &str = "graspopt_";
@@ -193,7 +215,7 @@ pub struct ShmConfig {
     /// run text; `open` refuses anything but ASCII letters, digits, `_`, `-`
     /// and `.` (not first), up to [`MAX_PREFIX_LEN`] bytes.
     pub prefix: String,
-    /// Most publishers on one service (default 16).
+    /// Most publishers on one service (default [`DEFAULT_MAX_PUBLISHERS`]).
     pub max_publishers: usize,
     /// Most subscribers on one service (default 8).
     pub max_subscribers: usize,
@@ -218,7 +240,7 @@ impl Default for ShmConfig {
     fn default() -> Self {
         Self {
             prefix: PREFIX_BASE.to_owned(),
-            max_publishers: 16,
+            max_publishers: DEFAULT_MAX_PUBLISHERS,
             max_subscribers: 8,
             subscriber_buffer: 64,
             initial_payload: 64 * 1024,
@@ -519,6 +541,25 @@ impl PublisherPorts {
         self.wake_subscribers();
         Ok(())
     }
+
+    fn send_with<E: From<ShmError>>(
+        &self,
+        service: &str,
+        len: usize,
+        fill: impl FnOnce(&mut [u8]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        // Zero-filled: the safe API has no uninitialised bytes to hand out
+        // (examples/fill.rs measures the alternatives).
+        let mut sample = self
+            .publisher
+            .loan_slice(len)
+            .map_err(service_err(service, "loan shared-memory slice"))?;
+        // An error drops the sample unsent, returning it to the publisher.
+        fill(sample.payload_mut())?;
+        sample.send().map_err(service_err(service, "send"))?;
+        self.wake_subscribers();
+        Ok(())
+    }
 }
 
 struct PublisherShared {
@@ -587,12 +628,31 @@ impl ShmPublisher {
     pub fn send(&self, bytes: &[u8]) -> Result<()> {
         let ports = self.lock("send")?;
         let sent = ports.send(&self.shared.service, bytes);
+        self.after_send(&ports);
+        sent
+    }
+
+    /// Like [`send`](Self::send), but the message is written straight into
+    /// shared memory: loans a zero-filled slice of `len` bytes, hands it to
+    /// `fill`, then sends it. If `fill` fails, nothing is sent and its error
+    /// is returned.
+    pub fn send_with<E: From<ShmError>>(
+        &self,
+        len: usize,
+        fill: impl FnOnce(&mut [u8]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let ports = self.lock("send")?;
+        let sent = ports.send_with(&self.shared.service, len, fill);
+        self.after_send(&ports);
+        sent
+    }
+
+    fn after_send(&self, ports: &PublisherPorts) {
         if self.shared.timed_out.swap(false, Ordering::Relaxed) {
             // A subscriber stayed full: if its process died, remove it so the
             // next send does not wait for it again.
             ports.endpoints.pubsub.try_cleanup_dead_nodes();
         }
-        sent
     }
 
     /// Number of subscribers currently on the service (from its dynamic

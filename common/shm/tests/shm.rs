@@ -116,6 +116,59 @@ fn messages_of_1_byte_to_2_mib_arrive_in_order() {
     assert_eq!(subscriber.receive_errors(), 0);
 }
 
+/// `send_with` hands a zero-filled slice of the asked length to the caller, sends what it
+/// wrote, and sends nothing when it fails.
+#[test]
+fn send_with_writes_into_the_sample_and_sends_nothing_on_error() {
+    let (config, _cleanup) = config("with");
+    let service = "graspopt/test/with";
+    let (_subscriber, rx) = collect(&config, service);
+    let publisher = ShmPublisher::open(&config, service).unwrap();
+    for len in [1, 100, 300_000] {
+        publisher
+            .send_with(len, |buf: &mut [u8]| {
+                assert_eq!(buf.len(), len);
+                assert!(buf.iter().all(|&b| b == 0), "the slice is zero-filled");
+                buf[len - 1] = 7;
+                Ok::<_, ShmError>(())
+            })
+            .unwrap();
+        let got = rx.recv_timeout(WAIT).unwrap();
+        assert_eq!(got.len(), len);
+        assert_eq!(got[len - 1], 7);
+    }
+    let refused = publisher.send_with(16, |buf: &mut [u8]| {
+        buf[0] = 1;
+        Err(ShmError::InvalidConfig("the caller's own error".into()))
+    });
+    assert!(matches!(refused, Err(ShmError::InvalidConfig(_))));
+    assert!(rx.recv_timeout(Duration::from_millis(100)).is_err());
+    // The sample was returned: the next send works.
+    publisher.send(b"after").unwrap();
+    assert_eq!(rx.recv_timeout(WAIT).unwrap(), b"after");
+}
+
+/// More than 16 publishers on one service (the hands of a run on one host): the default
+/// capacity admits them (it was 16). The e2e test `shm::` runs 64 hands; opening a publisher
+/// takes a while on a host whose iceoryx2 node directory holds many dead nodes.
+#[test]
+fn the_default_service_admits_more_than_16_publishers() {
+    let (config, _cleanup) = config("many");
+    let service = "graspopt/test/many";
+    let (_subscriber, rx) = collect(&config, service);
+    let publishers: Vec<ShmPublisher> = (0..24)
+        .map(|i| {
+            ShmPublisher::open(&config, service).unwrap_or_else(|e| panic!("publisher {i}: {e}"))
+        })
+        .collect();
+    for (i, p) in publishers.iter().enumerate() {
+        p.send(&[i as u8]).unwrap();
+    }
+    let mut got: Vec<u8> = (0..24).map(|_| rx.recv_timeout(WAIT).unwrap()[0]).collect();
+    got.sort();
+    assert_eq!(got, (0..24).collect::<Vec<u8>>());
+}
+
 #[test]
 fn two_publishers_on_two_threads_all_arrive() {
     let (config, _cleanup) = config("two");
