@@ -8,6 +8,7 @@
 //!   and scored directly).
 //! - [`clouds`]: latency of one contact-clouds message from a hand's sender to a metric's
 //!   receiver in another session on this host, over iceoryx2 shared memory and over Zenoh.
+//! - [`coordinator`]: the ceiling of one coordinator and its journal, with synthetic agents.
 
 use std::fmt;
 use std::path::Path;
@@ -24,6 +25,8 @@ use graspopt_trial::TrialSettings;
 use tokio::sync::watch;
 
 use crate::{Embedded, RunSettings, placeholder, run_embedded};
+
+pub mod coordinator;
 
 /// What [`pipeline`] measures.
 #[derive(Debug, Clone)]
