@@ -48,7 +48,11 @@ pub enum What {
     /// and trial latency versus workers, through the core alone and over the bus.
     Coordinator {
         /// Worker counts, each 1 to 256.
-        #[arg(long, default_value = "1,2,4,8,16,32,64,128,256", value_delimiter = ',')]
+        #[arg(
+            long,
+            default_value = "1,2,4,8,16,32,64,128,256",
+            value_delimiter = ','
+        )]
         workers: Vec<usize>,
         /// Trials of each run (at least 1, at most 100000).
         #[arg(long, default_value_t = 10_000)]

@@ -309,7 +309,14 @@ fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
         &["--trials", "got 0"],
     );
     refused(
-        &["bench", "coordinator", "--workers", "1,300", "--trials", "5"],
+        &[
+            "bench",
+            "coordinator",
+            "--workers",
+            "1,300",
+            "--trials",
+            "5",
+        ],
         &["--workers", "got 300"],
     );
     refused(
@@ -328,8 +335,15 @@ fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
     ];
     let out = graspopt_within(&args, Duration::from_secs(120)).expect("bench coordinator hung");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    let rows: Vec<&str> = stdout.lines().filter(|l| l.starts_with("| core |")).collect();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("| core |"))
+        .collect();
     assert_eq!(rows.len(), 2, "{stdout}");
     assert!(rows[0].starts_with("| core | 1 | 6 |"), "{stdout}");
     assert!(rows[1].starts_with("| core | 3 | 6 |"), "{stdout}");

@@ -32,8 +32,8 @@ use graspopt_coordinator::{Action, Coordinator, CoordinatorConfig, RunSpec, Writ
 use graspopt_journal::{Journal, TrialState, event_kind};
 use graspopt_protocol::keys::{AliveKey, COMMAND, OBJECT, RESULT, SUGGEST};
 use graspopt_protocol::{
-    AgentKind, Encoding, ObjectEstimate, PlannerMethod, Pose, RunId, SuggestReply,
-    SuggestRequest, TrialCommand, TrialResult,
+    AgentKind, Encoding, ObjectEstimate, PlannerMethod, Pose, RunId, SuggestReply, SuggestRequest,
+    TrialCommand, TrialResult,
 };
 use graspopt_sim::ParamKind;
 
@@ -281,7 +281,14 @@ pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRo
             lease_at = Instant::now();
             core.on_lease_tick(now_ms());
         }
-        carry_out(&mut core, &mut journal, &run, actions, &mut line, &mut clock)?;
+        carry_out(
+            &mut core,
+            &mut journal,
+            &run,
+            actions,
+            &mut line,
+            &mut clock,
+        )?;
     }
     let trials = check_journal(&journal, &run, trials)?;
     let (Some(first), Some(last)) = (clock.first_issue, clock.last_result) else {
@@ -383,8 +390,12 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
         tasks.spawn(async move {
             while let Some(c) = commands.recv().await {
                 if let Ok(command) = c.message {
-                    b.put(&RESULT.key((&r).into()), &answer(&command), Encoding::Bincode)
-                        .await?;
+                    b.put(
+                        &RESULT.key((&r).into()),
+                        &answer(&command),
+                        Encoding::Bincode,
+                    )
+                    .await?;
                 }
             }
             anyhow::Ok(())
@@ -430,7 +441,11 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
     let trials = check_journal(&journal, &run, trials)?;
     let rows = journal.trials(run.as_str())?;
     let first = rows.iter().map(|r| r.issued_ms).min().unwrap_or(0);
-    let last = rows.iter().filter_map(|r| r.completed_ms).max().unwrap_or(0);
+    let last = rows
+        .iter()
+        .filter_map(|r| r.completed_ms)
+        .max()
+        .unwrap_or(0);
     let latency = rows
         .iter()
         .filter_map(|r| Some((r.completed_ms? - r.issued_ms) as f64))
@@ -489,7 +504,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for workers in [1, 3] {
             let row = core_run(dir.path(), workers, 7).unwrap();
-            assert_eq!((row.path, row.workers, row.trials), (BenchPath::Core, workers, 7));
+            assert_eq!(
+                (row.path, row.workers, row.trials),
+                (BenchPath::Core, workers, 7)
+            );
             assert!(row.median_ms <= row.p99_ms);
             let share = row.journal_share.unwrap();
             assert!(share > 0.0 && share <= 1.0, "{share}");
