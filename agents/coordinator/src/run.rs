@@ -225,34 +225,7 @@ impl<'a> Io<'a> {
     }
 
     fn record(&mut self, write: Write) -> anyhow::Result<()> {
-        let run = self.run.as_str();
-        match write {
-            Write::Issue(issue) => self.journal.record_issue(&issue)?,
-            Write::Failure {
-                trial_id,
-                attempt,
-                error,
-                at_ms,
-            } => {
-                self.journal
-                    .record_failure(run, trial_id, attempt, &error, at_ms)?;
-            }
-            Write::Result(r) => match self.journal.record_result(&r)? {
-                ResultOutcome::Accepted => {}
-                other => tracing::warn!(
-                    "coordinator: journal says {other:?} for trial {}",
-                    r.trial_id
-                ),
-            },
-            Write::PlannerState { engine, at_ms } => {
-                if let Err(e) = self.journal.set_planner_state(run, &engine, at_ms) {
-                    tracing::warn!(
-                        "coordinator: cannot keep the planner's state in the journal: {e}"
-                    );
-                }
-            }
-        }
-        Ok(())
+        record(self.journal, self.run, write)
     }
 
     /// The run finished: recorded, its final status published.
@@ -304,4 +277,35 @@ impl<'a> Io<'a> {
         );
         Ok(s)
     }
+}
+
+/// Carries out one journal write of the core (the loop's, and `graspopt bench
+/// coordinator`'s). A journal that refuses a result says why in the log; a planner state
+/// that cannot be kept is only logged (see [`Write::PlannerState`]).
+pub fn record(journal: &mut Journal, run: &RunId, write: Write) -> anyhow::Result<()> {
+    let run = run.as_str();
+    match write {
+        Write::Issue(issue) => journal.record_issue(&issue)?,
+        Write::Failure {
+            trial_id,
+            attempt,
+            error,
+            at_ms,
+        } => {
+            journal.record_failure(run, trial_id, attempt, &error, at_ms)?;
+        }
+        Write::Result(r) => match journal.record_result(&r)? {
+            ResultOutcome::Accepted => {}
+            other => tracing::warn!(
+                "coordinator: journal says {other:?} for trial {}",
+                r.trial_id
+            ),
+        },
+        Write::PlannerState { engine, at_ms } => {
+            if let Err(e) = journal.set_planner_state(run, &engine, at_ms) {
+                tracing::warn!("coordinator: cannot keep the planner's state in the journal: {e}");
+            }
+        }
+    }
+    Ok(())
 }

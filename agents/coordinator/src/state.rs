@@ -2,7 +2,7 @@
 //! the observations for the planner, the best trial, the error counters. The async loop in
 //! [`crate::run`] feeds it events and carries out what it decides.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use graspopt_protocol::{
     BestTrial, ErrorCounts, ForceAnalysis, Observation, TrialResult, WorkerStatus,
@@ -82,6 +82,12 @@ pub enum Disposition {
 pub struct RunState {
     budget: u64,
     trials: BTreeMap<u64, Trial>,
+    /// The trials queued or running. A completed or failed trial never is again, so the
+    /// scans done on every event (queued, running, pending trials, leases) walk these
+    /// only: their cost follows the workers, not the number of trials the run has made.
+    open: BTreeSet<u64>,
+    completed: u64,
+    failed: u64,
     workers: BTreeMap<String, Worker>,
     /// Completed trials in completion order, for the planner.
     observations: Vec<Observation>,
@@ -112,7 +118,32 @@ impl RunState {
 
     /// Puts back a trial recorded in the journal (a resumed run).
     pub fn restore_trial(&mut self, trial_id: u64, trial: Trial) {
-        self.trials.insert(trial_id, trial);
+        self.count_phase(trial_id, &trial.phase, 1);
+        if let Some(old) = self.trials.insert(trial_id, trial) {
+            self.count_phase(trial_id, &old.phase, -1);
+        }
+    }
+
+    /// Counts a trial in `phase` in (`sign` 1) or out (-1) of the open set and counters.
+    fn count_phase(&mut self, trial_id: u64, phase: &TrialPhase, sign: i8) {
+        let add = |n: &mut u64| {
+            *n = if sign > 0 {
+                *n + 1
+            } else {
+                n.saturating_sub(1)
+            }
+        };
+        match phase {
+            TrialPhase::Completed { .. } => add(&mut self.completed),
+            TrialPhase::Failed { .. } => add(&mut self.failed),
+            TrialPhase::Queued { .. } | TrialPhase::Running { .. } => {
+                if sign > 0 {
+                    self.open.insert(trial_id);
+                } else {
+                    self.open.remove(&trial_id);
+                }
+            }
+        }
     }
 
     /// The trial `trial_id`, if the run has it.
@@ -195,19 +226,28 @@ impl RunState {
 
     /// Queued trials, oldest first, with the reason they were re-queued.
     pub fn queued(&self) -> Vec<(u64, Option<String>)> {
-        self.trials
-            .iter()
+        self.open_trials()
             .filter_map(|(id, t)| match &t.phase {
-                TrialPhase::Queued { reason } => Some((*id, reason.clone())),
+                TrialPhase::Queued { reason } => Some((id, reason.clone())),
                 _ => None,
             })
             .collect()
     }
 
+    /// The trials queued or running, by id.
+    fn open_trials(&self) -> impl Iterator<Item = (u64, &Trial)> {
+        self.open
+            .iter()
+            .filter_map(|id| self.trials.get(id).map(|t| (*id, t)))
+    }
+
     /// How many new trials to ask the planner for now.
     pub fn proposals_needed(&self) -> usize {
-        let idle = self.idle_workers().len();
-        let queued = self.queued().len();
+        let idle = self.workers.values().filter(|w| w.trial.is_none()).count();
+        let queued = self
+            .open_trials()
+            .filter(|(_, t)| matches!(t.phase, TrialPhase::Queued { .. }))
+            .count();
         let left = self.budget.saturating_sub(self.trials.len() as u64) as usize;
         idle.saturating_sub(queued).min(left)
     }
@@ -215,6 +255,7 @@ impl RunState {
     /// Adds a new trial (queued); returns its id (ids start at 1).
     pub fn add_trial(&mut self, params: Vec<f64>) -> u64 {
         let id = self.trials.keys().next_back().map_or(1, |k| k + 1);
+        self.open.insert(id);
         self.trials.insert(
             id,
             Trial {
@@ -257,10 +298,9 @@ impl RunState {
 
     /// Trials running now (their results depend on a metric agent being there).
     pub fn running_trials(&self) -> Vec<u64> {
-        self.trials
-            .iter()
+        self.open_trials()
             .filter(|(_, t)| matches!(t.phase, TrialPhase::Running { .. }))
-            .map(|(id, _)| *id)
+            .map(|(id, _)| id)
             .collect()
     }
 
@@ -328,7 +368,10 @@ impl RunState {
     /// it busy forever would stall the run). Returns the re-queued trials.
     pub fn expire_leases(&mut self, now_ms: i64, grace_ms: i64) -> Vec<u64> {
         let mut out = Vec::new();
-        for (id, t) in self.trials.iter_mut() {
+        for id in &self.open {
+            let Some(t) = self.trials.get_mut(id) else {
+                continue;
+            };
             if let TrialPhase::Running {
                 worker,
                 lease_until_ms,
@@ -395,6 +438,8 @@ impl RunState {
         }
         if let Some(e) = &result.error {
             t.phase = TrialPhase::Failed { error: e.clone() };
+            self.open.remove(&result.trial_id);
+            self.failed += 1;
             self.errors.failed += 1;
             return Disposition::Failed;
         }
@@ -406,6 +451,8 @@ impl RunState {
         t.phase = TrialPhase::Completed {
             score: result.score,
         };
+        self.open.remove(&result.trial_id);
+        self.completed += 1;
         let params = t.params.clone();
         self.observe(
             result.trial_id,
@@ -469,8 +516,8 @@ impl RunState {
 
     /// Parameters of trials issued and not finished (for the planner).
     pub fn pending_points(&self) -> Vec<Vec<f64>> {
-        self.trials
-            .values()
+        self.open_trials()
+            .map(|(_, t)| t)
             .filter(|t| {
                 matches!(
                     t.phase,
@@ -482,19 +529,16 @@ impl RunState {
     }
 
     pub fn completed(&self) -> u64 {
-        self.count(|p| matches!(p, TrialPhase::Completed { .. }))
+        self.completed
     }
 
     pub fn failed(&self) -> u64 {
-        self.count(|p| matches!(p, TrialPhase::Failed { .. }))
+        self.failed
     }
 
+    /// Trials queued or running.
     pub fn running(&self) -> u64 {
-        self.count(|p| matches!(p, TrialPhase::Running { .. } | TrialPhase::Queued { .. }))
-    }
-
-    fn count(&self, f: impl Fn(&TrialPhase) -> bool) -> u64 {
-        self.trials.values().filter(|t| f(&t.phase)).count() as u64
+        self.open.len() as u64
     }
 
     /// Every trial of the budget issued and finished.
@@ -536,6 +580,72 @@ pub(crate) mod tests {
             error: None,
             forces: None,
         }
+    }
+
+    /// (completed, failed, queued or running) counted over every trial, and the open set
+    /// checked against it.
+    fn scanned(s: &RunState) -> (u64, u64, u64) {
+        let n = |f: fn(&TrialPhase) -> bool| s.trials.values().filter(|t| f(&t.phase)).count();
+        let open: BTreeSet<u64> = s
+            .trials
+            .iter()
+            .filter(|(_, t)| {
+                matches!(
+                    t.phase,
+                    TrialPhase::Queued { .. } | TrialPhase::Running { .. }
+                )
+            })
+            .map(|(id, _)| *id)
+            .collect();
+        assert_eq!(open, s.open);
+        (
+            n(|p| matches!(p, TrialPhase::Completed { .. })) as u64,
+            n(|p| matches!(p, TrialPhase::Failed { .. })) as u64,
+            open.len() as u64,
+        )
+    }
+
+    #[test]
+    fn the_counts_kept_follow_every_change_of_phase() {
+        let mut s = RunState::new(6);
+        let counts = |s: &RunState| (s.completed(), s.failed(), s.running());
+        // A resumed run: one trial completed, one failed, one running, the last replaced.
+        let restored = |phase| Trial {
+            params: vec![0.0],
+            attempts: 1,
+            issued_to: BTreeMap::from([(1, "a".to_string())]),
+            phase,
+        };
+        s.restore_trial(1, restored(TrialPhase::Completed { score: 0.1 }));
+        s.restore_trial(2, restored(TrialPhase::Failed { error: "x".into() }));
+        s.restore_trial(3, restored(TrialPhase::Completed { score: 0.2 }));
+        s.restore_trial(3, restored(TrialPhase::Queued { reason: None }));
+        assert_eq!(counts(&s), (1, 1, 1));
+        assert_eq!(counts(&s), scanned(&s));
+        s.worker_up("a", "h");
+        s.worker_up("b", "h");
+        let t4 = s.add_trial(vec![0.4]);
+        assert_eq!(s.assign(3, "a", 0, 100), Some(2));
+        assert_eq!(s.assign(t4, "b", 0, 100), Some(1));
+        assert_eq!(counts(&s), (1, 1, 2));
+        // b is lost, a's lease expires: both trials queued, still open.
+        assert_eq!(s.worker_down("b"), Some(t4));
+        assert_eq!(s.expire_leases(101, 0), [3]);
+        assert_eq!(s.queued().len(), 2);
+        assert_eq!(counts(&s), scanned(&s));
+        // Trial 3 completes (late, from a), trial 4 fails, a duplicate changes nothing.
+        let mut r = result(3, "a", 0.9);
+        r.attempt = 2;
+        assert_eq!(s.on_result(&r, 102), Disposition::Completed);
+        assert_eq!(s.on_result(&r, 103), Disposition::Duplicate);
+        assert_eq!(s.assign(t4, "a", 104, 200), Some(2));
+        let mut f = result(t4, "a", 0.0);
+        f.attempt = 2;
+        f.error = Some("unreachable".into());
+        assert_eq!(s.on_result(&f, 105), Disposition::Failed);
+        assert_eq!(counts(&s), (2, 2, 0));
+        assert_eq!(counts(&s), scanned(&s));
+        assert!(s.running_trials().is_empty() && s.pending_points().is_empty());
     }
 
     #[test]

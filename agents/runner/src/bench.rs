@@ -9,6 +9,7 @@
 //! - [`clouds`]: latency of one contact-clouds message from a hand's sender to a metric's
 //!   receiver in another session on this host, over iceoryx2 shared memory (the fixed layout
 //!   written into the sample) and over Zenoh (bincode), in the same run.
+//! - [`coordinator`]: the ceiling of one coordinator and its journal, with synthetic agents.
 
 use std::fmt;
 use std::path::Path;
@@ -25,6 +26,8 @@ use graspopt_trial::TrialSettings;
 use tokio::sync::watch;
 
 use crate::{Embedded, RunSettings, placeholder, run_embedded};
+
+pub mod coordinator;
 
 /// What [`pipeline`] measures.
 #[derive(Debug, Clone)]

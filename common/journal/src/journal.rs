@@ -16,6 +16,13 @@ use crate::types::{
 /// How long a statement waits for another connection's lock before failing.
 const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
 
+/// Pages of write-ahead log after which a commit copies the log into the database (a
+/// checkpoint, SQLite's default is 1,000). A checkpoint syncs the disk twice: every 1,000
+/// pages it took most of a coordinator's time (`graspopt bench coordinator`,
+/// docs/benchmarks.md). A commit is in the log before the checkpoint either way, so this
+/// changes nothing of what survives a killed process; the log grows to about 40 MB.
+const WAL_CHECKPOINT_PAGES: u32 = 10_000;
+
 /// Columns read into a [`TrialRow`], in the order [`trial_from_row`] expects.
 const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, issued_ms, \
      lease_until_ms, completed_ms, result_attempt, score, rank, force_closure, epsilon, volume, \
@@ -61,7 +68,10 @@ impl Journal {
     }
 
     fn init(mut conn: Connection, path: Option<PathBuf>) -> Result<Journal> {
-        conn.execute_batch("PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON;")?;
+        conn.execute_batch(&format!(
+            "PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON; \
+             PRAGMA wal_autocheckpoint = {WAL_CHECKPOINT_PAGES};"
+        ))?;
         let fk: i64 = conn.query_row("PRAGMA foreign_keys", [], |r| r.get(0))?;
         if fk != 1 {
             return Err(JournalError::Schema(
@@ -746,4 +756,21 @@ fn insert_event(
         run_id, trial_id, attempt, kind, worker, at_ms, note
     ])?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_journal_checkpoints_its_log_every_ten_thousand_pages() {
+        let dir = tempfile::tempdir().unwrap();
+        let journal = Journal::open(&dir.path().join("j.sqlite")).unwrap();
+        let pages: u32 = journal
+            .conn
+            .query_row("PRAGMA wal_autocheckpoint", [], |r| r.get(0))
+            .unwrap();
+        assert_eq!(pages, WAL_CHECKPOINT_PAGES);
+        assert_eq!(pages, 10_000);
+    }
 }

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
 use graspopt_protocol::PlannerMethod;
+use graspopt_runner::bench::coordinator::{BenchPath, CoordinatorSettings};
 use graspopt_runner::bench::{self, PipelineSettings};
 
 use super::setup::planner_method;
@@ -43,6 +44,24 @@ pub enum What {
         #[arg(long, default_value = "random", value_parser = planner_method())]
         method: PlannerMethod,
     },
+    /// One coordinator and its journal with synthetic agents that answer at once: trials/s
+    /// and trial latency versus workers, through the core alone and over the bus.
+    Coordinator {
+        /// Worker counts, each 1 to 256.
+        #[arg(
+            long,
+            default_value = "1,2,4,8,16,32,64,128,256",
+            value_delimiter = ','
+        )]
+        workers: Vec<usize>,
+        /// Trials of each run (at least 1, at most 100000).
+        #[arg(long, default_value_t = 10_000)]
+        trials: u64,
+        /// Which coordinator: core (the I/O-free core and the journal), bus (the loop over
+        /// an in-process Zenoh bus), or both.
+        #[arg(long, default_value = "core,bus", value_delimiter = ',', value_parser = bench_path())]
+        paths: Vec<BenchPath>,
+    },
     /// Contact-cloud latency, shared memory versus Zenoh.
     Clouds {
         /// Points per message (at most 1000000).
@@ -54,9 +73,30 @@ pub enum What {
     },
 }
 
+fn bench_path() -> impl clap::builder::TypedValueParser<Value = BenchPath> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(["core", "bus"]).map(|s| match s.as_str() {
+        "core" => BenchPath::Core,
+        _ => BenchPath::Bus,
+    })
+}
+
 /// Checks every argument before anything runs.
 fn validate(what: &What) -> Result<()> {
     match what {
+        What::Coordinator {
+            workers,
+            trials,
+            paths,
+        } => {
+            check_workers(workers)?;
+            if !(1..=MAX_MESSAGES as u64).contains(trials) {
+                bail!("--trials must be between 1 and {MAX_MESSAGES}, got {trials}");
+            }
+            if paths.is_empty() {
+                bail!("--paths: give core, bus or both");
+            }
+        }
         What::Pipeline {
             trial_cost_ms,
             trials_per_worker,
@@ -64,12 +104,7 @@ fn validate(what: &What) -> Result<()> {
             overhead_trials,
             ..
         } => {
-            if workers.is_empty() {
-                bail!("--workers: give at least one worker count");
-            }
-            if let Some(w) = workers.iter().find(|w| !(1..=MAX_WORKERS).contains(*w)) {
-                bail!("--workers: each count must be between 1 and {MAX_WORKERS}, got {w}");
-            }
+            check_workers(workers)?;
             if *trials_per_worker < 1 {
                 bail!("--trials-per-worker must be at least 1, got {trials_per_worker}");
             }
@@ -101,6 +136,16 @@ fn validate(what: &What) -> Result<()> {
     Ok(())
 }
 
+fn check_workers(workers: &[usize]) -> Result<()> {
+    if workers.is_empty() {
+        bail!("--workers: give at least one worker count");
+    }
+    if let Some(w) = workers.iter().find(|w| !(1..=MAX_WORKERS).contains(*w)) {
+        bail!("--workers: each count must be between 1 and {MAX_WORKERS}, got {w}");
+    }
+    Ok(())
+}
+
 pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     validate(&args.what)?;
     let runtime = tokio::runtime::Runtime::new()?;
@@ -123,6 +168,24 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 "{}",
                 runtime
                     .block_on(bench::pipeline(&settings))?
+                    .to_string()
+                    .trim_end()
+            )?;
+        }
+        What::Coordinator {
+            workers,
+            trials,
+            paths,
+        } => {
+            let settings = CoordinatorSettings {
+                workers: workers.clone(),
+                trials: *trials,
+                paths: paths.clone(),
+            };
+            outln!(
+                "{}",
+                runtime
+                    .block_on(bench::coordinator::coordinator(&settings))?
                     .to_string()
                     .trim_end()
             )?;

@@ -302,6 +302,57 @@ fn bench_validates_every_argument_before_running() {
     );
 }
 
+#[test]
+fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
+    refused(
+        &["bench", "coordinator", "--trials", "0"],
+        &["--trials", "got 0"],
+    );
+    refused(
+        &[
+            "bench",
+            "coordinator",
+            "--workers",
+            "1,300",
+            "--trials",
+            "5",
+        ],
+        &["--workers", "got 300"],
+    );
+    // Clap refuses an unknown path itself (exit code 2).
+    let out = graspopt(&["bench", "coordinator", "--paths", "disk"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("'disk'") && stderr.contains("--paths"),
+        "{stderr}"
+    );
+    let args = [
+        "bench",
+        "coordinator",
+        "--workers",
+        "1,3",
+        "--trials",
+        "6",
+        "--paths",
+        "core",
+    ];
+    let out = graspopt_within(&args, Duration::from_secs(120)).expect("bench coordinator hung");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("| core |"))
+        .collect();
+    assert_eq!(rows.len(), 2, "{stdout}");
+    assert!(rows[0].starts_with("| core | 1 | 6 |"), "{stdout}");
+    assert!(rows[1].starts_with("| core | 3 | 6 |"), "{stdout}");
+}
+
 // --- experiment metrics ---
 
 #[test]
