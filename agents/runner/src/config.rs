@@ -108,7 +108,7 @@ mod tests {
             "{msg}"
         );
         assert!(
-            msg.contains("hand, id, mesh, mesh_scale, object, replay, trial_cost_ms"),
+            msg.contains("fingertips, forces, hand, id, mesh, mesh_scale, object, replay, sensing, trial_cost_ms"),
             "{msg}"
         );
         // In a table, the table's own keys.
