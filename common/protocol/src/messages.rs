@@ -448,20 +448,19 @@ impl ForceAnalysis {
             .map(|w| (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt())
     }
 
-    /// The analysis for people, as the tools print it: "holds the load (4.905 N) with contact
-    /// forces of norm 6.250 N at least (largest 3.500 N)" or "cannot hold the load (4.905 N)",
-    /// then for measured forces "; measured: net force 0.012 N, smallest slip margin 0.840 N".
+    /// The analysis for people, as the tools print it: "holds the load (4.905 N): least
+    /// contact forces 6.250 N (largest 3.500 N)" (their norm, and the largest one) or "cannot
+    /// hold the load (4.905 N)", then for measured forces "; measured: net force 0.012 N,
+    /// smallest slip margin 0.840 N".
     pub fn describe(&self) -> String {
         let e = &self.external;
         let load = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
         let mut text = match (self.resisting_norm, self.resisting_max) {
             (Some(norm), Some(max)) => format!(
-                "holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least (largest {max:.3} N)"
+                "holds the load ({load:.3} N): least contact forces {norm:.3} N (largest {max:.3} N)"
             ),
             (Some(norm), None) => {
-                format!(
-                    "holds the load ({load:.3} N) with contact forces of norm {norm:.3} N at least"
-                )
+                format!("holds the load ({load:.3} N): least contact forces {norm:.3} N")
             }
             (None, _) => format!("cannot hold the load ({load:.3} N)"),
         };

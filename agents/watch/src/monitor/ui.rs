@@ -191,7 +191,7 @@ mod tests {
             "30/60 trials",
             "30 completed, 1 running, 0 failed",
             "best: trial 12 score 0.21230 at approach=-0.03100, vertical=0.01040, force closure",
-            "best's forces: holds the load (4.905 N) with contact forces of norm 6.250 N at least (largest 3.500 N)",
+            "best's forces: holds the load (4.905 N): least contact forces 6.250 N (largest 3.500 N)",
             "hand-1@lab  trial 14",
             "hand-2@lab  idle",
             "2 duplicates",

@@ -125,7 +125,8 @@ mod tests {
                 "graspopt/r/hand/hand-1/command",
                 "graspopt/r/hand/hand-2/command",
                 "graspopt/r/result",
-                "graspopt/r/status"
+                "graspopt/r/status",
+                "graspopt/r/wrenches"
             ]
         );
         let clouds = &rows[0];
