@@ -21,7 +21,7 @@ use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
-use crate::support::{Cluster, Proc, check_journal, graspopt, repo_root};
+use crate::support::{Cluster, Proc, check_journal, graspopt};
 
 /// The mug. (The star prism's sharp edges, where its fingertip contacts often lie, make the
 /// score jump between noise-free readings and their true contacts.)
@@ -333,35 +333,6 @@ fn replay_hand_answers_with_recorded_fingertip_readings() {
     );
 }
 
-/// The Python force-sensing hand (`examples/python/ft_hand_agent.py`) as worker `id` of the
-/// cluster's run, answering from the recording `rec`. Needs `GRASPOPT_PYTHON`, a Python with
-/// eclipse-zenoh (`.ci/run` makes one).
-fn python_ft_hand(c: &Cluster, rec: &Path, id: &str) -> Proc {
-    let python = std::env::var("GRASPOPT_PYTHON")
-        .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
-    let script = repo_root().join("examples/python/ft_hand_agent.py");
-    let log = std::fs::File::create(c.dir.join(format!("{id}.log"))).unwrap();
-    let child = std::process::Command::new(python)
-        .arg(&script)
-        .args([
-            "--connect",
-            &c.endpoint,
-            "--run",
-            &c.run,
-            "--id",
-            id,
-            "--recording",
-            rec.to_str().unwrap(),
-        ])
-        .stderr(log)
-        .spawn()
-        .expect("start the Python force-sensing hand");
-    Proc {
-        name: id.into(),
-        child,
-    }
-}
-
 /// 30 trials with the Python force-sensing hand as the only worker: every score is the
 /// recorded score of the nearest recorded grasp, within the noise bound of its true contacts'.
 #[test]
@@ -369,7 +340,8 @@ fn python_ft_hand(c: &Cluster, rec: &Path, id: &str) -> Proc {
 fn python_ft_hand_is_the_only_worker_of_a_run() {
     let c = Cluster::start("pyft", "pyft");
     let (rec, grasps) = record(&c.dir);
-    let hand = python_ft_hand(&c, &rec, "py-ft-hand");
+    let hand =
+        crate::replay::python_agent(&c, "ft_hand_agent.py", &rec, "py-ft-hand", "py-ft-hand");
     let rows = optimize_with(&c, hand, "py-ft-hand", 30);
     let (abs, rel) = check_replayed(&rows, &grasps);
     println!(

@@ -115,9 +115,15 @@ fn replay_hand_answers_trials_from_a_recording() {
 /// cluster's run, answering from the recording `rec`; its stderr goes to `<dir>/<name>.log`.
 /// Needs `GRASPOPT_PYTHON`, a Python with eclipse-zenoh (`.ci/run` makes one).
 fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
+    python_agent(c, "hand_agent.py", rec, name, id)
+}
+
+/// The Python hand `script` of `examples/python/` as worker `id`, answering from the
+/// recording `rec`; its stderr goes to `<dir>/<name>.log`.
+pub(crate) fn python_agent(c: &Cluster, script: &str, rec: &Path, name: &str, id: &str) -> Proc {
     let python = std::env::var("GRASPOPT_PYTHON")
         .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
-    let script = repo_root().join("examples/python/hand_agent.py");
+    let script = repo_root().join("examples/python").join(script);
     let log = std::fs::File::create(c.dir.join(format!("{name}.log"))).unwrap();
     let child = std::process::Command::new(python)
         .arg(&script)
@@ -133,7 +139,7 @@ fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
         ])
         .stderr(log)
         .spawn()
-        .expect("start the Python hand agent");
+        .unwrap_or_else(|e| panic!("start the Python hand {}: {e}", script.display()));
     Proc {
         name: name.into(),
         child,

@@ -181,14 +181,16 @@ fn analysed(
     }
 }
 
+/// A score, and the force analysis beside it (which may fail on its own).
+type ScoreAndForces = (TrialScore, Result<GraspForces, TrialError>);
+
 /// The score of sensed fingertip contacts, and the analysis of their measured forces.
-#[allow(clippy::type_complexity)]
 fn score_sensed(
     measured: &MeasuredTrial,
     contacts: &[(usize, String, FingertipContact)],
     object: &Object,
     config: &MetricConfig,
-) -> Result<(TrialScore, Result<GraspForces, TrialError>), TrialError> {
+) -> Result<ScoreAndForces, TrialError> {
     let score = fingertip_score(&config.score);
     let (s, outcome) = score_measured(measured, object, &config.contacts, &score)?;
     let reference = grasp_model(&outcome, object, &score)?.reference_point;
