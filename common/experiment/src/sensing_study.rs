@@ -37,8 +37,10 @@ pub struct SensingStudySettings {
     /// Random trials per object.
     pub trials: usize,
     pub seed: u64,
-    /// The sensors' noise.
+    /// The sensors' noise, per sample.
     pub noise: SensorNoise,
+    /// Samples averaged per reading.
+    pub samples: u32,
     /// How readings become contacts.
     pub sensing: SensingSettings,
 }
@@ -50,6 +52,7 @@ impl Default for SensingStudySettings {
             trials: 200,
             seed: 0,
             noise: SensorNoise::default(),
+            samples: FingertipSettings::default().samples,
             sensing: graspopt_trial::fingertips::soft_finger_sensing(),
         }
     }
@@ -116,6 +119,7 @@ pub fn round_trip(
 ) -> Result<Vec<ObjectRoundTrip>, ExperimentError> {
     let tips_settings = FingertipSettings {
         noise: settings.noise,
+        samples: settings.samples,
         kind: settings.sensing.kind,
         ..FingertipSettings::default()
     };

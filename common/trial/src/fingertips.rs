@@ -42,8 +42,13 @@ pub struct FingertipSettings {
     /// What a fingertip transmits: a soft finger (a force and a moment about the normal, the
     /// thesis's contact model and the default) or a point contact with friction.
     pub kind: ContactKind,
-    /// The sensor noise (Nano17 by default; [`SensorNoise::NONE`] for exact readings).
+    /// The sensor noise of one sample (Nano17 by default; [`SensorNoise::NONE`] for exact
+    /// readings).
     pub noise: SensorNoise,
+    /// How many samples a reading averages: the hand holds still while its sensors sample
+    /// (a Nano17 is read at 1 kHz or more; 16 samples are 16 ms of it), which divides the
+    /// noise by about 4. 1: a single sample. Default 16.
+    pub samples: u32,
     /// How far below the sphere's centre the sensor's origin is (m). Default 15 mm.
     pub sensor_depth: f64,
     /// The normal force each touching tip applies when the tips alone cannot hold the
@@ -59,6 +64,7 @@ impl Default for FingertipSettings {
         FingertipSettings {
             kind: ContactKind::SoftFinger,
             noise: SensorNoise::default(),
+            samples: 16,
             sensor_depth: 0.015,
             squeeze: 10.0,
             grip: 10.0,
@@ -322,7 +328,7 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
             &(inverse * truth.force),
             truth.torsion,
         );
-        let reading = settings.noise.apply(&exact, rng);
+        let reading = sample_mean(&settings.noise, &exact, settings.samples, rng);
         out.push(SimulatedFingertip {
             sensor: SensorReading {
                 finger: tip.finger,
@@ -335,6 +341,29 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         });
     }
     Ok(out)
+}
+
+/// The mean of `samples` noisy samples of `exact` (one sample when `samples` is 0 or 1).
+fn sample_mean<R: rand::Rng + ?Sized>(
+    noise: &SensorNoise,
+    exact: &Reading,
+    samples: u32,
+    rng: &mut R,
+) -> Reading {
+    let n = samples.max(1);
+    let mut sum = Reading {
+        force: Vector3::zeros(),
+        torque: Vector3::zeros(),
+    };
+    for _ in 0..n {
+        let r = noise.apply(exact, rng);
+        sum.force += r.force;
+        sum.torque += r.torque;
+    }
+    Reading {
+        force: sum.force / f64::from(n),
+        torque: sum.torque / f64::from(n),
+    }
 }
 
 /// The contact a sensor reading stands for, in the world frame, or why there is none.

@@ -23,6 +23,9 @@ pub struct SensingArgs {
     /// Torque resolution of the noisy run (N m; default 1.5625e-5, 1/64 N mm).
     #[arg(long)]
     torque_resolution: Option<f64>,
+    /// Sensor samples averaged per reading (1: single samples).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
+    samples: u32,
 }
 
 pub fn sensing(args: &SensingArgs) -> Result<()> {
@@ -38,13 +41,15 @@ pub fn sensing(args: &SensingArgs) -> Result<()> {
             trials: args.trials,
             seed: args.seed,
             noise,
+            samples: args.samples,
             ..SensingStudySettings::default()
         };
         let rows = round_trip(&settings)?;
         outln!(
-            "Force-sensing round trip {title} (force resolution {} N, torque resolution {} N m), barrett_ft, {} trials per object, seed {}:\n",
+            "Force-sensing round trip {title} (force resolution {} N, torque resolution {} N m, {} samples averaged per reading), barrett_ft, {} trials per object, seed {}:\n",
             noise.force_resolution,
             noise.torque_resolution,
+            args.samples,
             args.trials,
             args.seed
         )?;
