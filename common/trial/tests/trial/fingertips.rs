@@ -74,3 +74,50 @@ fn noise_free_readings_give_back_the_fingertip_contacts_on_every_object() {
     }
     assert!(checked >= 30, "only {checked} fingertip contacts");
 }
+
+#[test]
+fn averaging_sixteen_samples_quarters_the_error_of_a_reading() {
+    let object = Object::by_name("cuboid").unwrap();
+    let space = TrialSpace::full_6d(&object);
+    let ev = Evaluator::new(object, hand_by_name("barrett_ft").unwrap(), space);
+    let median_error = |samples: u32| {
+        let settings = FingertipSettings {
+            samples,
+            ..FingertipSettings::default()
+        };
+        let mut trials = ChaCha8Rng::seed_from_u64(3);
+        let mut noise = ChaCha8Rng::seed_from_u64(4);
+        let mut errors = Vec::new();
+        for _ in 0..120 {
+            let u: Vec<f64> = (0..ev.space.dim())
+                .map(|_| trials.random::<f64>())
+                .collect();
+            let e = ev.evaluate(&ev.space.from_unit(&u).unwrap()).unwrap();
+            let tips = simulate_readings(
+                &e.outcome,
+                ev.hand.as_ref(),
+                &ev.object,
+                &ScoreSettings::default(),
+                &ForceSettings::default(),
+                &settings,
+                &mut noise,
+            )
+            .unwrap();
+            for tip in &tips {
+                let sensing = graspopt_trial::fingertips::soft_finger_sensing();
+                let got = sense(&tip.sensor, &sensing).unwrap();
+                errors.push((got.point - tip.truth.point).norm());
+            }
+        }
+        assert!(errors.len() >= 20, "{} fingertip contacts", errors.len());
+        errors.sort_by(f64::total_cmp);
+        errors[errors.len() / 2]
+    };
+    let (one, sixteen) = (median_error(1), median_error(16));
+    assert!(one > 0.0 && sixteen > 0.0);
+    let ratio = one / sixteen;
+    assert!(
+        (2.5..=6.0).contains(&ratio),
+        "median error {one} with 1 sample, {sixteen} with 16"
+    );
+}
