@@ -21,7 +21,8 @@ use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
-use crate::support::{Cluster, Proc, check_journal, graspopt};
+use crate::replay::{dist, run_with_only};
+use crate::support::{Cluster, Proc, graspopt};
 
 /// The mug. (The star prism's sharp edges, where its fingertip contacts often lie, make the
 /// score jump between noise-free readings and their true contacts.)
@@ -106,21 +107,8 @@ fn largest_differences(pairs: &[(f64, f64)]) -> (f64, f64) {
 /// (id `worker`); checks the journal and that every trial has a force analysis; returns the
 /// trials.
 fn optimize_with(c: &Cluster, hand: Proc, worker: &str, trials: usize) -> Vec<TrialRow> {
-    let journal = c.journal();
-    let _support = c.support(OBJECT);
-    let coordinator = c.coordinator(OBJECT, &trials.to_string(), "5", &["--hand", HAND]);
-    let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
-    assert!(
-        status.success(),
-        "coordinator failed: {stdout}\n{}\nhand log:\n{}\nmetric log:\n{}",
-        c.log("coordinator"),
-        c.log(&hand.name),
-        c.log("metric")
-    );
-    drop(hand);
-    let rows = check_journal(&journal, &c.run, trials);
+    let rows = run_with_only(c, hand, worker, OBJECT, trials, "5", &["--hand", HAND]);
     for t in &rows {
-        assert_eq!(t.worker, worker);
         assert!(
             t.forces.is_some(),
             "trial {} has no force analysis",
@@ -260,10 +248,6 @@ fn check_replayed(rows: &[TrialRow], grasps: &[Recorded]) -> (f64, f64) {
         pairs.push((score, nearest.true_score));
     }
     largest_differences(&pairs)
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
 /// `agent hand --replay` of a recording of fingertip readings sends them as

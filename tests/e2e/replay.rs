@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use graspopt_journal::TrialRow;
+
 use crate::support::{Cluster, Proc, check_journal, graspopt, repo_root};
 
 const TRIALS: usize = 10;
@@ -45,20 +47,8 @@ fn record(dir: &Path) -> (PathBuf, Vec<(Vec<f64>, f64)>) {
 /// Runs `TRIALS` trials on the cuboid with `hand` as the only worker; checks every score is
 /// the nearest recorded grasp's and that `worker` did them.
 fn optimize_with(c: &Cluster, hand: Proc, worker: &str, grasps: &[(Vec<f64>, f64)]) {
-    let journal = c.journal();
-    let _support = c.support("cuboid");
-    let coordinator = c.coordinator("cuboid", &TRIALS.to_string(), "3", &[]);
-    let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
-    assert!(
-        status.success(),
-        "coordinator failed: {stdout}\n{}\nhand log:\n{}",
-        c.log("coordinator"),
-        c.log(&hand.name)
-    );
-    drop(hand);
-    let trials = check_journal(&journal, &c.run, TRIALS);
+    let trials = run_with_only(c, hand, worker, "cuboid", TRIALS, "3", &[]);
     for t in &trials {
-        assert_eq!(t.worker, worker);
         let nearest = grasps
             .iter()
             .min_by(|a, b| dist(&a.0, &t.params).total_cmp(&dist(&b.0, &t.params)))
@@ -75,7 +65,39 @@ fn optimize_with(c: &Cluster, hand: Proc, worker: &str, grasps: &[(Vec<f64>, f64
     }
 }
 
-fn dist(a: &[f64], b: &[f64]) -> f64 {
+/// Runs `trials` trials on `object` (coordinator seed `seed`, more coordinator flags `extra`)
+/// with `hand` as the only worker, id `worker`; returns the journal's trials, checked: each
+/// recorded once, all by `worker`.
+pub(crate) fn run_with_only(
+    c: &Cluster,
+    hand: Proc,
+    worker: &str,
+    object: &str,
+    trials: usize,
+    seed: &str,
+    extra: &[&str],
+) -> Vec<TrialRow> {
+    let journal = c.journal();
+    let _support = c.support(object);
+    let coordinator = c.coordinator(object, &trials.to_string(), seed, extra);
+    let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
+    assert!(
+        status.success(),
+        "coordinator failed: {stdout}\n{}\nhand log:\n{}\nmetric log:\n{}",
+        c.log("coordinator"),
+        c.log(&hand.name),
+        c.log("metric")
+    );
+    drop(hand);
+    let rows = check_journal(&journal, &c.run, trials);
+    for t in &rows {
+        assert_eq!(t.worker, worker);
+    }
+    rows
+}
+
+/// Squared distance between two parameter vectors.
+pub(crate) fn dist(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 

@@ -4,11 +4,32 @@
 use graspopt_sensing::{SensingSettings, SensorNoise};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
-use graspopt_trial::fingertips::{FingertipSettings, fingertips, sense, simulate_readings};
+use graspopt_trial::fingertips::{
+    FingertipSettings, SimulatedFingertip, fingertips, sense, simulate_readings,
+};
 use graspopt_trial::forces::ForceSettings;
-use graspopt_trial::{Evaluator, ScoreSettings};
+use graspopt_trial::{Evaluation, Evaluator, ScoreSettings};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+/// The fingertip readings of trial `e` of `ev`, with the default score and load.
+fn readings(
+    ev: &Evaluator,
+    e: &Evaluation,
+    settings: &FingertipSettings,
+    rng: &mut ChaCha8Rng,
+) -> Vec<SimulatedFingertip> {
+    simulate_readings(
+        &e.outcome,
+        ev.hand.as_ref(),
+        &ev.object,
+        &ScoreSettings::default(),
+        &ForceSettings::default(),
+        settings,
+        rng,
+    )
+    .unwrap()
+}
 
 #[test]
 fn barrett_ft_has_one_spherical_fingertip_per_finger_and_barrett_has_none() {
@@ -37,16 +58,7 @@ fn noise_free_readings_give_back_the_fingertip_contacts_on_every_object() {
             let u: Vec<f64> = (0..ev.space.dim()).map(|_| rng.random::<f64>()).collect();
             let params = ev.space.from_unit(&u).unwrap();
             let e = ev.evaluate(&params).unwrap();
-            let tips = simulate_readings(
-                &e.outcome,
-                ev.hand.as_ref(),
-                &ev.object,
-                &ScoreSettings::default(),
-                &ForceSettings::default(),
-                &exact,
-                &mut rng,
-            )
-            .unwrap();
+            let tips = readings(&ev, &e, &exact, &mut rng);
             for tip in &tips {
                 let got = sense(&tip.sensor, &SensingSettings::default()).unwrap_or_else(|e| {
                     panic!("{name} {params:?} finger {}: {e}", tip.sensor.finger)
@@ -93,16 +105,7 @@ fn averaging_sixteen_samples_quarters_the_error_of_a_reading() {
                 .map(|_| trials.random::<f64>())
                 .collect();
             let e = ev.evaluate(&ev.space.from_unit(&u).unwrap()).unwrap();
-            let tips = simulate_readings(
-                &e.outcome,
-                ev.hand.as_ref(),
-                &ev.object,
-                &ScoreSettings::default(),
-                &ForceSettings::default(),
-                &settings,
-                &mut noise,
-            )
-            .unwrap();
+            let tips = readings(&ev, &e, &settings, &mut noise);
             for tip in &tips {
                 let sensing = graspopt_trial::fingertips::soft_finger_sensing();
                 let got = sense(&tip.sensor, &sensing).unwrap();
