@@ -161,6 +161,12 @@ impl Cluster {
         run: &str,
         router_flags: impl FnOnce(&Path) -> Vec<String>,
     ) -> Cluster {
+        // What earlier runs of these tests left (killed agents' shared memory), once per
+        // test process; live agents of concurrent tests are not touched.
+        static CLEAN: std::sync::Once = std::sync::Once::new();
+        CLEAN.call_once(|| {
+            let _ = graspopt_shm::clean_stale_prefixes("gpe2e_");
+        });
         let dir = tempdir(name);
         let port = free_port();
         let endpoint = format!("tcp/127.0.0.1:{port}");
@@ -316,6 +322,47 @@ impl Cluster {
             &self.dir,
         );
         wait_for_port(port, Duration::from_secs(20));
+    }
+}
+
+/// A failed test leaves the tail of every process's log on stderr: a run that stalled in CI
+/// then says which agent stopped and why.
+/// Its agents are dead by then (declared after the cluster, dropped and killed before it):
+/// the shared memory they left under this cluster's prefix is removed, so killed agents do
+/// not pile files into /dev/shm and /tmp/iceoryx2 run after run.
+impl Drop for Cluster {
+    fn drop(&mut self) {
+        // Best effort: a failure leaves files behind, never fails the test. What iceoryx2
+        // keeps per prefix once its nodes are gone (a management segment) goes too: the
+        // prefix is this cluster's alone.
+        let _ = graspopt_shm::clean_stale_prefixes(&self.shm);
+        for dir in ["/dev/shm", "/tmp/iceoryx2"] {
+            for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+                if entry.file_name().to_string_lossy().starts_with(&self.shm) {
+                    let _ = std::fs::remove_file(entry.path());
+                }
+            }
+        }
+        if !std::thread::panicking() {
+            return;
+        }
+        let Ok(entries) = std::fs::read_dir(&*self.dir) else {
+            return;
+        };
+        let mut logs: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "log"))
+            .collect();
+        logs.sort();
+        for path in logs {
+            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            let lines: Vec<&str> = text.lines().collect();
+            let tail = &lines[lines.len().saturating_sub(40)..];
+            eprintln!("---- {} (last {} lines)", path.display(), tail.len());
+            for line in tail {
+                eprintln!("{line}");
+            }
+        }
     }
 }
 
