@@ -23,26 +23,12 @@ use crate::waits::{self, Waits};
 /// After a question the planner did not answer, how long until it is asked again.
 pub const PLANNER_RETRY_MS: i64 = 500;
 
-/// A write to the run's journal.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Write {
-    /// A trial attempt leased to a worker.
-    Issue(TrialIssue),
-    /// A trial attempt that failed.
-    Failure {
-        trial_id: u64,
-        attempt: u32,
-        error: String,
-        at_ms: i64,
-    },
-    /// A trial's result.
-    Result(TrialResultRecord),
-    /// The planner's engine after its last reply (losing it costs a restarted planner its
-    /// exactness, not the run: a failure to write it is only logged).
-    PlannerState { engine: Vec<u8>, at_ms: i64 },
-}
+/// A write to the run's journal (what a batch of them keeps: `graspopt_journal::batch`).
+pub use graspopt_journal::Write;
 
-/// What the loop does for the core, in the order given.
+/// What the loop does for the core, in the order given, except that the journal writes of
+/// one call are committed together before the rest (see [`crate::run::record`]): a write
+/// only ever comes earlier, never a command before its issue.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action {
     Record(Write),
@@ -449,16 +435,41 @@ impl Coordinator {
         let Some((_, bounds)) = &self.space else {
             return true;
         };
-        let dim = bounds.len();
+        // A point of another dimension, not finite or outside the trial space is not a
+        // trial (it would fail its palm pose): counted, said, and not issued.
+        let inside = |p: &[f64]| {
+            p.len() == bounds.len()
+                && p.iter()
+                    .zip(bounds)
+                    .all(|(x, [lo, hi])| x.is_finite() && lo <= x && x <= hi)
+        };
         let n = self.state.proposals_needed();
+        let (mut taken, mut refused) = (0, None);
         for p in reply.points.into_iter().take(n) {
-            if p.len() != dim {
+            if inside(&p) {
+                self.state.add_trial(p);
+                taken += 1;
+            } else {
                 self.state.count_bad_message();
-                continue;
+                refused.get_or_insert(p);
             }
-            self.state.add_trial(p);
         }
-        true
+        match refused {
+            Some(p) if taken == 0 => {
+                let why = format!(
+                    "the planner proposed only points outside the trial space, e.g. {p:?} (bounds {bounds:?})"
+                );
+                self.planner_down(&why, now);
+                false
+            }
+            Some(p) => {
+                tracing::warn!(
+                    "coordinator: a proposal outside the trial space was left out: {p:?} (bounds {bounds:?})"
+                );
+                true
+            }
+            None => true,
+        }
     }
 
     /// Logs that no proposal came: once when it starts, then at most every 10 s.
@@ -689,6 +700,69 @@ mod tests {
         };
         assert_eq!(command.lease_ms, LEASE as u64);
         assert_eq!(command.issued_ms, 12 + 2 * LEASE);
+    }
+
+    /// The loop commits one event's writes together, then carries out the rest: the
+    /// issues of one planner reply are one batch, their commands keep their order.
+    #[test]
+    fn a_reply_s_issues_are_one_batch_before_its_commands() {
+        let mut c = coordinator(3, &["a", "b", "c"]);
+        let request = asked(&c.poll(0).unwrap());
+        let points = vec![vec![-0.1], vec![-0.05], vec![0.0]];
+        let actions = c.on_reply(Ok(reply(&request, points)), 5).unwrap();
+        let (writes, rest) = crate::run::split_writes(actions);
+        let issues: Vec<(u64, &str)> = writes
+            .iter()
+            .filter_map(|w| match w {
+                Write::Issue(i) => Some((i.trial_id, i.worker.as_str())),
+                _ => None,
+            })
+            .collect();
+        assert!(matches!(writes[0], Write::PlannerState { .. }));
+        assert_eq!(issues, [(1, "a"), (2, "b"), (3, "c")]);
+        let sent: Vec<(u64, &str)> = rest
+            .iter()
+            .filter_map(|a| match a {
+                Action::Send {
+                    worker, command, ..
+                } => Some((command.trial_id, worker.as_str())),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(sent, issues);
+        assert!(!rest.iter().any(|a| matches!(a, Action::Record(_))));
+    }
+
+    /// A planner's point outside the trial space (or not finite) is counted and left out;
+    /// it failed the whole coordinator before (its palm pose is refused when issued). A
+    /// reply of such points only is a planner that cannot propose: asked again later.
+    #[test]
+    fn proposals_outside_the_trial_space_are_left_out() {
+        let mut c = coordinator(3, &["a", "b", "c"]);
+        let request = asked(&c.poll(0).unwrap());
+        let points = vec![vec![0.5], vec![-0.1], vec![f64::NAN]];
+        let actions = c.on_reply(Ok(reply(&request, points)), 5).unwrap();
+        assert_eq!(issued(&actions), [(1, 1, "a".into(), None)]);
+        assert_eq!(c.status(5).errors.bad_messages, 2);
+        // Another question for the two still needed, at once.
+        let request = asked(&c.poll(6).unwrap());
+        assert_eq!(request.count, 2);
+        let actions = c
+            .on_reply(Ok(reply(&request, vec![vec![-0.2], vec![0.03]])), 7)
+            .unwrap();
+        assert!(issued(&actions).is_empty());
+        assert_eq!(c.status(7).errors.bad_messages, 4);
+        // Only bad points: asked again after the retry delay, not at once.
+        assert!(c.poll(8).unwrap().is_empty());
+        let request = asked(&c.poll(7 + PLANNER_RETRY_MS).unwrap());
+        let actions = c
+            .on_reply(Ok(reply(&request, vec![vec![-0.16], vec![0.02]])), 600)
+            .unwrap();
+        assert_eq!(
+            issued(&actions).len(),
+            2,
+            "the bounds themselves are inside"
+        );
     }
 
     #[test]

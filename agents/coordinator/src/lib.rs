@@ -24,7 +24,7 @@ use graspopt_protocol::RunId;
 use serde::{Deserialize, Serialize};
 
 pub use crate::core::{Action, Coordinator, Write};
-pub use crate::run::{record, run, run_until};
+pub use crate::run::{record, run, run_until, split_writes};
 pub use crate::spec::{
     Conflicts, RunSpec, open_run, param_names, quoted_runs, reconcile, recorded_runs,
     recorded_spec, resume_conflicts, sole_run, standalone_run, trial_space,

@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Server, Subscription, now_ms};
-use graspopt_journal::{Journal, ResultOutcome, RunLifecycle};
+use graspopt_journal::{Journal, ResultOutcome, RunLifecycle, Written};
 use graspopt_protocol::keys::{COMMAND, OBJECT, RESULT, STATE, STATUS, SUGGEST, alive_key};
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, TrialResult,
@@ -135,9 +135,16 @@ async fn drive<'a>(
                 planning = None;
                 core.on_reply(reply, now_ms())?
             },
-            Some(r) = inputs.results.recv() => match inbox.accept(r, "result") {
-                Some(result) => core.on_result(&result, now_ms()),
-                None => bad(core),
+            Some(r) = inputs.results.recv() => {
+                // Results that arrived together are handled together: their writes and the
+                // issues of the trials their workers take next make one commit.
+                let mut actions = on_result(core, &mut inbox, r);
+                for _ in 1..RESULTS_AT_ONCE {
+                    let Some(r) = inputs.results.try_recv() else { break };
+                    actions.extend(on_result(core, &mut inbox, r));
+                }
+                actions.extend(core.poll(now_ms())?);
+                actions
             },
             Some(r) = inputs.objects.recv() => match inbox.accept(r, "object estimate") {
                 Some(estimate) => {
@@ -170,6 +177,22 @@ async fn drive<'a>(
     }
 }
 
+/// At most this many results already arrived are handled as one event (a flood of them
+/// does not hold back timers and workers).
+const RESULTS_AT_ONCE: usize = 256;
+
+/// A result from the bus, to the core.
+fn on_result(
+    core: &mut Coordinator,
+    inbox: &mut Inbox,
+    r: graspopt_bus::Received<TrialResult>,
+) -> Vec<Action> {
+    match inbox.accept(r, "result") {
+        Some(result) => core.on_result(&result, now_ms()),
+        None => bad(core),
+    }
+}
+
 /// Counts a message that was not acted on; nothing to do.
 fn bad(core: &mut Coordinator) -> Vec<Action> {
     core.on_bad_message();
@@ -191,9 +214,14 @@ impl<'a> Io<'a> {
         actions: Vec<Action>,
         planning: &mut Option<PlannerCall<'a>>,
     ) -> anyhow::Result<()> {
-        for action in actions {
+        // The journal first, in one transaction: each write comes at most earlier than
+        // the core listed it, so no command goes out before its issue is committed.
+        let (writes, rest) = split_writes(actions);
+        record(self.journal, self.run, &writes)?;
+        for action in rest {
             match action {
-                Action::Record(write) => self.record(write)?,
+                // Committed above.
+                Action::Record(_) => {}
                 Action::Send {
                     worker,
                     encoding,
@@ -222,10 +250,6 @@ impl<'a> Io<'a> {
             }
         }
         Ok(())
-    }
-
-    fn record(&mut self, write: Write) -> anyhow::Result<()> {
-        record(self.journal, self.run, write)
     }
 
     /// The run finished: recorded, its final status published.
@@ -279,32 +303,45 @@ impl<'a> Io<'a> {
     }
 }
 
-/// Carries out one journal write of the core (the loop's, and `graspopt bench
-/// coordinator`'s). A journal that refuses a result says why in the log; a planner state
-/// that cannot be kept is only logged (see [`Write::PlannerState`]).
-pub fn record(journal: &mut Journal, run: &RunId, write: Write) -> anyhow::Result<()> {
-    let run = run.as_str();
-    match write {
-        Write::Issue(issue) => journal.record_issue(&issue)?,
-        Write::Failure {
-            trial_id,
-            attempt,
-            error,
-            at_ms,
-        } => {
-            journal.record_failure(run, trial_id, attempt, &error, at_ms)?;
+/// The journal writes among `actions`, in order, and the other actions, in order (what
+/// the loop commits at once, then carries out).
+pub fn split_writes(actions: Vec<Action>) -> (Vec<Write>, Vec<Action>) {
+    let mut writes = Vec::new();
+    let mut rest = Vec::with_capacity(actions.len());
+    for action in actions {
+        match action {
+            Action::Record(write) => writes.push(write),
+            other => rest.push(other),
         }
-        Write::Result(r) => match journal.record_result(&r)? {
-            ResultOutcome::Accepted => {}
-            other => tracing::warn!(
+    }
+    (writes, rest)
+}
+
+/// Carries out journal writes of the core in one transaction (the loop's, and `graspopt
+/// bench coordinator`'s): what one event decided, the issues of a planner reply or the
+/// results that arrived together, costs one commit. A result the journal does not accept
+/// (a duplicate, say) is logged; a planner state that cannot be kept is only logged (see
+/// [`Write::PlannerState`]); any other refusal, or a transaction that cannot commit, is an
+/// error, returned before any command of these writes is sent.
+pub fn record(journal: &mut Journal, run: &RunId, writes: &[Write]) -> anyhow::Result<()> {
+    if writes.is_empty() {
+        return Ok(());
+    }
+    let outcomes = journal
+        .record(run.as_str(), writes)
+        .context("the journal could not commit")?;
+    for (write, outcome) in writes.iter().zip(outcomes) {
+        match (write, outcome) {
+            (_, Ok(Written::Result(ResultOutcome::Accepted))) => {}
+            (Write::Result(r), Ok(Written::Result(other))) => tracing::warn!(
                 "coordinator: journal says {other:?} for trial {}",
                 r.trial_id
             ),
-        },
-        Write::PlannerState { engine, at_ms } => {
-            if let Err(e) = journal.set_planner_state(run, &engine, at_ms) {
-                tracing::warn!("coordinator: cannot keep the planner's state in the journal: {e}");
+            (_, Ok(_)) => {}
+            (Write::PlannerState { .. }, Err(e)) => {
+                tracing::warn!("coordinator: cannot keep the planner's state in the journal: {e}")
             }
+            (_, Err(e)) => return Err(e.into()),
         }
     }
     Ok(())

@@ -400,6 +400,16 @@ impl<T: Message> Subscription<T> {
         };
         Some(decode_sample(&sample))
     }
+
+    /// The next sample if one has arrived (`None`: none has, or the session closed): what
+    /// arrived together with a sample just received, taken without waiting.
+    pub fn try_recv(&self) -> Option<Received<T>> {
+        let sample = match &self.inner {
+            Inner::Fifo(s) => s.try_recv().ok().flatten()?,
+            Inner::Ring(s) => s.try_recv().ok().flatten()?,
+        };
+        Some(decode_sample(&sample))
+    }
 }
 
 /// The first reply of a query sent at `started`. A query that ends without a reply well

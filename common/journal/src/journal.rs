@@ -32,8 +32,9 @@ const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, 
 /// database file (write-ahead log, so a killed process loses at most the
 /// transaction it was in, and readers in other connections never block the writer).
 ///
-/// Every write method is one transaction. The journal is `Send` but not
-/// `Sync`: one thread (or a mutex) owns it.
+/// Every write method is one transaction; [`Journal::record`] writes several
+/// in one (see [`crate::batch`]). The journal is `Send` but not `Sync`: one
+/// thread (or a mutex) owns it.
 pub struct Journal {
     conn: Connection,
     path: Option<PathBuf>,
@@ -87,7 +88,7 @@ impl Journal {
         self.path.as_deref()
     }
 
-    fn write_tx(&mut self) -> Result<Transaction<'_>> {
+    pub(crate) fn write_tx(&mut self) -> Result<Transaction<'_>> {
         Ok(self
             .conn
             .transaction_with_behavior(TransactionBehavior::Immediate)?)
@@ -219,20 +220,7 @@ impl Journal {
     /// bytes), replacing the previous one.
     pub fn set_planner_state(&mut self, run_id: &str, state: &[u8], at_ms: i64) -> Result<()> {
         let tx = self.write_tx()?;
-        let known: bool = tx.query_row(
-            "SELECT EXISTS (SELECT 1 FROM runs WHERE run_id = ?1)",
-            params![run_id],
-            |r| r.get(0),
-        )?;
-        if !known {
-            return Err(JournalError::UnknownRun(run_id.to_string()));
-        }
-        tx.execute(
-            "INSERT INTO planner_state (run_id, state, updated_ms) VALUES (?1, ?2, ?3)
-             ON CONFLICT (run_id) DO UPDATE SET state = excluded.state,
-                                                updated_ms = excluded.updated_ms",
-            params![run_id, state, at_ms],
-        )?;
+        planner_state_in(&tx, run_id, state, at_ms)?;
         tx.commit()?;
         Ok(())
     }
@@ -260,120 +248,8 @@ impl Journal {
     /// attempt that is not the next one; re-issuing a completed or failed
     /// trial; re-issuing with different parameters.
     pub fn record_issue(&mut self, issue: &TrialIssue) -> Result<()> {
-        for (i, p) in issue.params.iter().enumerate() {
-            check_finite(|| format!("params[{i}]"), *p)?;
-        }
-        let id = db_id(issue.trial_id)?;
-        let params_json = serde_json::to_string(&issue.params)?;
         let tx = self.write_tx()?;
-        let names: Option<String> = tx
-            .query_row(
-                "SELECT param_names FROM runs WHERE run_id = ?1",
-                [&issue.run_id],
-                |r| r.get(0),
-            )
-            .optional()?;
-        let Some(names) = names else {
-            return Err(JournalError::UnknownRun(issue.run_id.clone()));
-        };
-        let names: Vec<String> = serde_json::from_str(&names)?;
-        if names.len() != issue.params.len() {
-            return Err(JournalError::ParamCount {
-                run_id: issue.run_id.clone(),
-                trial_id: issue.trial_id,
-                expected: names.len(),
-                found: issue.params.len(),
-            });
-        }
-        let existing: Option<(String, u32, String)> = tx
-            .query_row(
-                "SELECT state, attempts, params FROM trials WHERE run_id = ?1 AND trial_id = ?2",
-                params![issue.run_id, id],
-                |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
-            )
-            .optional()?;
-        match existing {
-            None => {
-                if issue.attempt != 1 {
-                    return Err(JournalError::AttemptMismatch {
-                        run_id: issue.run_id.clone(),
-                        trial_id: issue.trial_id,
-                        expected: 1,
-                        found: issue.attempt,
-                    });
-                }
-                tx.execute(
-                    "INSERT INTO trials (run_id, trial_id, state, attempts, params, worker,
-                                         issued_ms, lease_until_ms)
-                     VALUES (?1, ?2, 'running', 1, ?3, ?4, ?5, ?6)",
-                    params![
-                        issue.run_id,
-                        id,
-                        params_json,
-                        issue.worker,
-                        issue.at_ms,
-                        issue.lease_until_ms
-                    ],
-                )?;
-                insert_event(
-                    &tx,
-                    &issue.run_id,
-                    id,
-                    issue.attempt,
-                    event_kind::ISSUED,
-                    &issue.worker,
-                    issue.at_ms,
-                    issue.reason.as_deref(),
-                )?;
-            }
-            Some((state, attempts, stored_params)) => {
-                let state = parse_state(&state)?;
-                if state != TrialState::Running {
-                    return Err(JournalError::TrialClosed {
-                        run_id: issue.run_id.clone(),
-                        trial_id: issue.trial_id,
-                        state,
-                    });
-                }
-                let expected = attempts.saturating_add(1);
-                if issue.attempt != expected {
-                    return Err(JournalError::AttemptMismatch {
-                        run_id: issue.run_id.clone(),
-                        trial_id: issue.trial_id,
-                        expected,
-                        found: issue.attempt,
-                    });
-                }
-                let stored: Vec<f64> = serde_json::from_str(&stored_params)?;
-                if !same_bits(&stored, &issue.params) {
-                    return Err(JournalError::ParamsMismatch {
-                        run_id: issue.run_id.clone(),
-                        trial_id: issue.trial_id,
-                    });
-                }
-                tx.execute(
-                    "UPDATE trials SET attempts = ?3, worker = ?4, lease_until_ms = ?5
-                     WHERE run_id = ?1 AND trial_id = ?2",
-                    params![
-                        issue.run_id,
-                        id,
-                        issue.attempt,
-                        issue.worker,
-                        issue.lease_until_ms
-                    ],
-                )?;
-                insert_event(
-                    &tx,
-                    &issue.run_id,
-                    id,
-                    issue.attempt,
-                    event_kind::REISSUED,
-                    &issue.worker,
-                    issue.at_ms,
-                    issue.reason.as_deref(),
-                )?;
-            }
-        }
+        issue_in(&tx, issue)?;
         tx.commit()?;
         Ok(())
     }
@@ -390,110 +266,8 @@ impl Journal {
     /// A NaN or infinite score or metric is an error naming the field, and
     /// nothing is written.
     pub fn record_result(&mut self, result: &TrialResultRecord) -> Result<ResultOutcome> {
-        check_finite(|| "score".to_string(), result.score)?;
-        if let Some(m) = &result.metrics {
-            check_finite(|| "metrics.epsilon".to_string(), m.epsilon)?;
-            if let Some(v) = m.volume {
-                check_finite(|| "metrics.volume".to_string(), v)?;
-            }
-            check_finite(|| "metrics.distance".to_string(), m.distance)?;
-            check_finite(|| "metrics.bw".to_string(), m.bw)?;
-        }
-        if let Some(f) = &result.forces {
-            f.validate("forces").map_err(JournalError::Invalid)?;
-        }
-        let Ok(id) = db_id(result.trial_id) else {
-            return Ok(ResultOutcome::UnknownTrial);
-        };
         let tx = self.write_tx()?;
-        let existing: Option<(String, u32, Option<u32>)> = tx
-            .query_row(
-                "SELECT state, attempts, result_attempt FROM trials
-                 WHERE run_id = ?1 AND trial_id = ?2",
-                params![result.run_id, id],
-                |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
-            )
-            .optional()?;
-        let Some((state, attempts, result_attempt)) = existing else {
-            return Ok(ResultOutcome::UnknownTrial);
-        };
-        let outcome = match parse_state(&state)? {
-            TrialState::Completed | TrialState::Failed => {
-                let note = match result_attempt {
-                    Some(a) => format!("trial already completed by attempt {a}"),
-                    None => "trial already failed".to_string(),
-                };
-                insert_event(
-                    &tx,
-                    &result.run_id,
-                    id,
-                    result.attempt,
-                    event_kind::DUPLICATE,
-                    &result.worker,
-                    result.at_ms,
-                    Some(&note),
-                )?;
-                ResultOutcome::Duplicate
-            }
-            TrialState::Running => {
-                let note = if result.attempt < attempts {
-                    Some(format!(
-                        "late result from attempt {} (latest attempt {attempts})",
-                        result.attempt
-                    ))
-                } else if result.attempt > attempts {
-                    Some(format!(
-                        "result from attempt {} which was never issued (latest attempt {attempts})",
-                        result.attempt
-                    ))
-                } else {
-                    None
-                };
-                let m = result.metrics.as_ref();
-                let forces_json = match &result.forces {
-                    Some(f) => Some(serde_json::to_string(f)?),
-                    None => None,
-                };
-                tx.execute(
-                    "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
-                         result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
-                         epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
-                         fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16,
-                         forces_json = ?17
-                     WHERE run_id = ?1 AND trial_id = ?2",
-                    params![
-                        result.run_id,
-                        id,
-                        result.worker,
-                        result.at_ms,
-                        result.attempt,
-                        result.score,
-                        m.map(|m| m.rank),
-                        m.map(|m| m.force_closure),
-                        m.map(|m| m.epsilon),
-                        m.and_then(|m| m.volume),
-                        m.map(|m| m.distance),
-                        m.map(|m| m.bw),
-                        result.contacts,
-                        result.fingers_in_contact,
-                        result.cloud_points,
-                        result.details_json,
-                        forces_json,
-                    ],
-                )?;
-                insert_event(
-                    &tx,
-                    &result.run_id,
-                    id,
-                    result.attempt,
-                    event_kind::RESULT,
-                    &result.worker,
-                    result.at_ms,
-                    note.as_deref(),
-                )?;
-                ResultOutcome::Accepted
-            }
-        };
+        let outcome = result_in(&tx, result)?;
         tx.commit()?;
         Ok(outcome)
     }
@@ -510,39 +284,10 @@ impl Journal {
         message: &str,
         at_ms: i64,
     ) -> Result<bool> {
-        let Ok(id) = db_id(trial_id) else {
-            return Ok(false);
-        };
         let tx = self.write_tx()?;
-        let existing: Option<(String, String)> = tx
-            .query_row(
-                "SELECT state, worker FROM trials WHERE run_id = ?1 AND trial_id = ?2",
-                params![run_id, id],
-                |r| Ok((r.get(0)?, r.get(1)?)),
-            )
-            .optional()?;
-        let Some((state, worker)) = existing else {
-            return Ok(false);
-        };
-        if parse_state(&state)? != TrialState::Running {
-            return Ok(false);
-        }
-        tx.execute(
-            "UPDATE trials SET state = 'failed', error = ?3 WHERE run_id = ?1 AND trial_id = ?2",
-            params![run_id, id, message],
-        )?;
-        insert_event(
-            &tx,
-            run_id,
-            id,
-            attempt,
-            event_kind::FAILED,
-            &worker,
-            at_ms,
-            Some(message),
-        )?;
+        let written = failure_in(&tx, run_id, trial_id, attempt, message, at_ms)?;
         tx.commit()?;
-        Ok(true)
+        Ok(written)
     }
 
     // ---------------------------------------------------------------- reads
@@ -681,6 +426,294 @@ impl Journal {
             .collect::<rusqlite::Result<Vec<_>>>()?;
         Ok(lines.len() == 1 && lines[0] == "ok")
     }
+}
+
+pub(crate) fn planner_state_in(
+    tx: &Connection,
+    run_id: &str,
+    state: &[u8],
+    at_ms: i64,
+) -> Result<()> {
+    let known: bool = tx.query_row(
+        "SELECT EXISTS (SELECT 1 FROM runs WHERE run_id = ?1)",
+        params![run_id],
+        |r| r.get(0),
+    )?;
+    if !known {
+        return Err(JournalError::UnknownRun(run_id.to_string()));
+    }
+    tx.execute(
+        "INSERT INTO planner_state (run_id, state, updated_ms) VALUES (?1, ?2, ?3)
+         ON CONFLICT (run_id) DO UPDATE SET state = excluded.state,
+                                            updated_ms = excluded.updated_ms",
+        params![run_id, state, at_ms],
+    )?;
+    Ok(())
+}
+
+pub(crate) fn issue_in(tx: &Connection, issue: &TrialIssue) -> Result<()> {
+    for (i, p) in issue.params.iter().enumerate() {
+        check_finite(|| format!("params[{i}]"), *p)?;
+    }
+    let id = db_id(issue.trial_id)?;
+    let params_json = serde_json::to_string(&issue.params)?;
+    let names: Option<String> = tx
+        .query_row(
+            "SELECT param_names FROM runs WHERE run_id = ?1",
+            [&issue.run_id],
+            |r| r.get(0),
+        )
+        .optional()?;
+    let Some(names) = names else {
+        return Err(JournalError::UnknownRun(issue.run_id.clone()));
+    };
+    let names: Vec<String> = serde_json::from_str(&names)?;
+    if names.len() != issue.params.len() {
+        return Err(JournalError::ParamCount {
+            run_id: issue.run_id.clone(),
+            trial_id: issue.trial_id,
+            expected: names.len(),
+            found: issue.params.len(),
+        });
+    }
+    let existing: Option<(String, u32, String)> = tx
+        .query_row(
+            "SELECT state, attempts, params FROM trials WHERE run_id = ?1 AND trial_id = ?2",
+            params![issue.run_id, id],
+            |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
+        )
+        .optional()?;
+    match existing {
+        None => {
+            if issue.attempt != 1 {
+                return Err(JournalError::AttemptMismatch {
+                    run_id: issue.run_id.clone(),
+                    trial_id: issue.trial_id,
+                    expected: 1,
+                    found: issue.attempt,
+                });
+            }
+            tx.execute(
+                "INSERT INTO trials (run_id, trial_id, state, attempts, params, worker,
+                                     issued_ms, lease_until_ms)
+                 VALUES (?1, ?2, 'running', 1, ?3, ?4, ?5, ?6)",
+                params![
+                    issue.run_id,
+                    id,
+                    params_json,
+                    issue.worker,
+                    issue.at_ms,
+                    issue.lease_until_ms
+                ],
+            )?;
+            insert_event(
+                tx,
+                &issue.run_id,
+                id,
+                issue.attempt,
+                event_kind::ISSUED,
+                &issue.worker,
+                issue.at_ms,
+                issue.reason.as_deref(),
+            )?;
+        }
+        Some((state, attempts, stored_params)) => {
+            let state = parse_state(&state)?;
+            if state != TrialState::Running {
+                return Err(JournalError::TrialClosed {
+                    run_id: issue.run_id.clone(),
+                    trial_id: issue.trial_id,
+                    state,
+                });
+            }
+            let expected = attempts.saturating_add(1);
+            if issue.attempt != expected {
+                return Err(JournalError::AttemptMismatch {
+                    run_id: issue.run_id.clone(),
+                    trial_id: issue.trial_id,
+                    expected,
+                    found: issue.attempt,
+                });
+            }
+            let stored: Vec<f64> = serde_json::from_str(&stored_params)?;
+            if !same_bits(&stored, &issue.params) {
+                return Err(JournalError::ParamsMismatch {
+                    run_id: issue.run_id.clone(),
+                    trial_id: issue.trial_id,
+                });
+            }
+            tx.execute(
+                "UPDATE trials SET attempts = ?3, worker = ?4, lease_until_ms = ?5
+                 WHERE run_id = ?1 AND trial_id = ?2",
+                params![
+                    issue.run_id,
+                    id,
+                    issue.attempt,
+                    issue.worker,
+                    issue.lease_until_ms
+                ],
+            )?;
+            insert_event(
+                tx,
+                &issue.run_id,
+                id,
+                issue.attempt,
+                event_kind::REISSUED,
+                &issue.worker,
+                issue.at_ms,
+                issue.reason.as_deref(),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<ResultOutcome> {
+    check_finite(|| "score".to_string(), result.score)?;
+    if let Some(m) = &result.metrics {
+        check_finite(|| "metrics.epsilon".to_string(), m.epsilon)?;
+        if let Some(v) = m.volume {
+            check_finite(|| "metrics.volume".to_string(), v)?;
+        }
+        check_finite(|| "metrics.distance".to_string(), m.distance)?;
+        check_finite(|| "metrics.bw".to_string(), m.bw)?;
+    }
+    if let Some(f) = &result.forces {
+        f.validate("forces").map_err(JournalError::Invalid)?;
+    }
+    let Ok(id) = db_id(result.trial_id) else {
+        return Ok(ResultOutcome::UnknownTrial);
+    };
+    let existing: Option<(String, u32, Option<u32>)> = tx
+        .query_row(
+            "SELECT state, attempts, result_attempt FROM trials
+             WHERE run_id = ?1 AND trial_id = ?2",
+            params![result.run_id, id],
+            |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)),
+        )
+        .optional()?;
+    let Some((state, attempts, result_attempt)) = existing else {
+        return Ok(ResultOutcome::UnknownTrial);
+    };
+    let outcome = match parse_state(&state)? {
+        TrialState::Completed | TrialState::Failed => {
+            let note = match result_attempt {
+                Some(a) => format!("trial already completed by attempt {a}"),
+                None => "trial already failed".to_string(),
+            };
+            insert_event(
+                tx,
+                &result.run_id,
+                id,
+                result.attempt,
+                event_kind::DUPLICATE,
+                &result.worker,
+                result.at_ms,
+                Some(&note),
+            )?;
+            ResultOutcome::Duplicate
+        }
+        TrialState::Running => {
+            let note = if result.attempt < attempts {
+                Some(format!(
+                    "late result from attempt {} (latest attempt {attempts})",
+                    result.attempt
+                ))
+            } else if result.attempt > attempts {
+                Some(format!(
+                    "result from attempt {} which was never issued (latest attempt {attempts})",
+                    result.attempt
+                ))
+            } else {
+                None
+            };
+            let m = result.metrics.as_ref();
+            let forces_json = match &result.forces {
+                Some(f) => Some(serde_json::to_string(f)?),
+                None => None,
+            };
+            tx.execute(
+                "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
+                     result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
+                     epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
+                     fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16,
+                     forces_json = ?17
+                 WHERE run_id = ?1 AND trial_id = ?2",
+                params![
+                    result.run_id,
+                    id,
+                    result.worker,
+                    result.at_ms,
+                    result.attempt,
+                    result.score,
+                    m.map(|m| m.rank),
+                    m.map(|m| m.force_closure),
+                    m.map(|m| m.epsilon),
+                    m.and_then(|m| m.volume),
+                    m.map(|m| m.distance),
+                    m.map(|m| m.bw),
+                    result.contacts,
+                    result.fingers_in_contact,
+                    result.cloud_points,
+                    result.details_json,
+                    forces_json,
+                ],
+            )?;
+            insert_event(
+                tx,
+                &result.run_id,
+                id,
+                result.attempt,
+                event_kind::RESULT,
+                &result.worker,
+                result.at_ms,
+                note.as_deref(),
+            )?;
+            ResultOutcome::Accepted
+        }
+    };
+    Ok(outcome)
+}
+
+pub(crate) fn failure_in(
+    tx: &Connection,
+    run_id: &str,
+    trial_id: u64,
+    attempt: u32,
+    message: &str,
+    at_ms: i64,
+) -> Result<bool> {
+    let Ok(id) = db_id(trial_id) else {
+        return Ok(false);
+    };
+    let existing: Option<(String, String)> = tx
+        .query_row(
+            "SELECT state, worker FROM trials WHERE run_id = ?1 AND trial_id = ?2",
+            params![run_id, id],
+            |r| Ok((r.get(0)?, r.get(1)?)),
+        )
+        .optional()?;
+    let Some((state, worker)) = existing else {
+        return Ok(false);
+    };
+    if parse_state(&state)? != TrialState::Running {
+        return Ok(false);
+    }
+    tx.execute(
+        "UPDATE trials SET state = 'failed', error = ?3 WHERE run_id = ?1 AND trial_id = ?2",
+        params![run_id, id, message],
+    )?;
+    insert_event(
+        tx,
+        run_id,
+        id,
+        attempt,
+        event_kind::FAILED,
+        &worker,
+        at_ms,
+        Some(message),
+    )?;
+    Ok(true)
 }
 
 fn db_id(trial_id: u64) -> Result<i64> {

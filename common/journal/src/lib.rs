@@ -14,6 +14,7 @@
 //! starts no thread: one owner (a thread, a task or a mutex) calls it; a
 //! [`Journal`] is `Send`, not `Sync`.
 
+pub mod batch;
 mod error;
 pub mod export;
 mod journal;
@@ -22,6 +23,7 @@ mod rows;
 mod schema;
 mod types;
 
+pub use batch::{Write, Written};
 pub use error::{JournalError, Result};
 pub use journal::Journal;
 pub use schema::SCHEMA_VERSION;

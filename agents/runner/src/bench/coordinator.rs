@@ -7,8 +7,10 @@
 //!
 //! - [`BenchPath::Core`]: the coordinator's I/O-free core ([`Coordinator`]) driven directly,
 //!   its journal writes carried out by [`graspopt_coordinator::record`] as the loop does.
-//!   One thread: a command is answered by its result as soon as the workers before it in
-//!   line have answered (first in, first out), and a question to the planner at once. The
+//!   One thread: every command is answered by its result at once, the results arriving
+//!   together as they do from workers that answer at once (the loop takes them as one
+//!   event), and a question to the planner is answered at once. Each event's journal
+//!   writes are one transaction, as in the loop ([`graspopt_coordinator::split_writes`]). The
 //!   lease and status timers run as in the loop. This is the ceiling of the core and the
 //!   journal; the time inside journal calls is measured.
 //! - [`BenchPath::Bus`]: the real coordinator loop ([`graspopt_coordinator::run`]) on an
@@ -79,6 +81,8 @@ pub struct CoordinatorRow {
     pub p99_ms: f64,
     /// Share of the run's time spent in journal writes (`None`: not measured).
     pub journal_share: Option<f64>,
+    /// Journal transactions per trial (`None`: not measured). One per write would be two.
+    pub commits_per_trial: Option<f64>,
 }
 
 impl CoordinatorRow {
@@ -241,6 +245,7 @@ fn check_journal(journal: &Journal, run: &RunId, trials: u64) -> Result<u64> {
 #[derive(Default)]
 struct CoreClock {
     journal: Duration,
+    commits: u64,
     first_issue: Option<Instant>,
     last_result: Option<Instant>,
     issued: HashMap<(u64, u32), Instant>,
@@ -268,10 +273,16 @@ pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRo
     let (mut status_at, mut lease_at) = (Instant::now(), Instant::now());
     while !core.finished() {
         let mut actions = core.poll(now_ms())?;
-        if let Some(command) = line.pop_front() {
-            actions.extend(core.on_result(&answer(&command), now_ms()));
-        } else if actions.is_empty() {
+        if line.is_empty() && actions.is_empty() {
             bail!("the coordinator stalled: nothing running, nothing to issue");
+        }
+        // Every worker answers at once: the results arrive together, as the loop takes
+        // them (one event, then the issues of the freed workers' next trials).
+        if !line.is_empty() {
+            for command in line.drain(..) {
+                actions.extend(core.on_result(&answer(&command), now_ms()));
+            }
+            actions.extend(core.poll(now_ms())?);
         }
         if status_at.elapsed() >= status_period {
             status_at = Instant::now();
@@ -304,6 +315,7 @@ pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRo
         median_ms,
         p99_ms,
         journal_share: Some(clock.journal.as_secs_f64() / seconds),
+        commits_per_trial: Some(clock.commits as f64 / trials as f64),
     })
 }
 
@@ -317,38 +329,40 @@ fn carry_out(
     line: &mut VecDeque<TrialCommand>,
     clock: &mut CoreClock,
 ) -> Result<()> {
-    let mut todo = VecDeque::from(actions);
-    while let Some(action) = todo.pop_front() {
-        match action {
-            Action::Record(write) => {
-                let start = Instant::now();
-                let key = match &write {
-                    Write::Issue(i) => Some((true, i.trial_id, i.attempt)),
-                    Write::Result(r) => Some((false, r.trial_id, r.attempt)),
-                    _ => None,
-                };
-                graspopt_coordinator::record(journal, run, write)?;
-                let end = Instant::now();
-                clock.journal += end - start;
-                match key {
-                    Some((true, trial, attempt)) => {
-                        clock.first_issue.get_or_insert(start);
-                        clock.issued.insert((trial, attempt), start);
-                    }
-                    Some((false, trial, attempt)) => {
-                        clock.last_result = Some(end);
-                        if let Some(t) = clock.issued.remove(&(trial, attempt)) {
-                            clock.latency_ms.push((end - t).as_secs_f64() * 1e3);
-                        }
-                    }
-                    None => {}
+    let mut todo = actions;
+    while !todo.is_empty() {
+        // As the loop: the writes of one event in one transaction, then the rest.
+        let (writes, rest) = graspopt_coordinator::split_writes(std::mem::take(&mut todo));
+        let start = Instant::now();
+        graspopt_coordinator::record(journal, run, &writes)?;
+        let end = Instant::now();
+        clock.journal += end - start;
+        clock.commits += u64::from(!writes.is_empty());
+        for write in &writes {
+            match write {
+                Write::Issue(i) => {
+                    clock.first_issue.get_or_insert(start);
+                    clock.issued.insert((i.trial_id, i.attempt), start);
                 }
+                Write::Result(r) => {
+                    clock.last_result = Some(end);
+                    if let Some(t) = clock.issued.remove(&(r.trial_id, r.attempt)) {
+                        clock.latency_ms.push((end - t).as_secs_f64() * 1e3);
+                    }
+                }
+                _ => {}
             }
-            Action::Send { command, .. } => line.push_back(command),
-            Action::Ask(request) => {
-                todo.extend(core.on_reply(Ok(proposals(&request)), now_ms())?);
+        }
+        for action in rest {
+            match action {
+                Action::Record(_) => {}
+                Action::Send { command, .. } => line.push_back(command),
+                // Answered at once; what the reply leads to is the next event.
+                Action::Ask(request) => {
+                    todo.extend(core.on_reply(Ok(proposals(&request)), now_ms())?);
+                }
+                Action::CancelAsk | Action::Publish(_) | Action::Progress(_) => {}
             }
-            Action::CancelAsk | Action::Publish(_) | Action::Progress(_) => {}
         }
     }
     Ok(())
@@ -459,6 +473,7 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
         median_ms,
         p99_ms,
         journal_share: None,
+        commits_per_trial: None,
     })
 }
 
@@ -472,16 +487,19 @@ impl fmt::Display for CoordinatorReport {
         writeln!(f)?;
         writeln!(
             f,
-            "| path | workers | trials | seconds | trials/s | median trial (ms) | p99 trial (ms) | journal share |"
+            "| path | workers | trials | seconds | trials/s | median trial (ms) | p99 trial (ms) | journal share | commits per trial |"
         )?;
-        writeln!(f, "|---|---|---|---|---|---|---|---|")?;
+        writeln!(f, "|---|---|---|---|---|---|---|---|---|")?;
         for r in &self.rows {
             let share = r
                 .journal_share
                 .map_or("-".to_string(), |s| format!("{:.0}%", s * 100.0));
+            let commits = r
+                .commits_per_trial
+                .map_or("-".to_string(), |c| format!("{c:.3}"));
             writeln!(
                 f,
-                "| {} | {} | {} | {:.2} | {:.0} | {:.3} | {:.3} | {share} |",
+                "| {} | {} | {} | {:.2} | {:.0} | {:.3} | {:.3} | {share} | {commits} |",
                 r.path.as_str(),
                 r.workers,
                 r.trials,
@@ -514,6 +532,26 @@ mod tests {
         }
     }
 
+    /// With many workers the results arrive together and the issues of one planner reply
+    /// go together: far fewer commits than the two writes per trial (each trial's issue
+    /// and result), with every trial still issued and recorded once (checked in the run).
+    #[test]
+    fn the_core_path_commits_what_arrives_together_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let one = core_run(dir.path(), 1, 64)
+            .unwrap()
+            .commits_per_trial
+            .unwrap();
+        let many = core_run(dir.path(), 32, 640)
+            .unwrap()
+            .commits_per_trial
+            .unwrap();
+        // One worker: its result and the next issue (after the planner's answer) are two
+        // events; 32 workers: about two commits per 32 trials.
+        assert!((1.0..=2.0).contains(&one), "{one}");
+        assert!(many < 0.1, "{many} commits per trial with 32 workers");
+    }
+
     #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
     async fn the_bus_path_issues_and_records_every_trial_once() {
         let dir = tempfile::tempdir().unwrap();
@@ -543,6 +581,7 @@ mod tests {
             median_ms: 1.25,
             p99_ms: 3.5,
             journal_share,
+            commits_per_trial: journal_share.map(|_| 0.05),
         };
         let report = CoordinatorReport {
             settings: CoordinatorSettings {
@@ -553,7 +592,7 @@ mod tests {
             rows: vec![row(BenchPath::Core, Some(0.4)), row(BenchPath::Bus, None)],
         };
         let text = report.to_string();
-        assert!(text.contains("| core | 32 | 1000 | 0.50 | 2000 | 1.250 | 3.500 | 40% |"));
-        assert!(text.contains("| bus | 32 | 1000 | 0.50 | 2000 | 1.250 | 3.500 | - |"));
+        assert!(text.contains("| core | 32 | 1000 | 0.50 | 2000 | 1.250 | 3.500 | 40% | 0.050 |"));
+        assert!(text.contains("| bus | 32 | 1000 | 0.50 | 2000 | 1.250 | 3.500 | - | - |"));
     }
 }

@@ -157,6 +157,7 @@ fn parse_csv(text: &str) -> Vec<Vec<String>> {
 // -------------------------------------------------------------------- tests
 
 /// Issue, result, re-issue, failure and reopening: the life of a trial in the journal.
+mod batch;
 mod forces;
 mod lifecycle;
 
