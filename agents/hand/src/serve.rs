@@ -37,7 +37,7 @@ pub async fn serve(
         .await?;
     let commands = bus.subscribe(&COMMAND.worker_key(run.into(), id)).await?;
     let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
-    let sender = CloudSender::open(bus, run);
+    let sender = CloudSender::open(bus, run).await;
     // Declared last: the coordinator sends commands once it sees the token.
     let _token = bus.declare_alive(run, AgentKind::Hand, id).await?;
     let mut inbox = Inbox::new(format!("hand {id}"), run);

@@ -282,7 +282,7 @@ async fn cloud_latency(shm: bool, points: usize, messages: usize) -> Result<(Clo
     let metric_bus = Bus::open(&b).await?;
     let run = RunId::new("bench-clouds")?;
     let mut receiver = CloudReceiver::open(&metric_bus, &run).await?;
-    let sender = CloudSender::open(&hand_bus, &run);
+    let sender = CloudSender::open(&hand_bus, &run).await;
     tokio::time::sleep(Duration::from_millis(500)).await;
     let mut lat = Vec::with_capacity(messages);
     let mut path = CloudPath::Zenoh;

@@ -40,17 +40,27 @@ pub struct CloudSender {
 impl CloudSender {
     /// A sender for the run's clouds. Shared memory is used when available (and not disabled
     /// on the bus); if it cannot be opened, a warning is logged and Zenoh alone is used.
-    pub fn open(bus: &Bus, run: &RunId) -> CloudSender {
-        let shm =
-            bus.shm().and_then(
-                |cfg| match ShmPublisher::open(cfg, &shm_clouds_service(run)) {
-                    Ok(p) => Some(p),
-                    Err(e) => {
-                        tracing::warn!("shared memory unavailable, clouds go over Zenoh: {e}");
-                        None
-                    }
-                },
-            );
+    ///
+    /// Opening the shared-memory publisher blocks (iceoryx2 lists the host's nodes and waits
+    /// for the subscribers' acknowledgements: 45-180 ms measured with thousands of dead
+    /// nodes on the host), so it runs on a blocking thread: 64 hands in one process start
+    /// side by side instead of holding the runtime's worker threads in turn.
+    pub async fn open(bus: &Bus, run: &RunId) -> CloudSender {
+        let opened = match bus.shm().cloned() {
+            Some(cfg) => {
+                let service = shm_clouds_service(run);
+                tokio::task::spawn_blocking(move || ShmPublisher::open(&cfg, &service))
+                    .await
+                    .map_err(|e| e.to_string())
+                    .and_then(|r| r.map_err(|e| e.to_string()))
+                    .map(Some)
+            }
+            None => Ok(None),
+        };
+        let shm = opened.unwrap_or_else(|e| {
+            tracing::warn!("shared memory unavailable, clouds go over Zenoh: {e}");
+            None
+        });
         CloudSender {
             bus: bus.clone(),
             key: CLOUDS.key(run.into()),
