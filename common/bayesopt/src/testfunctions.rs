@@ -270,6 +270,7 @@ impl TestFunction {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     #[test]
     fn known_optima() {
@@ -304,7 +305,7 @@ mod tests {
                 1e-7,
             ),
             (TestFunction::GoldsteinPriceLog, &[0.0, -1.0], 1e-12),
-            (TestFunction::Michalewicz2, &[2.202_906, 1.570_796], 1e-6),
+            (TestFunction::Michalewicz2, &[2.202_906, FRAC_PI_2], 1e-6),
             (TestFunction::Ackley3, &[0.0; 3], 1e-12),
             (TestFunction::Levy4, &[1.0; 4], 1e-12),
             (TestFunction::StyblinskiTang4, &[-2.903_534; 4], 1e-4),
