@@ -35,7 +35,8 @@ pub enum FormatArg {
 /// Arguments of `graspopt optimize-function`.
 #[derive(clap::Args, Debug)]
 pub struct OptimizeFunctionArgs {
-    /// Test function: branin, hartmann3, hartmann6 or rosenbrock.
+    /// Test function: branin, hartmann3, hartmann6, rosenbrock, sixhumpcamel, goldsteinprice
+    /// (log form), michalewicz, ackley, levy or styblinskitang.
     pub function: String,
     /// Number of seeds, 1 to 1000 (seeds 0..N).
     #[arg(long, default_value_t = 10)]
