@@ -134,7 +134,7 @@ pub enum StopReason {
 }
 
 /// The model cap of [`Settings::for_grasps`] (observations).
-pub const GRASP_MODEL_CAP: usize = 100;
+pub const GRASP_MODEL_CAP: usize = 150;
 
 /// Smallest [`ModelCap::size`].
 pub const MIN_MODEL_CAP: usize = 8;
