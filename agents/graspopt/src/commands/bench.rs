@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
-use graspopt_planner::bench::{PlannerBenchSettings, planner_bench};
+use graspopt_planner::bench::{MAX_BENCH_POINTS, PlannerBenchSettings, planner_bench};
 use graspopt_protocol::PlannerMethod;
 use graspopt_runner::bench::coordinator::{BenchPath, CoordinatorSettings};
 use graspopt_runner::bench::{self, PipelineSettings};
@@ -142,9 +142,22 @@ fn validate(what: &What) -> Result<()> {
                 bail!("--trial-cost-ms must be at most 60000 (one minute), got {trial_cost_ms}");
             }
         }
-        What::Planner { dims, .. } => {
+        What::Planner {
+            observations,
+            pending,
+            rounds,
+            dims,
+        } => {
             if dims.is_empty() || dims.iter().any(|d| *d != 2 && *d != 6) {
                 bail!("--dims: give 2, 6 or 2,6");
+            }
+            for (flag, v) in [("--observations", observations), ("--pending", pending)] {
+                if !(1..=MAX_BENCH_POINTS).contains(v) {
+                    bail!("{flag} must be between 1 and {MAX_BENCH_POINTS}, got {v}");
+                }
+            }
+            if !(1..=1000).contains(rounds) {
+                bail!("--rounds must be between 1 and 1000, got {rounds}");
             }
         }
         What::Clouds { points, messages } => {
