@@ -48,7 +48,7 @@ struct SavedEngine<E> {
 /// `RandomSearch` or their settings change shape (the test
 /// `the_saved_engine_layout_is_pinned` fails until then): bincode reads fields by position,
 /// so a state of another layout would be misread rather than refused.
-pub(crate) const STATE_FORMAT: u32 = 1;
+pub(crate) const STATE_FORMAT: u32 = 2;
 
 /// Starts every `engine_state`, then an FNV-1a checksum of the rest (8 bytes, little
 /// endian), then the bincode of a [`SavedEngine`]. A state of another format or graspopt

@@ -32,8 +32,8 @@ pub use fit::{FitSettings, Hyperparameters};
 pub use gp::Gp;
 pub use kernel::{Kernel, KernelKind};
 pub use optimizer::{
-    BatchStrategy, InitialDesign, MAX_QEI_SAMPLES, ModelPoint, Optimizer, OutputTransform,
-    RestartRule, RoundInfo, Settings, StopReason, StopRule,
+    BatchStrategy, GRASP_MODEL_CAP, InitialDesign, MAX_QEI_SAMPLES, MIN_MODEL_CAP, ModelCap,
+    ModelPoint, Optimizer, OutputTransform, RestartRule, RoundInfo, Settings, StopReason, StopRule,
 };
 pub use preset::{Method, Preset};
 pub use testfunctions::TestFunction;

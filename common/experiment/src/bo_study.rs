@@ -8,7 +8,7 @@
 //!   the seeds against the grid maximum;
 //! - 6D ([`BoStudy::six_d`]): BO and random search in the pose space (no grid).
 
-use graspopt_bayesopt::{Method, Preset, Settings};
+use graspopt_bayesopt::{MIN_MODEL_CAP, Method, ModelCap, Preset, Settings};
 use graspopt_sim::{ContactModel, ParamKind};
 use graspopt_trial::Evaluator;
 use graspopt_trial::scan::ScanPoint;
@@ -44,6 +44,8 @@ pub const ONE_D_BUDGET: usize = 40;
 pub const MAX_SEEDS: u64 = 1000;
 pub const MAX_BUDGET: usize = 2000;
 pub const MAX_STEPS: usize = 1000;
+/// The most trials in flight of one run.
+pub const MAX_WORKERS: usize = 256;
 
 /// The parameters of the 2D part: approach x vertical.
 pub const TWO_D: [ParamKind; 2] = [ParamKind::Approach, ParamKind::Vertical];
@@ -93,9 +95,26 @@ pub struct BoRequest {
     pub objects: Vec<String>,
     pub parts: Vec<Part>,
     pub engine: Preset,
+    /// The engine's model cap: the preset's, or another ([`ModelCapChoice`]).
+    pub model_cap: ModelCapChoice,
+    /// Trials in flight in the 2D and 6D runs (1: sequential; see
+    /// [`SearchSettings::workers`]).
+    pub workers: usize,
     pub contacts: ContactModel,
     /// Worker threads (0: all cores).
     pub threads: usize,
+}
+
+/// The model cap of the study's engine ([`Settings::model_cap`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum ModelCapChoice {
+    /// The preset's.
+    #[default]
+    Preset,
+    /// None: every observation modelled (the exact GP).
+    Exact,
+    /// A cap of this many observations, with the default shares ([`ModelCap::of`]).
+    Size(usize),
 }
 
 /// The checked plan of the study.
@@ -103,6 +122,8 @@ pub struct BoRequest {
 pub struct BoStudy {
     pub hand: String,
     pub engine: Preset,
+    pub model_cap: ModelCapChoice,
+    pub workers: usize,
     pub contacts: ContactModel,
     pub parts: Vec<Part>,
     /// The 2D grid, approach x vertical.
@@ -177,6 +198,19 @@ impl BoStudy {
         let Some(end) = r.first_seed.checked_add(r.seeds) else {
             return settings_error("--first-seed + --seeds must stay below 2^64".into());
         };
+        if !(1..=MAX_WORKERS).contains(&r.workers) {
+            return settings_error(format!(
+                "--workers must be between 1 and {MAX_WORKERS}, got {}",
+                r.workers
+            ));
+        }
+        if let ModelCapChoice::Size(n) = r.model_cap
+            && n < MIN_MODEL_CAP
+        {
+            return settings_error(format!(
+                "--model-cap must be at least {MIN_MODEL_CAP} observations, got {n}"
+            ));
+        }
         let steps: Vec<usize> = r
             .steps
             .split(',')
@@ -237,6 +271,8 @@ impl BoStudy {
         Ok(BoStudy {
             hand: r.hand.clone(),
             engine: r.engine,
+            model_cap: r.model_cap,
+            workers: r.workers,
             contacts: r.contacts,
             parts: r.parts.clone(),
             steps: [nx, ny],
@@ -249,6 +285,17 @@ impl BoStudy {
     }
 
     /// Whether the plan runs `part`.
+    /// The engine's settings: the preset's, with the model cap of [`BoStudy::model_cap`].
+    pub fn engine_settings(&self) -> Settings {
+        let mut s = self.engine.settings();
+        match self.model_cap {
+            ModelCapChoice::Preset => {}
+            ModelCapChoice::Exact => s.model_cap = None,
+            ModelCapChoice::Size(n) => s.model_cap = Some(ModelCap::of(n)),
+        }
+        s
+    }
+
     pub fn runs(&self, part: Part) -> bool {
         self.parts.contains(&part)
     }
@@ -270,7 +317,7 @@ impl BoStudy {
             budget: ONE_D_BUDGET,
             n_init: Some(2),
             stop_on_small_ei: true,
-            engine: Some(self.engine.settings()),
+            engine: Some(self.engine_settings()),
             workers: 1,
         };
         let first = self.seeds.first().copied().unwrap_or_default();
@@ -294,8 +341,8 @@ impl BoStudy {
             budget,
             n_init: None,
             stop_on_small_ei: false,
-            engine: Some(self.engine.settings()),
-            workers: 1,
+            engine: Some(self.engine_settings()),
+            workers: self.workers,
         };
         compare(
             ev,
@@ -398,9 +445,34 @@ mod tests {
             objects: vec!["sphere".into(), " mug".into(), "sphere".into()],
             parts: vec![Part::TwoD, Part::SixD],
             engine: Preset::Grasp,
+            model_cap: ModelCapChoice::Preset,
+            workers: 1,
             contacts: ContactModel::MeanPoint,
             threads: 1,
         }
+    }
+
+    #[test]
+    fn the_model_cap_choice_sets_the_engines_cap() {
+        let plan = |model_cap| {
+            BoStudy::plan(&BoRequest {
+                model_cap,
+                ..request()
+            })
+            .unwrap()
+            .engine_settings()
+        };
+        assert_eq!(plan(ModelCapChoice::Preset), Preset::Grasp.settings());
+        assert_eq!(plan(ModelCapChoice::Exact).model_cap, None);
+        assert_eq!(
+            plan(ModelCapChoice::Size(30)).model_cap,
+            Some(ModelCap::of(30))
+        );
+        assert_ne!(
+            Preset::Grasp.settings().model_cap,
+            Some(ModelCap::of(30)),
+            "the test needs a cap other than the preset's"
+        );
     }
 
     #[test]
@@ -444,6 +516,20 @@ mod tests {
                 ..request()
             }),
             "--first-seed + --seeds must stay below 2^64"
+        );
+        assert_eq!(
+            msg(BoRequest {
+                workers: 0,
+                ..request()
+            }),
+            "--workers must be between 1 and 256, got 0"
+        );
+        assert_eq!(
+            msg(BoRequest {
+                model_cap: ModelCapChoice::Size(7),
+                ..request()
+            }),
+            "--model-cap must be at least 8 observations, got 7"
         );
         let budget = msg(BoRequest {
             budget: 5,

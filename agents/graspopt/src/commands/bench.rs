@@ -1,9 +1,11 @@
-//! `graspopt bench`: figures of the distributed pipeline ([`graspopt_runner::bench`]).
+//! `graspopt bench`: figures of the distributed pipeline ([`graspopt_runner::bench`]) and of
+//! the planner ([`graspopt_planner::bench`]).
 
 use std::process::ExitCode;
 
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
+use graspopt_planner::bench::{MAX_BENCH_POINTS, PlannerBenchSettings, planner_bench};
 use graspopt_protocol::PlannerMethod;
 use graspopt_runner::bench::coordinator::{BenchPath, CoordinatorSettings};
 use graspopt_runner::bench::{self, PipelineSettings};
@@ -61,6 +63,22 @@ pub enum What {
         /// an in-process Zenoh bus), or both.
         #[arg(long, default_value = "core,bus", value_delimiter = ',', value_parser = bench_path())]
         paths: Vec<BenchPath>,
+    },
+    /// The planner's proposal round at many observations, through the planner agent's
+    /// engine path (engine grasp) in this thread: pin it to one core with `taskset -c 0`.
+    Planner {
+        /// Observations at the first timed round (1 to 100000).
+        #[arg(long, default_value_t = 2000)]
+        observations: usize,
+        /// Points pending in each round, and proposals per round (1 to 100000).
+        #[arg(long, default_value_t = 32)]
+        pending: usize,
+        /// Timed rounds per dimension (1 to 1000).
+        #[arg(long, default_value_t = 9)]
+        rounds: usize,
+        /// Dimensions: 2 (Branin), 6 (Hartmann6) or both.
+        #[arg(long, default_value = "2,6", value_delimiter = ',')]
+        dims: Vec<usize>,
     },
     /// Contact-cloud latency, shared memory versus Zenoh.
     Clouds {
@@ -124,6 +142,24 @@ fn validate(what: &What) -> Result<()> {
                 bail!("--trial-cost-ms must be at most 60000 (one minute), got {trial_cost_ms}");
             }
         }
+        What::Planner {
+            observations,
+            pending,
+            rounds,
+            dims,
+        } => {
+            if dims.is_empty() || dims.iter().any(|d| *d != 2 && *d != 6) {
+                bail!("--dims: give 2, 6 or 2,6");
+            }
+            for (flag, v) in [("--observations", observations), ("--pending", pending)] {
+                if !(1..=MAX_BENCH_POINTS).contains(v) {
+                    bail!("{flag} must be between 1 and {MAX_BENCH_POINTS}, got {v}");
+                }
+            }
+            if !(1..=1000).contains(rounds) {
+                bail!("--rounds must be between 1 and 1000, got {rounds}");
+            }
+        }
         What::Clouds { points, messages } => {
             if *points > MAX_POINTS {
                 bail!("--points must be at most {MAX_POINTS}, got {points}");
@@ -148,6 +184,24 @@ fn check_workers(workers: &[usize]) -> Result<()> {
 
 pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     validate(&args.what)?;
+    if let What::Planner {
+        observations,
+        pending,
+        rounds,
+        dims,
+    } = &args.what
+    {
+        // No async runtime: the rounds run in this thread alone.
+        let settings = PlannerBenchSettings {
+            dims: dims.clone(),
+            observations: *observations,
+            pending: *pending,
+            rounds: *rounds,
+            ..PlannerBenchSettings::default()
+        };
+        outln!("{}", planner_bench(&settings)?.to_string().trim_end())?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let runtime = tokio::runtime::Runtime::new()?;
     match &args.what {
         What::Pipeline {
@@ -190,6 +244,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                     .trim_end()
             )?;
         }
+        What::Planner { .. } => {}
         What::Clouds { points, messages } => {
             outln!(
                 "{}",

@@ -303,6 +303,41 @@ fn bench_validates_every_argument_before_running() {
 }
 
 #[test]
+fn bench_planner_validates_its_arguments_and_prints_one_row_per_dimension() {
+    refused(&["bench", "planner", "--dims", "3"], &["--dims"]);
+    refused(
+        &["bench", "planner", "--pending", "0"],
+        &["--pending", "got 0"],
+    );
+    refused(
+        &["bench", "planner", "--rounds", "0"],
+        &["--rounds", "got 0"],
+    );
+    // Past the engine's model cap (150), small enough to be quick.
+    let out = graspopt(&[
+        "bench",
+        "planner",
+        "--observations",
+        "200",
+        "--pending",
+        "4",
+        "--rounds",
+        "2",
+        "--dims",
+        "2",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<&str> = stdout.lines().filter(|l| l.starts_with("| 2 |")).collect();
+    assert_eq!(rows.len(), 1, "{stdout}");
+    assert!(rows[0].starts_with("| 2 | branin | 200-204 |"), "{stdout}");
+}
+
+#[test]
 fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
     refused(
         &["bench", "coordinator", "--trials", "0"],

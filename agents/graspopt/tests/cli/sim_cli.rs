@@ -295,6 +295,37 @@ fn experiment_bo_writes_the_figures_tables_and_per_seed_counts() {
     assert!(rows[2][3].parse::<f64>().unwrap() > 0.0, "{samples}");
 }
 
+/// `--model-cap` and `--workers` run, and the report's command line names them.
+#[test]
+fn experiment_bo_with_a_model_cap_and_workers_names_them_in_its_report() {
+    let dir = tempdir("experiment-bo-cap");
+    let (report, _) = experiment_report(
+        &dir,
+        &[
+            "bo",
+            "--seeds",
+            "1",
+            "--budget",
+            "14",
+            "--steps",
+            "3",
+            "--objects",
+            "sphere",
+            "--parts",
+            "2d",
+            "--model-cap",
+            "8",
+            "--workers",
+            "2",
+        ],
+        &["Table 4.1"],
+    );
+    assert!(
+        report.contains("--engine grasp --model-cap 8 --workers 2`"),
+        "{report}"
+    );
+}
+
 #[test]
 fn experiment_bo_bad_input_is_named() {
     let dir = tempdir("experiment-bo-bad");
@@ -332,6 +363,14 @@ fn experiment_bo_bad_input_is_named() {
         (
             vec!["--parts", "6d", "--budget-6d", "10"],
             "--budget-6d must be more than the engine's 10 initial-design trials in 6D",
+        ),
+        (
+            vec!["--model-cap", "7"],
+            "--model-cap must be at least 8 observations, got 7",
+        ),
+        (
+            vec!["--workers", "0"],
+            "--workers must be between 1 and 256, got 0",
         ),
     ] {
         let mut all = vec!["experiment", "bo", "--out", dir.to_str().unwrap()];

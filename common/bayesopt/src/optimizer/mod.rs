@@ -10,6 +10,22 @@
 //! constant liar or sequential-greedy qEI ([`crate::qei`]). The whole state serialises with
 //! serde, including the generator state, so a restored optimizer proposes exactly what the
 //! original would have (serde_json needs its `float_roundtrip` feature for bit-exact floats).
+//!
+//! **Large-n mode** ([`Settings::model_cap`], on in [`Settings::for_grasps`] at
+//! [`GRASP_MODEL_CAP`] observations). The exact GP costs O(n^3) per fit evaluation and
+//! O(n^2) per prediction: a round of 32 proposals at 2,000 observations would take tens of
+//! seconds. Past the cap, a round models a subset of the epoch's observations: the
+//! incumbent's nearest neighbours (the local model a trust region would give), the best of
+//! the others by value (other basins), and a greedy farthest-point spread of the rest (so EI
+//! far from the incumbent still sees where the search has been). The hyperparameters are
+//! then only warm-started from the last fit (no restarts). A point proposed while others
+//! are pending or already proposed in the round (the kriging believer's batch path, one
+//! rank-one extension of the Cholesky factor per point) gets a smaller DIRECT budget
+//! ([`ModelCap::batch_evals_per_dim`]) and one polish start. Measured (docs/benchmarks.md,
+//! "Planner at thousands of observations"): with the cap the planner's round of 32 at
+//! 2,000 observations fits in the 250 ms of issue 19 on one core in 2D and 6D, and with the
+//! cap forced down to 30 observations the simulator objects are reached in as few trials
+//! as with the exact model; what was tried and dropped is listed there.
 
 use std::collections::HashMap;
 
@@ -44,7 +60,10 @@ const QEI_POLISH_ITERS: usize = 10;
 /// Most base samples a [`BatchStrategy::Qei`] may ask for (the cost of a point grows with them).
 pub const MAX_QEI_SAMPLES: usize = 65_536;
 
-pub use settings::{BatchStrategy, InitialDesign, RestartRule, Settings, StopReason, StopRule};
+pub use settings::{
+    BatchStrategy, GRASP_MODEL_CAP, InitialDesign, MIN_MODEL_CAP, ModelCap, RestartRule, Settings,
+    StopReason, StopRule,
+};
 
 /// The model at one point: see [`Optimizer::model_at`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -105,6 +124,7 @@ pub struct Optimizer {
     design_next: usize,
 }
 
+#[derive(Clone)]
 struct Standardised {
     x: Vec<Vec<f64>>,
     y: Vec<f64>,
@@ -513,9 +533,99 @@ impl Optimizer {
         }
     }
 
-    /// Refit the hyperparameters (MAP, warm-started) and build the GP on the observations.
+    /// The observations the model of a round conditions on: `data` itself, or with a
+    /// [`Settings::model_cap`] that `data` exceeds, the subset that [`ModelCap`] describes
+    /// (in the order observed). Deterministic: it draws nothing.
+    fn model_data<'a>(&self, data: &'a Standardised) -> std::borrow::Cow<'a, Standardised> {
+        use std::borrow::Cow;
+        let n = data.y.len();
+        let Some(cap) = self.settings.model_cap.filter(|c| n > c.size) else {
+            return Cow::Borrowed(data);
+        };
+        let d = self.dim();
+        let inv_ls: Vec<f64> = match &self.hyper {
+            Some(h) if h.length_scales.len() == d => {
+                h.length_scales.iter().map(|l| 1.0 / l).collect()
+            }
+            _ => vec![1.0; d],
+        };
+        let dist2 = |a: &[f64], b: &[f64]| -> f64 {
+            a.iter()
+                .zip(b)
+                .zip(&inv_ls)
+                .map(|((p, q), w)| (p - q) * (p - q) * w * w)
+                .sum()
+        };
+        let Some(top) = (0..n).max_by(|&a, &b| data.y[a].total_cmp(&data.y[b]).then(b.cmp(&a)))
+        else {
+            return Cow::Borrowed(data);
+        };
+        let share = |f: f64| (cap.size as f64 * f).round() as usize;
+        let n_near = share(cap.near).clamp(1, cap.size);
+        let n_best = share(cap.best).min(cap.size - n_near);
+        let mut chosen = vec![false; n];
+        let mut near: Vec<(f64, usize)> = (0..n)
+            .map(|i| (dist2(&data.x[i], &data.x[top]), i))
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for &(_, i) in near.iter().take(n_near) {
+            chosen[i] = true;
+        }
+        let mut rest: Vec<usize> = (0..n).filter(|&i| !chosen[i]).collect();
+        rest.sort_by(|&a, &b| data.y[b].total_cmp(&data.y[a]).then(a.cmp(&b)));
+        for &i in rest.iter().take(n_best) {
+            chosen[i] = true;
+        }
+        // Greedy farthest point: each next point is the one farthest from all chosen.
+        let picked: Vec<usize> = (0..n).filter(|&i| chosen[i]).collect();
+        let mut gap: Vec<f64> = (0..n)
+            .map(|i| {
+                if chosen[i] {
+                    f64::NEG_INFINITY
+                } else {
+                    picked
+                        .iter()
+                        .map(|&j| dist2(&data.x[i], &data.x[j]))
+                        .fold(f64::INFINITY, f64::min)
+                }
+            })
+            .collect();
+        for _ in n_near + n_best..cap.size {
+            let Some(far) = (0..n)
+                .filter(|&i| !chosen[i])
+                .max_by(|&a, &b| gap[a].total_cmp(&gap[b]).then(b.cmp(&a)))
+            else {
+                break;
+            };
+            chosen[far] = true;
+            gap[far] = f64::NEG_INFINITY;
+            for i in 0..n {
+                if !chosen[i] {
+                    gap[i] = gap[i].min(dist2(&data.x[i], &data.x[far]));
+                }
+            }
+        }
+        let keep: Vec<usize> = (0..n).filter(|&i| chosen[i]).collect();
+        Cow::Owned(Standardised {
+            x: keep.iter().map(|&i| data.x[i].clone()).collect(),
+            y: keep.iter().map(|&i| data.y[i]).collect(),
+            mean: data.mean,
+            std: data.std,
+            warp: data.warp.clone(),
+        })
+    }
+
+    /// Refit the hyperparameters (MAP, warm-started) and build the GP on the observations
+    /// (on [`Optimizer::model_data`]'s subset when capped: then warm-started only, once a
+    /// fit exists).
     fn fit_model(&mut self, data: &Standardised, full: bool) -> Result<Gp> {
-        let restarts = if full || self.hyper.is_none() {
+        let capped = self
+            .settings
+            .model_cap
+            .is_some_and(|c| data.y.len() > c.size);
+        let model = self.model_data(data);
+        let data: &Standardised = &model;
+        let restarts = if (full && !capped) || self.hyper.is_none() {
             self.settings.fit.restarts
         } else {
             0
@@ -555,7 +665,8 @@ impl Optimizer {
         if self.xs.is_empty() {
             return Err(BoError::NotEnoughData("no observation yet".into()));
         }
-        let mut data = self.standardised();
+        let full = self.standardised();
+        let mut data = self.model_data(&full).into_owned();
         let h = self.hyper.clone().unwrap_or_else(|| {
             Hyperparameters::from_theta(&self.settings.fit.prior_mean(self.dim()))
         });

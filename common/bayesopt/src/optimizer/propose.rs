@@ -179,6 +179,7 @@ impl Optimizer {
             y_range: y_max - y_min,
             taken: data.x.clone(),
             chosen: Vec::new(),
+            capped: self.settings.model_cap.filter(|c| data.y.len() > c.size),
             qei: match self.settings.batch {
                 BatchStrategy::Qei { samples } => Some(samples.max(1)),
                 _ => None,
@@ -231,7 +232,19 @@ impl Optimizer {
                 // nothing pending is diversified.
                 let alone = round.qei.is_none() || (q == 1 && self.pending.is_empty());
                 let (gp, incumbent, xi) = (&round.gp, round.incumbent, round.xi);
-                self.ei_point(gp, incumbent, xi, round.y_min, alone && first)
+                // The large-n mode's batch path: a point conditioned on others (pending, or
+                // earlier in the round) gets the cap's smaller effort.
+                let effort = match round.capped {
+                    Some(cap) if !first || !self.pending.is_empty() => Effort {
+                        evals_per_dim: cap.batch_evals_per_dim,
+                        polish_starts: self.settings.polish_starts.min(1),
+                    },
+                    _ => Effort {
+                        evals_per_dim: self.settings.direct_evals_per_dim,
+                        polish_starts: self.settings.polish_starts,
+                    },
+                };
+                self.ei_point(gp, incumbent, xi, round.y_min, alone && first, effort)
             }
         }
     }
@@ -276,6 +289,7 @@ impl Optimizer {
         xi: f64,
         y_min: f64,
         first: bool,
+        effort: Effort,
     ) -> Result<(Vec<f64>, f64)> {
         let k = self.settings.diversify_every;
         let diversify = k > 0 && first && self.rounds % k == k - 1;
@@ -289,7 +303,7 @@ impl Optimizer {
         // one, whose GP only has fantasy points appended (see `RowMemo`).
         let mut memo = diversify.then(RowMemo::default);
         let (mut u, mut ei) =
-            self.maximize_acquisition(gp, incumbent, xi, share, None, memo.as_mut())?;
+            self.maximize_acquisition(gp, incumbent, xi, (share, effort), None, memo.as_mut())?;
         if diversify {
             let mut g2 = gp.clone();
             for step in 0..depth {
@@ -300,7 +314,7 @@ impl Optimizer {
                     &g2,
                     incumbent,
                     xi,
-                    share,
+                    (share, effort),
                     previous.as_ref(),
                     memo.as_mut(),
                 )?;
@@ -434,7 +448,7 @@ impl Optimizer {
         gp: &Gp,
         incumbent: f64,
         xi: f64,
-        budget_share: f64,
+        (budget_share, effort): (f64, Effort),
         reuse: Option<&RowMemo>,
         mut record: Option<&mut RowMemo>,
     ) -> Result<(Vec<f64>, f64)> {
@@ -464,13 +478,18 @@ impl Optimizer {
             a + self.tabu_penalty(u, None)
         };
         let ds = DirectSettings {
-            max_evals: ((self.settings.direct_evals_per_dim * d) as f64 * budget_share)
-                .max(2.0 * d as f64 + 1.0) as usize,
+            max_evals: ((effort.evals_per_dim * d) as f64 * budget_share).max(2.0 * d as f64 + 1.0)
+                as usize,
             ..DirectSettings::default()
         };
-        let res = direct::maximize(value, &lo, &hi, &ds, self.settings.polish_starts.max(1))?;
-        let (best_u, best_v) =
-            self.polish_acquisition(gp, &res.top, incumbent, xi, (res.x, res.value));
+        let res = direct::maximize(value, &lo, &hi, &ds, effort.polish_starts.max(1))?;
+        let (best_u, best_v) = self.polish_acquisition(
+            gp,
+            &res.top[..res.top.len().min(effort.polish_starts)],
+            incumbent,
+            xi,
+            (res.x, res.value),
+        );
         let (m, var) = gp.predict(&best_u);
         let ei = match acq {
             AcquisitionKind::ExpectedImprovement => {
@@ -561,6 +580,14 @@ pub(super) fn predict_with_memo(
     mv
 }
 
+/// The work spent maximising one point's acquisition: DIRECT evaluations per dimension and
+/// polish starts.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Effort {
+    evals_per_dim: usize,
+    polish_starts: usize,
+}
+
 /// One model-based round of [`Optimizer::suggest`] (standardised outputs, unit cube).
 pub(super) struct Round {
     /// The model, with the lies of the points entered so far (not with qEI).
@@ -577,6 +604,8 @@ pub(super) struct Round {
     chosen: Vec<Vec<f64>>,
     /// With qEI: its number of base samples.
     qei: Option<usize>,
+    /// The model cap, when this round's model is capped (the large-n mode).
+    capped: Option<ModelCap>,
     qei_rng: Rng,
 }
 

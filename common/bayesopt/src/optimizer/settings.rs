@@ -89,6 +89,41 @@ pub struct RestartRule {
     pub tabu_radius: f64,
 }
 
+/// The large-n mode ([`Settings::model_cap`]): once the epoch holds more than `size`
+/// observations, the model of a round is built on `size` of them: the incumbent's nearest
+/// neighbours (distance scaled by the last fit's length scales), then the best of the rest by
+/// value (other good basins), then a space-filling spread of the rest (greedy farthest
+/// point), in the shares below. The choice is deterministic (no random draws), so a capped
+/// engine restored from its state proposes what the original would have.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ModelCap {
+    /// Observations modelled (>= 8).
+    pub size: usize,
+    /// Share of `size` given to the incumbent's nearest neighbours (0 to 1).
+    pub near: f64,
+    /// Share given to the best of the others by value (0 to 1, `near + best <= 1`); the
+    /// rest is spread.
+    pub best: f64,
+    /// The batch path of a capped round (kriging believer and constant liars): a point
+    /// proposed while others are pending or already proposed in the round gets a DIRECT
+    /// budget of this many evaluations per dimension (>= 1) and one polish start, instead of
+    /// [`Settings::direct_evals_per_dim`] and [`Settings::polish_starts`].
+    pub batch_evals_per_dim: usize,
+}
+
+impl ModelCap {
+    /// A cap of `size` observations with the shares measured for the planner: half nearest
+    /// neighbours, a quarter best values, a quarter spread.
+    pub fn of(size: usize) -> Self {
+        ModelCap {
+            size,
+            near: 0.5,
+            best: 0.25,
+            batch_evals_per_dim: 40,
+        }
+    }
+}
+
 /// Why the optimizer says to stop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum StopReason {
@@ -97,6 +132,12 @@ pub enum StopReason {
     /// The best EI stayed below the threshold for `patience` rounds after `min_evals`.
     SmallExpectedImprovement,
 }
+
+/// The model cap of [`Settings::for_grasps`] (observations).
+pub const GRASP_MODEL_CAP: usize = 150;
+
+/// Smallest [`ModelCap::size`].
+pub const MIN_MODEL_CAP: usize = 8;
 
 /// Engine settings. Defaults follow the thesis (Matern 3/2, EI with xi = sigma_f^2/100,
 /// DIRECT) plus the robustness measures listed in the module doc.
@@ -148,6 +189,12 @@ pub struct Settings {
     /// Restart of a stagnating search (None: off). See [`RestartRule`].
     #[serde(default)]
     pub restart: Option<RestartRule>,
+    /// The most observations the model conditions on (None: all of the epoch's, the exact
+    /// GP). Beyond it a round models a subset (see [`ModelCap`]) and refits the
+    /// hyperparameters from the last fit only, without restarts. Rounds at or below it are
+    /// exactly as without a cap.
+    #[serde(default)]
+    pub model_cap: Option<ModelCap>,
     /// Stopping rule.
     pub stop: StopRule,
 }
@@ -173,6 +220,7 @@ impl Default for Settings {
             diversify_depth: 1,
             explore_below_ei: None,
             restart: None,
+            model_cap: None,
             stop: StopRule::default(),
         }
     }
@@ -185,10 +233,16 @@ impl Settings {
     /// object scores far below every grasp; without the compression those few values set the
     /// model's scale. The best of the settings measured on the simulator's seven objects
     /// (`graspopt experiment bo`, docs/benchmarks.md); maximising.
+    ///
+    /// With a model cap of [`GRASP_MODEL_CAP`] observations ([`ModelCap::of`]): the planner
+    /// of a many-worker run keeps up at thousands of observations (docs/benchmarks.md,
+    /// "Planner at thousands of observations"), and runs of at most that many trials are
+    /// exactly as without the cap.
     pub fn for_grasps() -> Self {
         Settings {
             output_transform: OutputTransform::TailLog,
             initial_design: InitialDesign::MaximinLatinHypercube { candidates: 50 },
+            model_cap: Some(ModelCap::of(GRASP_MODEL_CAP)),
             ..Settings::default()
         }
     }
@@ -233,6 +287,18 @@ impl Settings {
         {
             return Err(BoError::InvalidSetting(format!(
                 "a qEI batch strategy needs 1 to {MAX_QEI_SAMPLES} samples, got {samples}"
+            )));
+        }
+        if let Some(c) = self.model_cap
+            && !(c.size >= MIN_MODEL_CAP
+                && c.batch_evals_per_dim >= 1
+                && (0.0..=1.0).contains(&c.near)
+                && (0.0..=1.0).contains(&c.best)
+                && c.near + c.best <= 1.0)
+        {
+            return Err(BoError::InvalidSetting(format!(
+                "a model cap needs a size of at least {MIN_MODEL_CAP}, batch_evals_per_dim >= 1 \
+                 and shares near, best in [0, 1] with near + best <= 1, got {c:?}"
             )));
         }
         if let InitialDesign::MaximinLatinHypercube { candidates: 0 } = self.initial_design {

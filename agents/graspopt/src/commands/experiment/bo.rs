@@ -17,7 +17,7 @@ use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use graspopt_bayesopt::Preset;
-use graspopt_experiment::bo_study::{BoRequest, BoStudy, Part};
+use graspopt_experiment::bo_study::{BoRequest, BoStudy, ModelCapChoice, Part};
 
 use crate::commands::setup::contact_model;
 use crate::out::outln;
@@ -58,6 +58,15 @@ pub struct BoArgs {
     /// benchmark (tuned on Branin and Hartmann6) or thesis (as written).
     #[arg(long, default_value = "grasp", value_parser = preset_parser())]
     pub engine: Preset,
+    /// The engine's model cap (observations the GP conditions on): `preset` (the engine's
+    /// own), `none` (every observation, the exact GP) or a number (at least 8), to run the
+    /// large-n mode inside short runs.
+    #[arg(long, default_value = "preset", value_parser = model_cap_parser)]
+    pub model_cap: ModelCapChoice,
+    /// Trials in flight in the 2D and 6D runs (1: one at a time, as the thesis; W: the engine
+    /// proposes each trial with the other W - 1 pending).
+    #[arg(long, default_value_t = 1)]
+    pub workers: usize,
     /// Contact model scored: surface, patch or mean.
     #[arg(long, default_value = "surface", value_parser = contact_model())]
     pub contacts: ContactModel,
@@ -78,6 +87,18 @@ fn preset_parser() -> impl TypedValueParser<Value = Preset> {
         .try_map(|name| Preset::from_name(&name))
 }
 
+/// `--model-cap`: `preset`, `none` or a number.
+fn model_cap_parser(text: &str) -> Result<ModelCapChoice, String> {
+    match text {
+        "preset" => Ok(ModelCapChoice::Preset),
+        "none" => Ok(ModelCapChoice::Exact),
+        n => n
+            .parse()
+            .map(ModelCapChoice::Size)
+            .map_err(|_| format!("expected preset, none or a number of observations, got '{n}'")),
+    }
+}
+
 pub(super) fn bo(args: &BoArgs) -> Result<()> {
     let study = BoStudy::plan(&BoRequest {
         hand: args.hand.clone(),
@@ -89,6 +110,8 @@ pub(super) fn bo(args: &BoArgs) -> Result<()> {
         objects: args.objects.clone(),
         parts: args.parts.clone(),
         engine: args.engine,
+        model_cap: args.model_cap,
+        workers: args.workers,
         contacts: args.contacts,
         threads: args.threads,
     })?;
