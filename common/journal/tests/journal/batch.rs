@@ -3,7 +3,6 @@
 
 use std::io::{BufRead, BufReader, Write as _};
 use std::path::Path;
-use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -13,6 +12,7 @@ use graspopt_journal::{
 
 use super::{
     RUN, TempDir, bits, issue, journal_with_run, kinds, params_for, result, run_record, score_for,
+    spawn_writer,
 };
 
 /// A batch with every kind of write, two of them refused (a NaN parameter, a failure of an
@@ -182,23 +182,13 @@ fn batch_child_writer() {
 fn kill9_mid_batch_leaves_whole_batches() {
     let dir = TempDir::new("kill9-batch");
     let db = dir.db();
-    let exe = std::env::current_exe().unwrap();
     let mut previous = 0;
     // Kills at moments spread over a batch's duration (a batch takes about a millisecond).
     for (round, delay_us) in [150_000u64, 150_300, 150_700, 151_100, 151_900, 153_100]
         .into_iter()
         .enumerate()
     {
-        let mut child = Command::new(&exe)
-            .args(["--exact", "batch::batch_child_writer", "--nocapture"])
-            .args(["--test-threads=1"])
-            .env(BATCH_CHILD_ENV, &db)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
-        let stdout = child.stdout.take().unwrap();
+        let (mut child, stdout) = spawn_writer("batch::batch_child_writer", BATCH_CHILD_ENV, &db);
         let (tx, rx) = mpsc::channel();
         let reader = std::thread::spawn(move || {
             for line in BufReader::new(stdout).lines().map_while(Result::ok) {

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use graspopt_journal::export::{write_csv, write_json};
@@ -667,22 +667,29 @@ fn check_prefix(j: &Journal) -> usize {
     trials.len()
 }
 
+/// Runs this test binary's test `name` alone in a child process, with `env` set to the
+/// journal `db` (the child's writer body runs only then); its stdout piped.
+fn spawn_writer(name: &str, env: &str, db: &Path) -> (Child, ChildStdout) {
+    let exe = std::env::current_exe().unwrap();
+    let mut child = Command::new(exe)
+        .args(["--exact", name, "--nocapture", "--test-threads=1"])
+        .env(env, db)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    (child, stdout)
+}
+
 #[test]
 fn kill9_leaves_consistent_prefix() {
     let dir = TempDir::new("kill9");
     let db = dir.db();
-    let exe = std::env::current_exe().unwrap();
     let mut previous = 0;
     for round in 0..3 {
-        let mut child = Command::new(&exe)
-            .args(["--exact", "child_writer", "--nocapture", "--test-threads=1"])
-            .env(CHILD_ENV, &db)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
-        let stdout = child.stdout.take().unwrap();
+        let (mut child, stdout) = spawn_writer("child_writer", CHILD_ENV, &db);
         let mut lines = BufReader::new(stdout).lines();
         loop {
             match lines.next() {
