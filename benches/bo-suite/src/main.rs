@@ -110,9 +110,11 @@ fn run_ours(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
 }
 
 /// Changes to `recommended_settings()` for a comparison run, comma-separated (environment
-/// `BO_SUITE_VARIANT`): `norestart`, `nodiv`, `notail`, `nopm`, `rank`, `m52`, `se`, and
+/// `BO_SUITE_VARIANT`): `norestart`, `nodiv`, `notail`, `nopm`, `rank`, `m52`, `se`, `pm32`, and
 /// `winN`, `tolX`, `tabuX`, `rinitN` (restart rule), `pmqX`, `divN`, `lsX` (length-scale
-/// prior median), `lssdX`, `directN`, `refitN`, `fitrN`, `xiX`.
+/// prior median), `lssdX`, `directN`, `refitN`, `fitrN`, `xiX`, `nfixX` (noise held near X),
+/// `nfloorX` (noise floor), `sigsdX`, `lsminX`, `lsmaxX`, `itersN` (fit iterations),
+/// `polishN` (polish starts), `piterN` (polish iterations).
 fn apply_variant(s: &mut Settings, variant: &str) -> anyhow::Result<()> {
     for part in variant.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let num = |prefix: &str| -> anyhow::Result<f64> {
@@ -128,6 +130,7 @@ fn apply_variant(s: &mut Settings, variant: &str) -> anyhow::Result<()> {
             "rank" => s.output_transform = OutputTransform::Rank,
             "m52" => s.kernel = KernelKind::Matern52,
             "se" => s.kernel = KernelKind::SquaredExponential,
+            "pm32" => s.kernel = KernelKind::ProductMatern32,
             p if p.starts_with("win") => rule(s, part)?.window = num("win")? as usize,
             p if p.starts_with("tol") => rule(s, part)?.tol = num("tol")?,
             p if p.starts_with("tabu") => rule(s, part)?.tabu_radius = num("tabu")?,
@@ -140,6 +143,18 @@ fn apply_variant(s: &mut Settings, variant: &str) -> anyhow::Result<()> {
             p if p.starts_with("refit") => s.full_refit_every = num("refit")? as usize,
             p if p.starts_with("fitr") => s.fit.restarts = num("fitr")? as usize,
             p if p.starts_with("xi") => s.xi = XiRule::Fixed(num("xi")?),
+            p if p.starts_with("nfix") => {
+                let v = num("nfix")?;
+                s.fit.noise_bounds = (v, 2.0 * v);
+                s.fit.noise_log_mean = v.ln();
+            }
+            p if p.starts_with("nfloor") => s.fit.noise_bounds.0 = num("nfloor")?,
+            p if p.starts_with("sigsd") => s.fit.signal_log_sd = num("sigsd")?,
+            p if p.starts_with("lsmax") => s.fit.length_scale_bounds.1 = num("lsmax")?,
+            p if p.starts_with("lsmin") => s.fit.length_scale_bounds.0 = num("lsmin")?,
+            p if p.starts_with("polish") => s.polish_starts = num("polish")? as usize,
+            p if p.starts_with("piter") => s.polish_iters = num("piter")? as usize,
+            p if p.starts_with("iters") => s.fit.max_iter = num("iters")? as usize,
             other => bail!("unknown variant {other}"),
         }
     }
@@ -206,7 +221,7 @@ fn run_egobox(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
                 .max_iters(iters)
                 .seed(seed)
                 .infill_strategy(InfillStrategy::LogEI)
-                .configure_gp(|g| g.correlation_spec(CorrelationSpec::MATERN32))
+                .configure_gp(|g| g.correlation_spec(egobox_correlation()))
         })
         .min_within(&xlimits)?
         .run()?;
@@ -216,6 +231,16 @@ fn run_egobox(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
     drop(l);
     ys.truncate(budget(f));
     Ok(record("egobox", f, seed, &ys, proposal_s))
+}
+
+/// egobox-ego's correlation: Matern 3/2 unless `BO_SUITE_EGOBOX_CORR` says `se` or `m52`
+/// (for a comparison of kernels).
+fn egobox_correlation() -> CorrelationSpec {
+    match std::env::var("BO_SUITE_EGOBOX_CORR").as_deref() {
+        Ok("se") => CorrelationSpec::SQUAREDEXPONENTIAL,
+        Ok("m52") => CorrelationSpec::MATERN52,
+        _ => CorrelationSpec::MATERN32,
+    }
 }
 
 fn record(engine: &str, f: TestFunction, seed: u64, ys: &[f64], proposal_s: Vec<f64>) -> Record {

@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{BoError, Result};
-use crate::kernel::{Kernel, KernelKind};
+use crate::kernel::{Kernel, KernelKind, product_matern32, product_matern32_dlog_l};
 use crate::lbfgs;
 use crate::linalg;
 use crate::rng::Rng;
@@ -147,6 +147,8 @@ pub struct Objective<'a> {
     d: usize,
     /// Packed lower triangle (i > j), per dimension: `diff2[p * d + k]`.
     diff2: Vec<f64>,
+    /// The same, `|a_k - b_k|` (product kernel only, else empty).
+    diff_abs: Vec<f64>,
 }
 
 impl<'a> Objective<'a> {
@@ -167,6 +169,11 @@ impl<'a> Objective<'a> {
                 }
             }
         }
+        let diff_abs = if kind == KernelKind::ProductMatern32 {
+            diff2.iter().map(|v| v.sqrt()).collect()
+        } else {
+            Vec::new()
+        };
         Objective {
             kind,
             settings,
@@ -174,6 +181,7 @@ impl<'a> Objective<'a> {
             n,
             d,
             diff2,
+            diff_abs,
         }
     }
 
@@ -201,9 +209,21 @@ impl<'a> Objective<'a> {
         ws.k.resize(n * n, 0.0);
         ws.gmat.resize(n * n.saturating_sub(1) / 2, 0.0);
         let (k, gmat) = (&mut ws.k, &mut ws.gmat);
+        let product = self.kind == KernelKind::ProductMatern32;
+        if product {
+            ws.inv_l.clear();
+            ws.inv_l.extend(theta[..d].iter().map(|t| (-t).exp()));
+        }
         let mut p = 0;
         for i in 0..n {
             for j in 0..i {
+                if product {
+                    let row = &self.diff_abs[p * d..(p + 1) * d];
+                    k[i * n + j] =
+                        s * product_matern32(row.iter().zip(&ws.inv_l).map(|(a, b)| a * b));
+                    p += 1;
+                    continue;
+                }
                 let row = &self.diff2[p * d..(p + 1) * d];
                 let r2: f64 = row.iter().zip(&ws.inv_l2).map(|(a, b)| a * b).sum();
                 let (rho, g) = self.kind.profile(r2.sqrt());
@@ -248,6 +268,7 @@ impl<'a> Objective<'a> {
         // W = alpha alpha^T - K^{-1}; dLML/dtheta = 0.5 tr(W dK/dtheta).
         linalg::inverse_lower_from_cholesky_into(&ws.l, n, &mut ws.lt, &mut ws.kinv);
         let (alpha, kinv, k, gmat, inv_l2) = (&ws.alpha, &ws.kinv, &ws.k, &ws.gmat, &ws.inv_l2);
+        let (product, inv_l) = (self.kind == KernelKind::ProductMatern32, &ws.inv_l);
         let mut trace_w = 0.0;
         let mut wsum = 0.0; // sum W_ij K_ij without noise (signal part)
         let mut p = 0;
@@ -255,6 +276,15 @@ impl<'a> Objective<'a> {
             for j in 0..i {
                 let w = alpha[i] * alpha[j] - kinv[i * n + j];
                 wsum += 2.0 * w * k[i * n + j];
+                if product {
+                    let row = &self.diff_abs[p * d..(p + 1) * d];
+                    let kw = 2.0 * w * k[i * n + j];
+                    for kk in 0..d {
+                        grad[kk] += kw * product_matern32_dlog_l(row[kk] * inv_l[kk]);
+                    }
+                    p += 1;
+                    continue;
+                }
                 let gw = 2.0 * w * gmat[p];
                 let row = &self.diff2[p * d..(p + 1) * d];
                 for kk in 0..d {
@@ -297,6 +327,8 @@ impl<'a> Objective<'a> {
 #[derive(Default)]
 struct Workspace {
     inv_l2: Vec<f64>,
+    /// Inverse length scales (product kernel only).
+    inv_l: Vec<f64>,
     /// Kernel matrix K (noise on the diagonal), n x n.
     k: Vec<f64>,
     /// `s g(r)` per pair (packed lower triangle).
@@ -417,6 +449,7 @@ mod tests {
             KernelKind::Matern32,
             KernelKind::Matern52,
             KernelKind::SquaredExponential,
+            KernelKind::ProductMatern32,
         ] {
             let obj = Objective::new(kind, &st, &x, &y);
             let theta = vec![(0.4f64).ln(), (0.9f64).ln(), 0.2, (1e-3f64).ln()];

@@ -7,7 +7,7 @@
 //! and standardises outputs before building a [`Gp`].
 
 use crate::error::{BoError, Result};
-use crate::kernel::Kernel;
+use crate::kernel::{Kernel, KernelKind, product_matern32};
 use crate::linalg;
 
 const LN_2PI: f64 = 1.837_877_066_409_345_3;
@@ -185,6 +185,12 @@ impl Gp {
                 p[k] = xs[k] * self.inv_ls[k];
             }
             let (kind, sv) = (self.kernel.kind, self.kernel.signal_variance);
+            if kind == KernelKind::ProductMatern32 {
+                for row in self.xs_scaled.chunks_exact(d).skip(from) {
+                    out.push(sv * product_matern32((0..d).map(|k| p[k] - row[k])));
+                }
+                return;
+            }
             for row in self.xs_scaled.chunks_exact(d).skip(from) {
                 let mut r2 = 0.0;
                 for k in 0..d {
@@ -347,32 +353,41 @@ mod tests {
 
     #[test]
     fn gradients_match_finite_differences() {
-        let k = Kernel {
-            kind: KernelKind::Matern52,
-            length_scales: vec![0.3, 0.6],
-            signal_variance: 1.2,
-        };
-        let x = vec![
-            vec![0.1, 0.2],
-            vec![0.8, 0.4],
-            vec![0.5, 0.9],
-            vec![0.3, 0.6],
-        ];
-        let gp = Gp::new(x, vec![0.3, -1.0, 0.5, 1.1], k, 1e-4).unwrap();
-        let p = [0.42, 0.37];
-        let mut dm = [0.0; 2];
-        let mut dv = [0.0; 2];
-        gp.predict_with_grad(&p, &mut dm, &mut dv);
-        for d in 0..2 {
-            let e = 1e-6;
-            let mut a = p;
-            a[d] += e;
-            let mut b = p;
-            b[d] -= e;
-            let (ma, va) = gp.predict(&a);
-            let (mb, vb) = gp.predict(&b);
-            assert!(((ma - mb) / (2.0 * e) - dm[d]).abs() < 1e-6);
-            assert!(((va - vb) / (2.0 * e) - dv[d]).abs() < 1e-6);
+        // `predict` takes the fast kernel rows, `predict_with_grad` `Kernel::eval_with_grad`:
+        // the finite differences of one match the gradients of the other.
+        for kind in [KernelKind::Matern52, KernelKind::ProductMatern32] {
+            let k = Kernel {
+                kind,
+                length_scales: vec![0.3, 0.6],
+                signal_variance: 1.2,
+            };
+            let x = vec![
+                vec![0.1, 0.2],
+                vec![0.8, 0.4],
+                vec![0.5, 0.9],
+                vec![0.3, 0.6],
+            ];
+            let gp = Gp::new(x, vec![0.3, -1.0, 0.5, 1.1], k, 1e-4).unwrap();
+            let p = [0.42, 0.37];
+            let mut dm = [0.0; 2];
+            let mut dv = [0.0; 2];
+            let (m0, v0) = gp.predict_with_grad(&p, &mut dm, &mut dv);
+            let (m1, v1) = gp.predict(&p);
+            assert!(
+                (m0 - m1).abs() < 1e-12 && (v0 - v1).abs() < 1e-12,
+                "{kind:?}"
+            );
+            for d in 0..2 {
+                let e = 1e-6;
+                let mut a = p;
+                a[d] += e;
+                let mut b = p;
+                b[d] -= e;
+                let (ma, va) = gp.predict(&a);
+                let (mb, vb) = gp.predict(&b);
+                assert!(((ma - mb) / (2.0 * e) - dm[d]).abs() < 1e-6, "{kind:?}");
+                assert!(((va - vb) / (2.0 * e) - dv[d]).abs() < 1e-6, "{kind:?}");
+            }
         }
     }
 
