@@ -206,6 +206,10 @@ fn kill9_mid_batch_leaves_whole_batches() {
             start, previous,
             "round {round}: the child starts where the journal is"
         );
+        // Its first batch committed (so every round makes progress, however loaded the
+        // machine), the kill comes at a moment spread over the batches that follow.
+        let first = rx.recv_timeout(Duration::from_secs(30)).unwrap();
+        assert_eq!(first, start + WIDTH, "round {round}");
         std::thread::sleep(Duration::from_micros(delay_us));
         child.kill().unwrap(); // SIGKILL on Unix
         let status = child.wait().unwrap();
