@@ -219,6 +219,24 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         )
         .await
         .unwrap();
+        // The duplicate only once the real result is in the journal: the real one comes from
+        // the metric agent, this one from another session, and the coordinator may receive
+        // messages of two sessions in either order (a forged first result would be the
+        // trial's, which is what leases and attempts allow, not what this test checks).
+        let recorded = || {
+            Journal::open(&journal)
+                .ok()
+                .and_then(|j| j.trial("bad", first.trial_id).ok().flatten())
+                .is_some_and(|t| t.state == TrialState::Completed)
+        };
+        let waited = Instant::now();
+        while !recorded() {
+            assert!(
+                waited.elapsed() < Duration::from_secs(30),
+                "first result not recorded"
+            );
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
         bus.put(
             &RESULT.key(Runs::One(&run)).to_string(),
             &duplicate,
