@@ -10,6 +10,12 @@
 //! Usage:
 //!   graspopt-bo-suite run --engine ours|egobox [--functions a,b,..] [--seeds N] --out FILE
 //!   graspopt-bo-suite table FILE...
+//!   graspopt-bo-suite tuned
+//!
+//! `tuned` runs issue 4's figures for the settings (with `BO_SUITE_VARIANT` applied): Branin
+//! seeds 0-9 (50 evaluations, 5 initial; target a median of at most 8 evaluations to 1%)
+//! and Hartmann6 seeds 0-9 (100 evaluations, 10 initial; target 1% in every seed), each with
+//! the engine's own initial design, as `bo_bench` does.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, Write};
@@ -82,12 +88,9 @@ fn best_so_far(ys: &[f64]) -> Vec<f64> {
 fn run_ours(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
     let (lo, hi) = f.bounds();
     let bounds: Vec<(f64, f64)> = lo.into_iter().zip(hi).collect();
-    let mut settings = recommended_settings();
+    let mut settings = settings_under_test()?;
     settings.minimize = true;
     settings.n_init = Some(n_init(f));
-    if let Ok(v) = std::env::var("BO_SUITE_VARIANT") {
-        apply_variant(&mut settings, &v)?;
-    }
     let mut opt = Optimizer::new(&bounds, settings, seed)?;
     let mut ys = Vec::with_capacity(budget(f));
     for x in initial_design(f, seed) {
@@ -398,13 +401,123 @@ fn table(paths: &[String]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One seed of ours on one function, printed evaluation by evaluation: the value, the best
+/// regret so far and the epoch (restarts), to see where a seed stops.
+fn trace(args: &[String]) -> anyhow::Result<()> {
+    let f = TestFunction::from_name(args.first().context("trace FUNCTION SEED")?)?;
+    let seed: u64 = args.get(1).context("trace FUNCTION SEED")?.parse()?;
+    let (lo, hi) = f.bounds();
+    let bounds: Vec<(f64, f64)> = lo.into_iter().zip(hi).collect();
+    let mut settings = settings_under_test()?;
+    settings.minimize = true;
+    settings.n_init = Some(n_init(f));
+    let mut opt = Optimizer::new(&bounds, settings, seed)?;
+    let mut best = f64::INFINITY;
+    let mut n = 0;
+    let show = |opt: &Optimizer, x: &[f64], y: f64, best: f64, n: usize| {
+        let xs: Vec<String> = x.iter().map(|v| format!("{v:.2}")).collect();
+        println!(
+            "{n:3} epoch@{:3} y {y:12.5} best regret {:.2e} x [{}]",
+            opt.epoch_start(),
+            f.regret(best),
+            xs.join(", ")
+        );
+    };
+    for x in initial_design(f, seed) {
+        let y = f.eval(&x);
+        opt.observe(&x, y)?;
+        best = best.min(y);
+        n += 1;
+        show(&opt, &x, y, best, n);
+    }
+    while n < budget(f) {
+        for x in opt.suggest(1)? {
+            let y = f.eval(&x);
+            opt.observe(&x, y)?;
+            best = best.min(y);
+            n += 1;
+            show(&opt, &x, y, best, n);
+        }
+    }
+    Ok(())
+}
+
+/// The settings of a run: `recommended_settings()` with `BO_SUITE_VARIANT` applied.
+fn settings_under_test() -> anyhow::Result<Settings> {
+    let mut settings = recommended_settings();
+    if let Ok(v) = std::env::var("BO_SUITE_VARIANT") {
+        apply_variant(&mut settings, &v)?;
+    }
+    Ok(settings)
+}
+
+/// Issue 4's figures for the settings under test (see the module doc).
+fn tuned() -> anyhow::Result<()> {
+    for (f, budget, init) in [
+        (TestFunction::Branin, 50, 5),
+        (TestFunction::Hartmann6, 100, 10),
+    ] {
+        let mut settings = settings_under_test()?;
+        settings.n_init = Some(init);
+        let handles: Vec<_> = (0..2u64)
+            .map(|t| {
+                let s = settings.clone();
+                std::thread::spawn(move || {
+                    (0..10u64)
+                        .filter(|seed| seed % 2 == t)
+                        .map(|seed| {
+                            graspopt_bayesopt::benchmark::run_seed_with(
+                                f,
+                                seed,
+                                budget,
+                                1,
+                                s.clone(),
+                            )
+                            .map(|trace| summarize(f, seed, &trace, 1))
+                        })
+                        .collect::<Result<Vec<_>, _>>()
+                })
+            })
+            .collect();
+        let mut seeds = Vec::new();
+        for h in handles {
+            let part = h
+                .join()
+                .map_err(|_| anyhow::anyhow!("a seed's thread panicked"))??;
+            seeds.extend(part);
+        }
+        seeds.sort_by_key(|s| s.seed);
+        let l = aggregate(&seeds, budget, 1);
+        let missed: Vec<String> = seeds
+            .iter()
+            .filter(|s| s.evals_to[1].is_none())
+            .map(|s| format!("{} ({:.1}%)", s.seed, 100.0 * s.final_regret))
+            .collect();
+        println!(
+            "{}: 1% in {}/{} seeds, median evals {}; missed: {}",
+            f.name(),
+            l[1].reached,
+            l[1].seeds,
+            fmt_med(l[1].median_evals),
+            if missed.is_empty() {
+                "none".into()
+            } else {
+                missed.join(", ")
+            }
+        );
+    }
+    Ok(())
+}
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("run") => run(&args[1..]),
         Some("table") => table(&args[1..]),
+        Some("tuned") => tuned(),
+        Some("trace") => trace(&args[1..]),
         _ => bail!(
-            "usage: graspopt-bo-suite run --engine ours|egobox [--functions a,b] [--seeds N] --out FILE\n       graspopt-bo-suite table FILE..."
+            "usage: graspopt-bo-suite run --engine ours|egobox [--functions a,b] [--seeds N] --out FILE\n       graspopt-bo-suite table FILE...\n       graspopt-bo-suite tuned"
         ),
     }
 }

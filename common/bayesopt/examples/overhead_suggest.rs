@@ -1,18 +1,23 @@
 //! Planner overhead per proposal at about 100 observations in 6D (Hartmann6, recommended
 //! settings): 100 random observations, then 20 consecutive rounds of `suggest(1)` + `observe`
 //! (all kinds of rounds: plain, diversification, full refit). Prints each round's time and the
-//! median. Run on one core: `taskset -c 0 cargo run --release -p graspopt-bayesopt --features
+//! median. `OV_PRESET=grasp` times the planner's preset ([`Settings::for_grasps`]) instead.
+//! Run on one core: `taskset -c 0 cargo run --release -p graspopt-bayesopt --features
 //! tools --example overhead_suggest`.
 
 use std::time::Instant;
 
 use graspopt_bayesopt::benchmark::recommended_settings;
 use graspopt_bayesopt::rng::Rng;
-use graspopt_bayesopt::{Optimizer, TestFunction};
+use graspopt_bayesopt::{Optimizer, Settings, TestFunction};
 
 fn main() {
     let f = TestFunction::Hartmann6;
-    let mut s = recommended_settings();
+    let mut s = if std::env::var("OV_PRESET").as_deref() == Ok("grasp") {
+        Settings::for_grasps()
+    } else {
+        recommended_settings()
+    };
     s.minimize = true;
     // keep the 100-observation model (the restart rule would start a new, small epoch)
     s.restart = None;

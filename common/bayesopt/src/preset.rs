@@ -17,8 +17,8 @@ pub enum Preset {
     /// vanishes) with the bad tail of the scores compressed logarithmically
     /// ([`Settings::for_grasps`]). The best measured on the seven objects (docs/benchmarks.md).
     Grasp,
-    /// The settings tuned on the Branin and Hartmann6 test functions
-    /// ([`recommended_settings`]).
+    /// The settings measured on the BO suite's ten test functions against egobox-ego
+    /// ([`recommended_settings`]; for noise-free objectives).
     Benchmark,
     /// The thesis's settings as written ([`Settings::default`]).
     Thesis,

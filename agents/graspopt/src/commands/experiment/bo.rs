@@ -55,7 +55,7 @@ pub struct BoArgs {
     #[arg(long, value_delimiter = ',', default_values = Part::ALL.map(|p| p.name()), value_parser = part_parser())]
     pub parts: Vec<Part>,
     /// The engine's settings: grasp (the thesis's with the misses' scores compressed),
-    /// benchmark (tuned on Branin and Hartmann6) or thesis (as written).
+    /// benchmark (for noise-free test functions) or thesis (as written).
     #[arg(long, default_value = "grasp", value_parser = preset_parser())]
     pub engine: Preset,
     /// The engine's model cap (observations the GP conditions on): `preset` (the engine's
