@@ -83,15 +83,21 @@ fn best_so_far(ys: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// graspopt with `recommended_settings()`: the design observed first, then one proposal at
-/// a time.
-fn run_ours(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
+/// Our engine for `f` and `seed` as the suite runs it: the settings under test, minimising,
+/// with the suite's initial-design size.
+fn suite_optimizer(f: TestFunction, seed: u64) -> anyhow::Result<Optimizer> {
     let (lo, hi) = f.bounds();
     let bounds: Vec<(f64, f64)> = lo.into_iter().zip(hi).collect();
     let mut settings = settings_under_test()?;
     settings.minimize = true;
     settings.n_init = Some(n_init(f));
-    let mut opt = Optimizer::new(&bounds, settings, seed)?;
+    Ok(Optimizer::new(&bounds, settings, seed)?)
+}
+
+/// graspopt with `recommended_settings()`: the design observed first, then one proposal at
+/// a time.
+fn run_ours(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
+    let mut opt = suite_optimizer(f, seed)?;
     let mut ys = Vec::with_capacity(budget(f));
     for x in initial_design(f, seed) {
         let y = f.eval(&x);
@@ -406,12 +412,7 @@ fn table(paths: &[String]) -> anyhow::Result<()> {
 fn trace(args: &[String]) -> anyhow::Result<()> {
     let f = TestFunction::from_name(args.first().context("trace FUNCTION SEED")?)?;
     let seed: u64 = args.get(1).context("trace FUNCTION SEED")?.parse()?;
-    let (lo, hi) = f.bounds();
-    let bounds: Vec<(f64, f64)> = lo.into_iter().zip(hi).collect();
-    let mut settings = settings_under_test()?;
-    settings.minimize = true;
-    settings.n_init = Some(n_init(f));
-    let mut opt = Optimizer::new(&bounds, settings, seed)?;
+    let mut opt = suite_optimizer(f, seed)?;
     let mut best = f64::INFINITY;
     let mut n = 0;
     let show = |opt: &Optimizer, x: &[f64], y: f64, best: f64, n: usize| {
