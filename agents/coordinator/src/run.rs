@@ -422,8 +422,7 @@ mod tests {
             );
             let e = outcome
                 .expect("the coordinator gives way within 10 s")
-                .err()
-                .expect("an error");
+                .expect_err("an error");
             assert_eq!(
                 e.to_string(),
                 "run \"givewayrun\": another agent, a coordinator, took its place at the same \

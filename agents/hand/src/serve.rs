@@ -46,25 +46,27 @@ pub async fn serve(
     let _token = bus.declare_alive(run, AgentKind::Hand, id).await?;
     let mut inbox = Inbox::new(format!("hand {id}"), run);
     loop {
+        // A subscription that ends (`None`): the session closed.
         let command = tokio::select! {
             // The place first: a hand that gives way takes no further command.
             biased;
             e = place.lost() => return Err(e.into()),
-            Some(r) = objects.recv() => {
+            r = objects.recv() => {
+                let Some(r) = r else { return Ok(()) };
                 if let Some(e) = inbox.accept(r, "object estimate") {
                     driver.set_object(&e);
                 }
                 continue;
             },
-            Some(r) = commands.recv() => match inbox.accept(r, "command") {
-                Some(c) if c.worker == id => c,
-                Some(c) => {
+            r = commands.recv() => match r.map(|r| inbox.accept(r, "command")) {
+                None => return Ok(()),
+                Some(Some(c)) if c.worker == id => c,
+                Some(Some(c)) => {
                     inbox.refuse(format_args!("command for {}/{} ignored", c.run_id, c.worker));
                     continue;
                 }
-                None => continue,
+                Some(None) => continue,
             },
-            else => return Ok(()),
         };
         // Wait for the world's object if perception has not spoken yet.
         tokio::select! {
@@ -302,7 +304,8 @@ mod tests {
     /// The coordinator's and metric agent's side of one hand served on loopback: a command
     /// waits for the object estimate, each command of the run and worker gets its clouds
     /// (tagged, padded to the cost, a failure as an error), a command for another hand is
-    /// refused without executing, and stray messages are not acted on.
+    /// refused without executing, stray messages are not acted on, and serving ends when the
+    /// session closes.
     #[test]
     fn serve_answers_each_command_of_its_run_and_worker_once() {
         let rt = tokio::runtime::Runtime::new().unwrap();
@@ -396,9 +399,14 @@ mod tests {
                 *seen.lock().unwrap(),
                 ["sphere", "trial 1", "trial 2", "trial 5"]
             );
-            served.abort();
+            // The hand's session closing ends it.
+            hand_bus.close().await.unwrap();
+            tokio::time::timeout(Duration::from_secs(5), served)
+                .await
+                .expect("serve ends once its session closed")
+                .unwrap()
+                .unwrap();
             let _ = bus.close().await;
-            let _ = hand_bus.close().await;
         });
     }
 
@@ -442,8 +450,7 @@ mod tests {
                 .await
                 .expect("the hand gives way within 2 s")
                 .unwrap()
-                .err()
-                .expect("an error");
+                .expect_err("an error");
             assert!(
                 e.to_string().contains(
                     "another agent, a hand with the id w1, took its place at the same moment \
