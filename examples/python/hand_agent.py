@@ -17,6 +17,7 @@ Only the Python standard library and eclipse-zenoh are needed.
 import argparse
 import json
 import math
+import queue
 import random
 import socket
 import sys
@@ -59,14 +60,53 @@ def measure(grasps, command):
     return best, None
 
 
-def take_place(session, prefix, hand_id, wait_s=5.0):
+def claim_of(key):
+    """The claim a claim key names, (number, held), or None for another key."""
+    number, phase = key.split("/")[-2:]
+    if len(number) != 16 or phase not in ("starting", "held"):
+        return None
+    try:
+        return int(number, 16), phase == "held"
+    except ValueError:
+        return None
+
+
+class Place:
+    """A hand's place in a run, held (see take_place): keep it while the hand runs, undeclare
+    it when the hand stops. It watches the held claims of the place: should another hand
+    with the id hold it with a smaller number (the two took it at the same moment and each
+    one's claim reached the other late), `lost` turns to the reason this hand gives way,
+    and `on_lost()` is called (from Zenoh's thread): take no more commands, and exit."""
+
+    def __init__(self, session, claims_key, nonce, held, lost_why, on_lost):
+        self.lost = None
+        self._held = held
+
+        def watch(sample):
+            claim = claim_of(str(sample.key_expr))
+            if (self.lost is None and sample.kind == zenoh.SampleKind.PUT and claim
+                    and claim[1] and claim[0] < nonce):
+                self.lost = lost_why
+                on_lost()
+
+        self._watch = session.liveliness().declare_subscriber(
+            f"{claims_key}/**", watch, history=True)
+
+    def undeclare(self):
+        self._watch.undeclare()
+        self._held.undeclare()
+
+
+def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
     """Makes sure this is the run's only hand with this id, as graspopt's own agents do
-    (docs/reliability.md), and returns the claim token that holds the place (keep it).
+    (docs/reliability.md), and returns the Place that holds it (keep it).
 
     First waits (up to wait_s) until no hand with the id is alive: six empty answers in a
     row, 0.2 s apart. Then claims the place with a random number and looks at the other
     claims twice, 0.15 s apart: a held claim, then the smallest number, comes first; seeing
-    none, holds the place and looks once more. Exits if the place stays taken."""
+    none, holds the place and looks once more. Exits if the place stays taken. While held,
+    the place watches for a held claim with a smaller number (see Place): liveliness that
+    came too late for these looks (a loaded machine) still leaves one hand with the id."""
     deadline = time.monotonic() + wait_s
 
     def keys(key_expr):
@@ -85,12 +125,7 @@ def take_place(session, prefix, hand_id, wait_s=5.0):
     nonce = random.getrandbits(64)
 
     def claims():
-        out = []
-        for key in keys(f"{claims_key}/**"):
-            number, phase = key.split("/")[-2:]
-            if len(number) == 16 and phase in ("starting", "held"):
-                out.append((int(number, 16), phase == "held"))
-        return out
+        return [c for c in map(claim_of, keys(f"{claims_key}/**")) if c]
 
     def blocker(seen):
         others = [c for c in seen if c[0] != nonce]
@@ -110,8 +145,12 @@ def take_place(session, prefix, hand_id, wait_s=5.0):
             time.sleep(0.15)
             seen = next((c for c in claims() if c[1] and c[0] < nonce), None)
             if not seen:
+                place = Place(session, claims_key, nonce, held,
+                              f"{hand_id}: another hand with this id took the run's place at the "
+                              "same moment and keeps it: this one gives way (give it another --id)",
+                              on_lost)
                 starting.undeclare()
-                return held
+                return place
             held.undeclare()
         if time.monotonic() >= deadline:
             starting.undeclare()
@@ -163,8 +202,17 @@ def serve(args, grasps, answer):
     # A key chunk: ASCII letters, digits, '-', '_', '.', at most 64, not starting with '.'.
     host = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_"
                    for c in socket.gethostname())[:64].lstrip(".") or "host"
-    place = take_place(session, prefix, args.id)
-    commands = queue_of(session, f"{prefix}/hand/{args.id}/command")
+    # The commands' samples, and None when the place is lost (see Place).
+    incoming = queue.Queue(256)
+
+    def wake():
+        try:
+            incoming.put_nowait(None)
+        except queue.Full:
+            pass  # the loop is busy with commands: it looks at place.lost before each
+
+    place = take_place(session, prefix, args.id, wake)
+    commands = session.declare_subscriber(f"{prefix}/hand/{args.id}/command", incoming.put)
     # The trailing /json asks the coordinator for JSON commands.
     token = session.liveliness().declare_token(f"{prefix}/alive/hand/{host}/{args.id}/json")
     print(f"{args.id}: {len(grasps)} recorded grasps, waiting for trials on {args.connect}",
@@ -173,7 +221,9 @@ def serve(args, grasps, answer):
     bad = 0
     try:
         while True:
-            sample = commands.recv()
+            sample = incoming.get()
+            if place.lost:
+                sys.exit(place.lost)
             started = time.monotonic()
             try:
                 command = json.loads(sample.payload.to_bytes())
@@ -198,6 +248,7 @@ def serve(args, grasps, answer):
         pass
     finally:
         token.undeclare()
+        commands.undeclare()
         place.undeclare()
         session.close()
 
@@ -205,11 +256,6 @@ def serve(args, grasps, answer):
 def main():
     args = argument_parser(__doc__).parse_args()
     serve(args, load_recording(args.recording), clouds_of)
-
-
-def queue_of(session, key):
-    """A subscriber whose samples are read one at a time with .recv()."""
-    return session.declare_subscriber(key, zenoh.handlers.FifoChannel(256))
 
 
 if __name__ == "__main__":

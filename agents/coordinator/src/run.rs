@@ -37,7 +37,9 @@ pub async fn run(
 
 /// [`run`], stopping early when `stop` resolves (Ctrl-C, say): the journal then records the
 /// run as stopped (every result already in stays; `--resume` continues it) and the status
-/// returned has the phase it had.
+/// returned has the phase it had. Another live coordinator of the run is an error: found at
+/// the start, or later, when both took the run at the same moment and this one gives way
+/// (every result already in the journal stays).
 pub async fn run_until(
     bus: &Bus,
     run: &RunId,
@@ -48,7 +50,7 @@ pub async fn run_until(
     stop: impl std::future::Future<Output = ()>,
 ) -> anyhow::Result<RunStatus> {
     // Two coordinators on one run would issue each trial twice and fight over the journal.
-    let _place = bus
+    let place = bus
         .wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
         .await?;
     let journal_path = config.journal_path(run);
@@ -69,7 +71,7 @@ pub async fn run_until(
         planner_timeout: Duration::from_millis(config.planner_timeout_ms),
     };
     let period = Duration::from_millis(config.status_period_ms.max(20));
-    if drive(&mut core, &inputs, &mut io, period, stop).await? {
+    if drive(&mut core, &inputs, &mut io, period, stop, place.lost()).await? {
         io.stopped(&core, &journal_path)
     } else {
         io.finished(&core).await
@@ -106,15 +108,20 @@ impl Inputs {
 
 /// Feeds events to `core` until the run finishes (false) or `stop` resolves (true). The
 /// planner's answer is awaited beside everything else, so results, leases and workers are
-/// still handled while it thinks or while the bus cannot reach it.
+/// still handled while it thinks or while the bus cannot reach it. Should `lost` resolve
+/// (another coordinator holds the run too, see [`graspopt_bus::Claim::lost`]), it stops
+/// with that error: what is in the journal stays, and the run's status there is the other
+/// coordinator's to write.
 async fn drive<'a>(
     core: &mut Coordinator,
     inputs: &Inputs,
     io: &mut Io<'a>,
     status_period: Duration,
     stop: impl std::future::Future<Output = ()>,
+    lost: impl std::future::Future<Output = BusError>,
 ) -> anyhow::Result<bool> {
     tokio::pin!(stop);
+    tokio::pin!(lost);
     let mut tick = tokio::time::interval(status_period);
     let mut lease_tick = tokio::time::interval(Duration::from_millis(50));
     let mut planning: Option<PlannerCall<'a>> = None;
@@ -171,6 +178,7 @@ async fn drive<'a>(
                 Vec::new()
             },
             _ = &mut stop => return Ok(true),
+            e = &mut lost => return Err(e.into()),
             _ = tick.tick() => core.on_status_tick(now_ms()),
         };
         io.apply(actions, &mut planning).await?;
@@ -345,4 +353,88 @@ pub fn record(journal: &mut Journal, run: &RunId, writes: &[Write]) -> anyhow::R
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use graspopt_bus::{BusArgs, free_loopback_port};
+    use graspopt_protocol::PlannerMethod;
+    use graspopt_protocol::keys::{Claim, claim_token};
+    use graspopt_sim::ParamKind;
+
+    use super::*;
+
+    /// A coordinator whose run turns out to be held by another with a smaller nonce (both
+    /// took it at the same moment; the other's claim, declared here by hand, reached it
+    /// late) stops with the error naming the place, and leaves the journal's record of the
+    /// run as it was: still running, not marked stopped (that is the other's to write).
+    #[test]
+    fn a_coordinator_gives_way_to_one_that_holds_its_run_with_a_smaller_nonce() {
+        let rt = tokio::runtime::Runtime::new().unwrap();
+        rt.block_on(async {
+            let endpoint = format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap());
+            let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
+            args.no_shm = true;
+            let hub = Bus::open(&args).await.unwrap();
+            // The coordinator on the session that connects: one that only listens meets
+            // nobody and holds its run unchallenged.
+            let mut args = BusArgs::loopback(Vec::new(), vec![endpoint]);
+            args.no_shm = true;
+            let bus = Bus::open(&args).await.unwrap();
+            assert!(bus.reaches_out());
+            let dir = std::env::temp_dir().join(format!("graspopt-giveway-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let config = CoordinatorConfig {
+                journal: dir.join("journal.sqlite"),
+                ..CoordinatorConfig::default()
+            };
+            let run_id = RunId::new("givewayrun").unwrap();
+            let spec = RunSpec {
+                object: "sphere".into(),
+                hand: "barrett".into(),
+                params: vec![ParamKind::Approach],
+                bounds: None,
+                trials: 5,
+                seed: 1,
+                method: PlannerMethod::Random,
+                initial: None,
+                settings: None,
+            };
+            let coordinators = hub
+                .watch_alive(&alive_key((&run_id).into(), Some(AgentKind::Coordinator)))
+                .await
+                .unwrap();
+            let (outcome, _other) = tokio::join!(
+                tokio::time::timeout(
+                    Duration::from_secs(10),
+                    run(&bus, &run_id, &spec, &config, false, None)
+                ),
+                async {
+                    let alive = coordinators.recv().await.unwrap();
+                    assert!(alive.alive, "{alive:?}");
+                    let claim = Claim {
+                        nonce: 0,
+                        held: true,
+                    };
+                    let key = claim_token(&run_id, AgentKind::Coordinator, "any", claim);
+                    hub.session().liveliness().declare_token(key).await.unwrap()
+                },
+            );
+            let e = outcome
+                .expect("the coordinator gives way within 10 s")
+                .expect_err("an error");
+            assert_eq!(
+                e.to_string(),
+                "run \"givewayrun\": another agent, a coordinator, took its place at the same \
+                 moment and keeps it: this one gives way"
+            );
+            let journal = Journal::open(&config.journal).unwrap();
+            let record = journal.run(run_id.as_str()).unwrap().expect("the run");
+            assert_eq!(record.status, RunLifecycle::Running);
+            drop(journal);
+            let _ = std::fs::remove_dir_all(&dir);
+            let _ = bus.close().await;
+            let _ = hub.close().await;
+        });
+    }
 }

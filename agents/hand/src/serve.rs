@@ -23,7 +23,11 @@ pub const UNIQUE_WAIT: Duration = Duration::from_secs(5);
 /// metric agents (or, for a driver that senses [`Sensing::Ft`], the fingertip readings on
 /// the wrenches topic). A failed execution is sent as clouds (readings) with the reason in
 /// `error`. Messages of other runs or workers, and ones that do not decode, are counted and
-/// logged.
+/// logged. Should another hand with the id turn out to hold the place too (both claimed
+/// it at the same moment and liveliness came late, see [`graspopt_bus::Claim::lost`]), the
+/// one that gives
+/// way takes no more commands and returns the error naming it (a trial already running is
+/// finished and sent first).
 pub async fn serve(
     bus: &Bus,
     run: &RunId,
@@ -32,7 +36,7 @@ pub async fn serve(
     mut driver: impl HandDriver,
 ) -> anyhow::Result<()> {
     // Two hands with one id would both execute every trial sent to that id.
-    let _place = bus
+    let place = bus
         .wait_until_unique(run, AgentKind::Hand, Some(id), UNIQUE_WAIT)
         .await?;
     let commands = bus.subscribe(&COMMAND.worker_key(run.into(), id)).await?;
@@ -42,26 +46,35 @@ pub async fn serve(
     let _token = bus.declare_alive(run, AgentKind::Hand, id).await?;
     let mut inbox = Inbox::new(format!("hand {id}"), run);
     loop {
+        // A subscription that ends (`None`): the session closed.
         let command = tokio::select! {
-            Some(r) = objects.recv() => {
+            // The place first: a hand that gives way takes no further command.
+            biased;
+            e = place.lost() => return Err(e.into()),
+            r = objects.recv() => {
+                let Some(r) = r else { return Ok(()) };
                 if let Some(e) = inbox.accept(r, "object estimate") {
                     driver.set_object(&e);
                 }
                 continue;
             },
-            Some(r) = commands.recv() => match inbox.accept(r, "command") {
-                Some(c) if c.worker == id => c,
-                Some(c) => {
+            r = commands.recv() => match r.map(|r| inbox.accept(r, "command")) {
+                None => return Ok(()),
+                Some(Some(c)) if c.worker == id => c,
+                Some(Some(c)) => {
                     inbox.refuse(format_args!("command for {}/{} ignored", c.run_id, c.worker));
                     continue;
                 }
-                None => continue,
+                Some(None) => continue,
             },
-            else => return Ok(()),
         };
         // Wait for the world's object if perception has not spoken yet.
-        if !wait_for_object(&mut driver, &objects, &mut inbox).await {
-            return Ok(());
+        tokio::select! {
+            biased;
+            e = place.lost() => return Err(e.into()),
+            object = wait_for_object(&mut driver, &objects, &mut inbox) => if !object {
+                return Ok(());
+            },
         }
         let started = Instant::now();
         let (back, outcome) = execute(driver, &command, id).await?;
@@ -188,7 +201,7 @@ mod tests {
     use std::sync::{Arc, Mutex};
 
     use graspopt_bus::{BusArgs, CloudReceiver, CongestionControl, free_loopback_port};
-    use graspopt_protocol::keys::alive_key;
+    use graspopt_protocol::keys::{Claim, alive_key, claim_token};
     use graspopt_protocol::{CloudPoint, Encoding, FingerCloud, Pose};
 
     use super::*;
@@ -291,7 +304,8 @@ mod tests {
     /// The coordinator's and metric agent's side of one hand served on loopback: a command
     /// waits for the object estimate, each command of the run and worker gets its clouds
     /// (tagged, padded to the cost, a failure as an error), a command for another hand is
-    /// refused without executing, and stray messages are not acted on.
+    /// refused without executing, stray messages are not acted on, and serving ends when the
+    /// session closes.
     #[test]
     fn serve_answers_each_command_of_its_run_and_worker_once() {
         let rt = tokio::runtime::Runtime::new().unwrap();
@@ -385,7 +399,70 @@ mod tests {
                 *seen.lock().unwrap(),
                 ["sphere", "trial 1", "trial 2", "trial 5"]
             );
-            served.abort();
+            // The hand's session closing ends it.
+            hand_bus.close().await.unwrap();
+            tokio::time::timeout(Duration::from_secs(5), served)
+                .await
+                .expect("serve ends once its session closed")
+                .unwrap()
+                .unwrap();
+            let _ = bus.close().await;
+        });
+    }
+
+    /// A hand whose place turns out to be held by another with a smaller nonce (both took
+    /// it at the same moment; the other's claim, declared here by hand, reached it late)
+    /// stops serving with the error naming its id, and its token vanishes.
+    #[test]
+    fn serve_gives_way_to_a_hand_that_holds_its_id_with_a_smaller_nonce() {
+        let rt = tokio::runtime::Runtime::new().unwrap();
+        rt.block_on(async {
+            let run = RunId::new("givewaytest").unwrap();
+            // The hand on the session that connects: one that only listens meets nobody and
+            // holds its place unchallenged.
+            let (bus, hand_bus) = sessions().await;
+            assert!(hand_bus.reaches_out());
+            let hands = bus
+                .watch_alive(&alive_key((&run).into(), Some(AgentKind::Hand)))
+                .await
+                .unwrap();
+            let driver = Flaky {
+                seen: Arc::new(Mutex::new(Vec::new())),
+                object: true,
+            };
+            let (b, r) = (hand_bus.clone(), run.clone());
+            let served =
+                tokio::spawn(async move { serve(&b, &r, "w1", Duration::ZERO, driver).await });
+            let alive = hands.recv().await.unwrap();
+            assert!(alive.alive && alive.agent.id == "w1");
+            assert!(!served.is_finished());
+            let claim = Claim {
+                nonce: 0,
+                held: true,
+            };
+            let _other = bus
+                .session()
+                .liveliness()
+                .declare_token(claim_token(&run, AgentKind::Hand, "w1", claim))
+                .await
+                .unwrap();
+            let e = tokio::time::timeout(Duration::from_secs(2), served)
+                .await
+                .expect("the hand gives way within 2 s")
+                .unwrap()
+                .expect_err("an error");
+            assert!(
+                e.to_string().contains(
+                    "another agent, a hand with the id w1, took its place at the same moment \
+                     and keeps it: this one gives way (give it another --id)"
+                ),
+                "{e}"
+            );
+            let gone = tokio::time::timeout(Duration::from_secs(2), hands.recv())
+                .await
+                .expect("the token vanishes")
+                .unwrap();
+            assert!(!gone.alive && gone.agent.id == "w1", "{gone:?}");
             let _ = bus.close().await;
             let _ = hand_bus.close().await;
         });

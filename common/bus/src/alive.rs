@@ -7,6 +7,7 @@ use graspopt_protocol::keys::{
     parse_alive_key, parse_claim_key,
 };
 use graspopt_protocol::{AgentKind, RunId};
+use tokio::sync::watch;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Subscriber;
@@ -46,8 +47,9 @@ impl AliveWatch {
 pub const UNIQUE_CHECKS: u32 = 6;
 
 /// Looks at the other claims of a place, 150 ms apart, before [`Bus::wait_until_unique`]
-/// holds it, and once more after. Agents that claim together see each other as long as
-/// liveliness reaches them within about 150 ms.
+/// holds it, and once more after. Agents that claim together settle it in these looks when
+/// liveliness reaches them within about 150 ms; later than that, both may hold the place
+/// until their [`Claim`]s see each other (see [`Claim::lost`]).
 pub const CLAIM_CHECKS: u32 = 2;
 
 /// Pause between two looks at the claims of a place.
@@ -55,9 +57,66 @@ const CLAIM_LOOK: std::time::Duration = std::time::Duration::from_millis(150);
 
 /// A place in a run held by this agent (see [`Bus::wait_until_unique`]): keep it as long as
 /// the agent runs; it is released when dropped or when the process dies.
+///
+/// While held, it watches the other held claims of the place: one with a smaller nonce (an
+/// agent that took the place at the same moment, whose claim reached this one late) takes
+/// it from this agent, which must then give way: see [`Claim::lost`].
 #[must_use = "the place is released when the claim is dropped"]
 pub struct Claim {
     _held: Option<LivelinessToken>,
+    /// The liveliness subscriber on the place's claims; its callback sets `lost`.
+    _watch: Option<Subscriber<()>>,
+    /// Why this agent lost the place, once it has.
+    lost: watch::Receiver<Option<String>>,
+}
+
+impl Claim {
+    /// A claim that nobody can take (a session that only listens).
+    fn unchallenged() -> Claim {
+        Claim {
+            _held: None,
+            _watch: None,
+            lost: watch::channel(None).1,
+        }
+    }
+
+    /// Resolves once another agent holds this place with a smaller nonce (both took it at
+    /// the same moment, and liveliness reached them too late to settle it while claiming),
+    /// with the error the agent gives way with: [`BusError::Taken`], naming the place. It
+    /// never resolves while the place stays this agent's. An agent's loop selects on it
+    /// beside its work and, when it resolves, stops taking work and exits with the error.
+    /// Resolves at once when the place is already lost; cancel-safe.
+    pub async fn lost(&self) -> BusError {
+        let mut lost = self.lost.clone();
+        // The reason is copied out at once: the value's guard is not kept across an await.
+        let why = lost
+            .wait_for(Option::is_some)
+            .await
+            .map(|why| why.clone().unwrap_or_default());
+        match why {
+            Ok(why) => BusError::Taken(why),
+            // The watch is gone (an unchallenged claim, or the session closed): nobody can
+            // take the place any more.
+            Err(_) => std::future::pending().await,
+        }
+    }
+}
+
+/// The error of an agent that gives way to another, `what` (e.g. "has just taken its
+/// place"), in `run`'s place of `kind` with `id` (`None`: the run's one agent of `kind`).
+fn gives_way(run: &RunId, kind: AgentKind, id: Option<&str>, what: &str) -> String {
+    let who = match id {
+        Some(id) => format!("a {} with the id {id}", kind.as_str()),
+        None => format!("a {}", kind.as_str()),
+    };
+    format!(
+        "run {run:?}: another agent, {who}, {what}: this one gives way{}",
+        if id.is_some() {
+            " (give it another --id)"
+        } else {
+            ""
+        }
+    )
 }
 
 /// A random nonce for a claim.
@@ -128,8 +187,12 @@ impl Bus {
     /// moment, the smaller number keeps it. An agent that comes second waits, as for a
     /// predecessor, until the deadline: if the first is gone by then (killed while it took
     /// the place), it takes the place; else it gives up with an error. The winner's claim is
-    /// returned; it holds the place until dropped. This is sound while liveliness reaches
-    /// the claimants within about 150 ms. A session that only listens ([`Bus::reaches_out`]
+    /// returned; it holds the place until dropped. These looks settle it when liveliness
+    /// reaches the claimants within about 150 ms; when it comes later (a loaded machine),
+    /// several may hold the place at once, so a holder goes on watching the held claims of
+    /// its place, and one that sees a smaller nonce held loses the place: its
+    /// [`Claim::lost`] resolves, and the agent gives way. Once liveliness arrives, one
+    /// holder is left, whatever the delay. A session that only listens ([`Bus::reaches_out`]
     /// false: the embedded run's, on a fresh loopback port) cannot meet another agent and
     /// skips all this.
     pub async fn wait_until_unique(
@@ -140,7 +203,7 @@ impl Bus {
         wait: std::time::Duration,
     ) -> Result<Claim, BusError> {
         if !self.reaches_out() {
-            return Ok(Claim { _held: None });
+            return Ok(Claim::unchallenged());
         }
         let deadline = tokio::time::Instant::now() + wait;
         self.wait_for_holders(run, kind, id, deadline).await?;
@@ -179,31 +242,70 @@ impl Bus {
                     .into_iter()
                     .find(|c| c.held && c.nonce < nonce);
                 if seen.is_none() {
-                    return Ok(Claim { _held: Some(held) });
+                    let (watch, lost) = self
+                        .watch_claims(
+                            &claims_key,
+                            nonce,
+                            gives_way(
+                                run,
+                                kind,
+                                id,
+                                "took its place at the same moment and keeps it",
+                            ),
+                        )
+                        .await?;
+                    return Ok(Claim {
+                        _held: Some(held),
+                        _watch: Some(watch),
+                        lost,
+                    });
                 }
             }
             // Another agent is taking or holds the place: wait for it to go, as for a
             // predecessor, until the deadline.
             if tokio::time::Instant::now() >= deadline {
-                let what = match id {
-                    Some(id) => format!("a {} with the id {id}", kind.as_str()),
-                    None => format!("a {}", kind.as_str()),
-                };
                 let when = if seen.is_some_and(|c| c.held) {
                     "has just taken its place"
                 } else {
                     "is taking its place at the same moment"
                 };
-                return Err(BusError::Taken(format!(
-                    "run {run:?}: another agent, {what}, {when}: this one gives way{}",
-                    if id.is_some() {
-                        " (give it another --id)"
-                    } else {
-                        ""
-                    }
-                )));
+                return Err(BusError::Taken(gives_way(run, kind, id, when)));
             }
         }
+    }
+
+    /// Watches the held claims under `key` (one place's) for the holder with nonce `mine`:
+    /// the receiver turns to `why` once one with a smaller nonce is seen (those already
+    /// held included). The watch lasts as long as the subscriber returned.
+    async fn watch_claims(
+        &self,
+        key: &str,
+        mine: u64,
+        why: String,
+    ) -> Result<(Subscriber<()>, watch::Receiver<Option<String>>), BusError> {
+        let (lost, on_lost) = watch::channel(None);
+        let sub = self
+            .session()
+            .liveliness()
+            .declare_subscriber(key)
+            .history(true)
+            .callback(move |sample| {
+                let taken = sample.kind() == SampleKind::Put
+                    && parse_claim_key(sample.key_expr().as_str())
+                        .is_some_and(|c| c.held && c.nonce < mine);
+                if taken {
+                    lost.send_if_modified(|l| {
+                        let first = l.is_none();
+                        if first {
+                            *l = Some(why.clone());
+                        }
+                        first
+                    });
+                }
+            })
+            .await
+            .map_err(|e| BusError::zenoh(format!("watching liveliness {key}"), e))?;
+        Ok((sub, on_lost))
     }
 
     /// The claims alive under `key`.
