@@ -357,7 +357,6 @@ pub fn record(journal: &mut Journal, run: &RunId, writes: &[Write]) -> anyhow::R
 
 #[cfg(test)]
 mod tests {
-    use graspopt_bus::{BusArgs, free_loopback_port};
     use graspopt_protocol::PlannerMethod;
     use graspopt_protocol::keys::{Claim, claim_token};
     use graspopt_sim::ParamKind;
@@ -372,20 +371,14 @@ mod tests {
     fn a_coordinator_gives_way_to_one_that_holds_its_run_with_a_smaller_nonce() {
         let rt = tokio::runtime::Runtime::new().unwrap();
         rt.block_on(async {
-            let endpoint = format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap());
-            let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
-            args.no_shm = true;
-            let hub = Bus::open(&args).await.unwrap();
             // The coordinator on the session that connects: one that only listens meets
             // nobody and holds its run unchallenged.
-            let mut args = BusArgs::loopback(Vec::new(), vec![endpoint]);
-            args.no_shm = true;
-            let bus = Bus::open(&args).await.unwrap();
+            let sessions = Bus::loopback(1).await.unwrap();
+            let (hub, bus) = (sessions.hub, sessions.peers.into_iter().next().unwrap());
             assert!(bus.reaches_out());
-            let dir = std::env::temp_dir().join(format!("graspopt-giveway-{}", std::process::id()));
-            std::fs::create_dir_all(&dir).unwrap();
+            let dir = tempfile::tempdir().unwrap();
             let config = CoordinatorConfig {
-                journal: dir.join("journal.sqlite"),
+                journal: dir.path().join("journal.sqlite"),
                 ..CoordinatorConfig::default()
             };
             let run_id = RunId::new("givewayrun").unwrap();
@@ -432,7 +425,6 @@ mod tests {
             let record = journal.run(run_id.as_str()).unwrap().expect("the run");
             assert_eq!(record.status, RunLifecycle::Running);
             drop(journal);
-            let _ = std::fs::remove_dir_all(&dir);
             let _ = bus.close().await;
             let _ = hub.close().await;
         });

@@ -200,7 +200,7 @@ pub fn tag_wrenches(
 mod tests {
     use std::sync::{Arc, Mutex};
 
-    use graspopt_bus::{BusArgs, CloudReceiver, CongestionControl, free_loopback_port};
+    use graspopt_bus::{CloudReceiver, CongestionControl};
     use graspopt_protocol::keys::{Claim, alive_key, claim_token};
     use graspopt_protocol::{CloudPoint, Encoding, FingerCloud, Pose};
 
@@ -280,13 +280,8 @@ mod tests {
 
     /// A session listening on loopback (the hand's) and one connected to it.
     async fn sessions() -> (Bus, Bus) {
-        let endpoint = format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap());
-        let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
-        args.no_shm = true;
-        let listening = Bus::open(&args).await.unwrap();
-        let mut args = BusArgs::loopback(Vec::new(), vec![endpoint]);
-        args.no_shm = true;
-        (listening, Bus::open(&args).await.unwrap())
+        let s = Bus::loopback(1).await.unwrap();
+        (s.hub, s.peers.into_iter().next().unwrap())
     }
 
     /// Trial, attempt, worker, hand, number of clouds and error of a clouds message.

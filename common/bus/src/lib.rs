@@ -26,8 +26,8 @@ pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
 pub use error::BusError;
 pub use inbox::Inbox;
 pub use session::{
-    Bus, Incoming, RawSample, RawSubscription, Received, Server, Subscription, host_name,
-    protocol_encoding, zenoh_encoding,
+    Bus, Incoming, LoopbackSessions, RawSample, RawSubscription, Received, Server, Subscription,
+    host_name, protocol_encoding, zenoh_encoding,
 };
 /// Whether a put waits (`Block`) or drops (`Drop`) under congestion.
 pub use zenoh::qos::CongestionControl;

@@ -59,7 +59,45 @@ pub fn host_name() -> String {
     graspopt_protocol::keys::sanitize_chunk(raw.trim())
 }
 
+/// Sessions on loopback for tests: a hub listening on a free port (`endpoint`) and sessions
+/// connected to it, none with shared memory.
+pub struct LoopbackSessions {
+    /// The listening session.
+    pub hub: Bus,
+    /// Where the hub listens (`tcp/127.0.0.1:PORT`), for more peers ([`Bus::loopback_peer`]).
+    pub endpoint: String,
+    /// The connected sessions.
+    pub peers: Vec<Bus>,
+}
+
 impl Bus {
+    /// A hub on a free loopback port and `peers` sessions connected to it (no shared
+    /// memory): what a test of several agents on one machine needs.
+    pub async fn loopback(peers: usize) -> Result<LoopbackSessions, BusError> {
+        let port = crate::free_loopback_port()
+            .map_err(|e| BusError::Config(format!("no free loopback port: {e}")))?;
+        let endpoint = format!("tcp/127.0.0.1:{port}");
+        let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
+        args.no_shm = true;
+        let hub = Bus::open(&args).await?;
+        let mut connected = Vec::with_capacity(peers);
+        for _ in 0..peers {
+            connected.push(Bus::loopback_peer(&endpoint).await?);
+        }
+        Ok(LoopbackSessions {
+            hub,
+            endpoint,
+            peers: connected,
+        })
+    }
+
+    /// A session connected to `endpoint` (a [`Bus::loopback`] hub's), without shared memory.
+    pub async fn loopback_peer(endpoint: &str) -> Result<Bus, BusError> {
+        let mut args = BusArgs::loopback(Vec::new(), vec![endpoint.to_string()]);
+        args.no_shm = true;
+        Bus::open(&args).await
+    }
+
     /// Opens a session from the flags.
     pub async fn open(args: &BusArgs) -> Result<Bus, BusError> {
         let config = args.zenoh_config()?;

@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use graspopt_bus::{Bus, BusArgs, BusError, free_loopback_port};
+use graspopt_bus::{Bus, BusError};
 use graspopt_protocol::{PlannerMethod, RunId, SuggestReply, SuggestRequest};
 
 const KEY: &str = "graspopt/querytest/planner/suggest";
@@ -25,15 +25,10 @@ fn request(run: &RunId) -> SuggestRequest {
 }
 
 async fn sessions() -> (Bus, Bus, Bus) {
-    let endpoint = format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap());
-    let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
-    args.no_shm = true;
-    let hub = Bus::open(&args).await.unwrap();
-    let mut args = BusArgs::loopback(Vec::new(), vec![endpoint]);
-    args.no_shm = true;
-    let a = Bus::open(&args).await.unwrap();
-    let b = Bus::open(&args).await.unwrap();
-    (hub, a, b)
+    let s = Bus::loopback(2).await.unwrap();
+    let mut peers = s.peers.into_iter();
+    let (a, b) = (peers.next().unwrap(), peers.next().unwrap());
+    (s.hub, a, b)
 }
 
 #[test]

@@ -5,26 +5,18 @@
 
 use std::time::Duration;
 
-use graspopt_bus::{Bus, BusArgs, BusError, free_loopback_port};
+use graspopt_bus::{Bus, BusError};
 use graspopt_protocol::keys::{Claim as ClaimKey, claim_token};
 use graspopt_protocol::{AgentKind, RunId};
 
 async fn hub_and_peers(n: usize) -> (Bus, String, Vec<Bus>) {
-    let endpoint = format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap());
-    let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
-    args.no_shm = true;
-    let hub = Bus::open(&args).await.unwrap();
-    let mut peers = Vec::new();
-    for _ in 0..n {
-        peers.push(peer(&endpoint).await);
-    }
-    (hub, endpoint, peers)
+    let s = Bus::loopback(n).await.unwrap();
+    assert!(s.peers.iter().all(Bus::reaches_out));
+    (s.hub, s.endpoint, s.peers)
 }
 
 async fn peer(endpoint: &str) -> Bus {
-    let mut args = BusArgs::loopback(Vec::new(), vec![endpoint.to_string()]);
-    args.no_shm = true;
-    let bus = Bus::open(&args).await.unwrap();
+    let bus = Bus::loopback_peer(endpoint).await.unwrap();
     assert!(bus.reaches_out());
     bus
 }
