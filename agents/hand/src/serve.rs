@@ -25,9 +25,8 @@ pub const UNIQUE_WAIT: Duration = Duration::from_secs(5);
 /// `error`. Messages of other runs or workers, and ones that do not decode, are counted and
 /// logged. Should another hand with the id turn out to hold the place too (both claimed
 /// it at the same moment and liveliness came late, see [`graspopt_bus::Claim::lost`]), the
-/// one that gives
-/// way takes no more commands and returns the error naming it (a trial already running is
-/// finished and sent first).
+/// one that gives way takes no more commands and returns the error naming it (a trial
+/// already running is finished and sent first).
 pub async fn serve(
     bus: &Bus,
     run: &RunId,
