@@ -21,6 +21,7 @@ import queue
 import random
 import socket
 import sys
+import threading
 import time
 
 import zenoh
@@ -60,39 +61,81 @@ def measure(grasps, command):
     return best, None
 
 
+PHASES = ("starting", "held", "settled")
+SETTLE_AFTER_S = 2.0
+
+
 def claim_of(key):
-    """The claim a claim key names, (number, held), or None for another key."""
+    """The claim a claim key names, (number, phase), or None for another key."""
     number, phase = key.split("/")[-2:]
-    if len(number) != 16 or phase not in ("starting", "held"):
+    if len(number) != 16 or phase not in PHASES:
         return None
     try:
-        return int(number, 16), phase == "held"
+        return int(number, 16), phase
     except ValueError:
         return None
 
 
+def gives_way_to(mine, settled, other):
+    """Whether a holder with number `mine` (settled or not) gives way to the claim `other`:
+    before it has held its place for SETTLE_AFTER_S, to a smaller number held (taken at the
+    same moment) or to anyone settled (this one is the newcomer whose view came late); once
+    settled, only to a smaller number settled."""
+    number, phase = other
+    if number == mine or phase == "starting":
+        return False
+    if phase == "held":
+        return not settled and number < mine
+    return not settled or number < mine
+
+
 class Place:
     """A hand's place in a run, held (see take_place): keep it while the hand runs, undeclare
-    it when the hand stops. It watches the held claims of the place: should another hand
-    with the id hold it with a smaller number (the two took it at the same moment and each
-    one's claim reached the other late), `lost` turns to the reason this hand gives way,
-    and `on_lost()` is called (from Zenoh's thread): take no more commands, and exit."""
+    it when the hand stops. After SETTLE_AFTER_S it declares itself settled. It watches the
+    claims of the place: should another hand with the id come first (see gives_way_to; the
+    two took it at the same moment and each one's claim reached the other late), `lost`
+    turns to the reason this hand gives way, and `on_lost()` is called (from Zenoh's
+    thread): take no more commands, and exit."""
 
     def __init__(self, session, claims_key, nonce, held, lost_why, on_lost):
         self.lost = None
         self._held = held
+        self._settled = None
+        self._is_settled = False
+        self._lock = threading.Lock()
 
         def watch(sample):
             claim = claim_of(str(sample.key_expr))
-            if (self.lost is None and sample.kind == zenoh.SampleKind.PUT and claim
-                    and claim[1] and claim[0] < nonce):
-                self.lost = lost_why
-                on_lost()
+            if not claim or sample.kind != zenoh.SampleKind.PUT:
+                return
+            with self._lock:
+                if self.lost is None and gives_way_to(nonce, self._is_settled, claim):
+                    self.lost = lost_why
+                    on_lost()
 
+        def settle():
+            with self._lock:
+                if self.lost is not None or self._stopped:
+                    return
+                # Settled before the token is out: a claim seen from now on is judged as
+                # the others will judge this one's.
+                self._is_settled = True
+                self._settled = session.liveliness().declare_token(
+                    f"{claims_key}/{nonce:016x}/settled")
+
+        self._stopped = False
         self._watch = session.liveliness().declare_subscriber(
             f"{claims_key}/**", watch, history=True)
+        self._timer = threading.Timer(SETTLE_AFTER_S, settle)
+        self._timer.daemon = True
+        self._timer.start()
 
     def undeclare(self):
+        self._timer.cancel()
+        with self._lock:
+            self._stopped = True
+            if self._settled is not None:
+                self._settled.undeclare()
         self._watch.undeclare()
         self._held.undeclare()
 
@@ -105,8 +148,9 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
     row, 0.2 s apart. Then claims the place with a random number and looks at the other
     claims twice, 0.15 s apart: a held claim, then the smallest number, comes first; seeing
     none, holds the place and looks once more. Exits if the place stays taken. While held,
-    the place watches for a held claim with a smaller number (see Place): liveliness that
-    came too late for these looks (a loaded machine) still leaves one hand with the id."""
+    the place watches for a claim that comes first (see Place and gives_way_to): liveliness
+    that came too late for these looks (a loaded machine) still leaves one hand with the id,
+    and a newcomer whose view came late gives way to the hand that held the place before."""
     deadline = time.monotonic() + wait_s
 
     def keys(key_expr):
@@ -129,7 +173,9 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
 
     def blocker(seen):
         others = [c for c in seen if c[0] != nonce]
-        return next((c for c in others if c[1]), None) or next(
+        holding = sorted((c for c in others if c[1] != "starting"),
+                         key=lambda c: (-PHASES.index(c[1]), c[0]))
+        return (holding or [None])[0] or next(
             (c for c in sorted(others) if c[0] < nonce), None)
 
     starting = session.liveliness().declare_token(f"{claims_key}/{nonce:016x}/starting")
@@ -143,7 +189,7 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
         if not seen:
             held = session.liveliness().declare_token(f"{claims_key}/{nonce:016x}/held")
             time.sleep(0.15)
-            seen = next((c for c in claims() if c[1] and c[0] < nonce), None)
+            seen = next((c for c in claims() if gives_way_to(nonce, False, c)), None)
             if not seen:
                 place = Place(session, claims_key, nonce, held,
                               f"{hand_id}: another hand with this id took the run's place at the "
@@ -154,6 +200,9 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
             held.undeclare()
         if time.monotonic() >= deadline:
             starting.undeclare()
+            if seen[1] != "starting":
+                sys.exit(f"{hand_id}: the run already has a hand with this id: "
+                         "stop it first, or give this one another --id")
             sys.exit(f"{hand_id}: another hand with this id is taking the run's place at the "
                      "same moment: this one gives way (give it another --id)")
 

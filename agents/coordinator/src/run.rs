@@ -358,7 +358,7 @@ pub fn record(journal: &mut Journal, run: &RunId, writes: &[Write]) -> anyhow::R
 #[cfg(test)]
 mod tests {
     use graspopt_protocol::PlannerMethod;
-    use graspopt_protocol::keys::{Claim, claim_token};
+    use graspopt_protocol::keys::{Claim, ClaimPhase, claim_token};
     use graspopt_sim::ParamKind;
 
     use super::*;
@@ -407,7 +407,7 @@ mod tests {
                     assert!(alive.alive, "{alive:?}");
                     let claim = Claim {
                         nonce: 0,
-                        held: true,
+                        phase: ClaimPhase::Settled,
                     };
                     let key = claim_token(&run_id, AgentKind::Coordinator, "any", claim);
                     hub.session().liveliness().declare_token(key).await.unwrap()

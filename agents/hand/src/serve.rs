@@ -200,7 +200,7 @@ mod tests {
     use std::sync::{Arc, Mutex};
 
     use graspopt_bus::{CloudReceiver, CongestionControl};
-    use graspopt_protocol::keys::{Claim, alive_key, claim_token};
+    use graspopt_protocol::keys::{Claim, ClaimPhase, alive_key, claim_token};
     use graspopt_protocol::{CloudPoint, Encoding, FingerCloud, Pose};
 
     use super::*;
@@ -432,7 +432,7 @@ mod tests {
             assert!(!served.is_finished());
             let claim = Claim {
                 nonce: 0,
-                held: true,
+                phase: ClaimPhase::Settled,
             };
             let _other = bus
                 .session()

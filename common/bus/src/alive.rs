@@ -3,7 +3,7 @@
 //! network, which is how a killed hand worker is noticed.
 
 use graspopt_protocol::keys::{
-    AliveKey, Claim as ClaimKey, alive_key, alive_token, claim_slot_key, claim_token,
+    AliveKey, Claim as ClaimKey, ClaimPhase, alive_key, alive_token, claim_slot_key, claim_token,
     parse_alive_key, parse_claim_key,
 };
 use graspopt_protocol::{AgentKind, RunId};
@@ -13,6 +13,7 @@ use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Subscriber;
 use zenoh::sample::{Sample, SampleKind};
 
+use crate::task::OwnedTask;
 use crate::{Bus, BusError};
 
 /// An agent appeared or vanished.
@@ -55,17 +56,28 @@ pub const CLAIM_CHECKS: u32 = 2;
 /// Pause between two looks at the claims of a place.
 const CLAIM_LOOK: std::time::Duration = std::time::Duration::from_millis(150);
 
+/// How long an agent holds its place before it settles in it ([`ClaimPhase::Settled`]). A
+/// holder that has not settled yet gives way to a smaller nonce held (an agent that took
+/// the place at the same moment) and to anyone settled; a settled one gives way only to a
+/// smaller nonce settled. So a newcomer whose view of the claims came late (it found the
+/// place free and held it) gives way to the agent that held the place before it, whatever
+/// their nonces, unless its view stayed blind for longer than this after it held.
+pub const SETTLE_AFTER: std::time::Duration = std::time::Duration::from_secs(2);
+
 /// A place in a run held by this agent (see [`Bus::wait_until_unique`]): keep it as long as
 /// the agent runs; it is released when dropped or when the process dies.
 ///
-/// While held, it watches the other held claims of the place: one with a smaller nonce (an
-/// agent that took the place at the same moment, whose claim reached this one late) takes
-/// it from this agent, which must then give way: see [`Claim::lost`].
+/// While held, it watches the other held claims of the place: an agent that took the place
+/// at the same moment (its claim reached this one late) and comes first by the rule of
+/// [`SETTLE_AFTER`] takes it from this agent, which must then give way: see
+/// [`Claim::lost`]. After [`SETTLE_AFTER`] it declares itself settled.
 #[must_use = "the place is released when the claim is dropped"]
 pub struct Claim {
     _held: Option<LivelinessToken>,
     /// The liveliness subscriber on the place's claims; its callback sets `lost`.
     _watch: Option<Subscriber<()>>,
+    /// Declares the settled claim after [`SETTLE_AFTER`] and keeps it.
+    _settle: Option<OwnedTask>,
     /// Why this agent lost the place, once it has.
     lost: watch::Receiver<Option<String>>,
 }
@@ -76,16 +88,18 @@ impl Claim {
         Claim {
             _held: None,
             _watch: None,
+            _settle: None,
             lost: watch::channel(None).1,
         }
     }
 
-    /// Resolves once another agent holds this place with a smaller nonce (both took it at
-    /// the same moment, and liveliness reached them too late to settle it while claiming),
-    /// with the error the agent gives way with: [`BusError::Taken`], naming the place. It
-    /// never resolves while the place stays this agent's. An agent's loop selects on it
-    /// beside its work and, when it resolves, stops taking work and exits with the error.
-    /// Resolves at once when the place is already lost; cancel-safe.
+    /// Resolves once another agent comes first for this place (both took it at the same
+    /// moment, and liveliness reached them too late to settle it while claiming; see
+    /// [`SETTLE_AFTER`] for who comes first), with the error the agent gives way with:
+    /// [`BusError::Taken`], naming the place. It never resolves while the place stays this
+    /// agent's. An agent's loop selects on it beside its work and, when it resolves, stops
+    /// taking work and exits with the error. Resolves at once when the place is already
+    /// lost; cancel-safe.
     pub async fn lost(&self) -> BusError {
         let mut lost = self.lost.clone();
         // The reason is copied out at once: the value's guard is not kept across an await.
@@ -102,8 +116,27 @@ impl Claim {
     }
 }
 
-/// The error of an agent that gives way to another, `what` (e.g. "has just taken its
-/// place"), in `run`'s place of `kind` with `id` (`None`: the run's one agent of `kind`).
+/// Where a holder stands, shared by its claims' watch and the task that settles it.
+#[derive(Default)]
+struct Standing {
+    settled: bool,
+    lost: bool,
+}
+
+/// Whether a holder with nonce `mine` (`settled` or not) gives way to `other`, a claim of
+/// its place: see [`SETTLE_AFTER`].
+fn gives_way_to(mine: u64, settled: bool, other: ClaimKey) -> bool {
+    other.nonce != mine
+        && match other.phase {
+            ClaimPhase::Starting => false,
+            ClaimPhase::Held => !settled && other.nonce < mine,
+            ClaimPhase::Settled => !settled || other.nonce < mine,
+        }
+}
+
+/// The error of an agent that gives way to another, `what` (e.g. "took its place at the
+/// same moment and keeps it"), in `run`'s place of `kind` with `id` (`None`: the run's one
+/// agent of `kind`).
 fn gives_way(run: &RunId, kind: AgentKind, id: Option<&str>, what: &str) -> String {
     let who = match id {
         Some(id) => format!("a {} with the id {id}", kind.as_str()),
@@ -113,6 +146,30 @@ fn gives_way(run: &RunId, kind: AgentKind, id: Option<&str>, what: &str) -> Stri
         "run {run:?}: another agent, {who}, {what}: this one gives way{}",
         if id.is_some() {
             " (give it another --id)"
+        } else {
+            ""
+        }
+    )
+}
+
+/// The error of an agent whose place in `run` is held by `holder` (of `kind`, with `id`;
+/// `None` when only its claim was seen).
+fn already_has(
+    run: &RunId,
+    kind: AgentKind,
+    id: Option<&str>,
+    holder: Option<&AliveKey>,
+) -> String {
+    let what = match (id, holder) {
+        (Some(id), _) => format!("a {} with the id {id}", kind.as_str()),
+        (None, Some(holder)) => format!("a {} ({})", kind.as_str(), holder.id),
+        (None, None) => format!("a {}", kind.as_str()),
+    };
+    let host = holder.map_or(String::new(), |h| format!(", alive on host {}", h.host));
+    format!(
+        "run {run:?} already has {what}{host}: stop it first{}",
+        if id.is_some() {
+            ", or give this one another --id"
         } else {
             ""
         }
@@ -131,13 +188,13 @@ fn claim_nonce() -> u64 {
 }
 
 /// Who keeps a claimant with nonce `mine` from its place, among `claims`: another agent
-/// holding it, else a smaller starting nonce.
+/// holding it (a settled one first), else a smaller starting nonce.
 fn blocker(claims: &[ClaimKey], mine: u64) -> Option<ClaimKey> {
     let others = claims.iter().filter(|c| c.nonce != mine);
     others
         .clone()
-        .filter(|c| c.held)
-        .min_by_key(|c| c.nonce)
+        .filter(|c| c.phase.holds())
+        .max_by_key(|c| (c.phase, std::cmp::Reverse(c.nonce)))
         .or_else(|| others.filter(|c| c.nonce < mine).min_by_key(|c| c.nonce))
         .copied()
 }
@@ -189,9 +246,11 @@ impl Bus {
     /// the place), it takes the place; else it gives up with an error. The winner's claim is
     /// returned; it holds the place until dropped. These looks settle it when liveliness
     /// reaches the claimants within about 150 ms; when it comes later (a loaded machine),
-    /// several may hold the place at once, so a holder goes on watching the held claims of
-    /// its place, and one that sees a smaller nonce held loses the place: its
-    /// [`Claim::lost`] resolves, and the agent gives way. Once liveliness arrives, one
+    /// several may hold the place at once, so a holder goes on watching the claims of its
+    /// place, and one that sees another come first loses the place: its [`Claim::lost`]
+    /// resolves, and the agent gives way. Who comes first: the agent that has held the
+    /// place for [`SETTLE_AFTER`] (a newcomer whose view of the claims came late gives way
+    /// to it), else the smaller number. Once liveliness arrives, one
     /// holder is left, whatever the delay. A session that only listens ([`Bus::reaches_out`]
     /// false: the embedded run's, on a fresh loopback port) cannot meet another agent and
     /// skips all this.
@@ -209,22 +268,22 @@ impl Bus {
         self.wait_for_holders(run, kind, id, deadline).await?;
         let slot = id.unwrap_or("any");
         let nonce = claim_nonce();
-        let declare = |held: bool| {
-            let key = claim_token(run, kind, slot, ClaimKey { nonce, held });
+        let declare = |phase: ClaimPhase| {
+            let key = claim_token(run, kind, slot, ClaimKey { nonce, phase });
+            let session = self.session().clone();
             async move {
-                self.session()
+                session
                     .liveliness()
                     .declare_token(key.clone())
                     .await
                     .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
             }
         };
-        let _starting = declare(false).await?;
+        let _starting = declare(ClaimPhase::Starting).await?;
         let claims_key = claim_slot_key(run, kind, slot);
         loop {
             // Looks until another claimant is seen; none: hold the place, and look once
-            // more in case another claimant held it at the same moment (the smaller nonce
-            // keeps it).
+            // more in case another claimant held it at the same moment.
             let mut seen = None;
             for _ in 0..CLAIM_CHECKS {
                 tokio::time::sleep(CLAIM_LOOK).await;
@@ -234,18 +293,20 @@ impl Bus {
                 }
             }
             if seen.is_none() {
-                let held = declare(true).await?;
+                let held = declare(ClaimPhase::Held).await?;
                 tokio::time::sleep(CLAIM_LOOK).await;
                 seen = self
                     .claims(&claims_key)
                     .await?
                     .into_iter()
-                    .find(|c| c.held && c.nonce < nonce);
+                    .find(|c| gives_way_to(nonce, false, *c));
                 if seen.is_none() {
+                    let standing = std::sync::Arc::new(std::sync::Mutex::new(Standing::default()));
                     let (watch, lost) = self
                         .watch_claims(
                             &claims_key,
                             nonce,
+                            standing.clone(),
                             gives_way(
                                 run,
                                 kind,
@@ -254,9 +315,30 @@ impl Bus {
                             ),
                         )
                         .await?;
+                    let settle = declare(ClaimPhase::Settled);
+                    let settle = OwnedTask::spawn(async move {
+                        tokio::time::sleep(SETTLE_AFTER).await;
+                        {
+                            let mut standing = lock(&standing);
+                            if standing.lost {
+                                return;
+                            }
+                            // Settled before the token is out: a claim seen from now on
+                            // is judged as the others will judge this one's.
+                            standing.settled = true;
+                        }
+                        match settle.await {
+                            Ok(token) => {
+                                std::future::pending::<()>().await;
+                                drop(token);
+                            }
+                            Err(_) => lock(&standing).settled = false,
+                        }
+                    });
                     return Ok(Claim {
                         _held: Some(held),
                         _watch: Some(watch),
+                        _settle: Some(settle),
                         lost,
                     });
                 }
@@ -264,23 +346,27 @@ impl Bus {
             // Another agent is taking or holds the place: wait for it to go, as for a
             // predecessor, until the deadline.
             if tokio::time::Instant::now() >= deadline {
-                let when = if seen.is_some_and(|c| c.held) {
-                    "has just taken its place"
-                } else {
-                    "is taking its place at the same moment"
+                let e = match seen {
+                    Some(c) if c.phase.holds() => {
+                        let holders = self.holders(run, kind, id).await.unwrap_or_default();
+                        already_has(run, kind, id, holders.first())
+                    }
+                    _ => gives_way(run, kind, id, "is taking its place at the same moment"),
                 };
-                return Err(BusError::Taken(gives_way(run, kind, id, when)));
+                return Err(BusError::Taken(e));
             }
         }
     }
 
-    /// Watches the held claims under `key` (one place's) for the holder with nonce `mine`:
-    /// the receiver turns to `why` once one with a smaller nonce is seen (those already
-    /// held included). The watch lasts as long as the subscriber returned.
+    /// Watches the claims under `key` (one place's) for the holder with nonce `mine`: the
+    /// receiver turns to `why` once a claim it gives way to is seen (those already declared
+    /// included; see [`gives_way_to`]), and `standing` records it. The watch lasts as long as
+    /// the subscriber returned.
     async fn watch_claims(
         &self,
         key: &str,
         mine: u64,
+        standing: std::sync::Arc<std::sync::Mutex<Standing>>,
         why: String,
     ) -> Result<(Subscriber<()>, watch::Receiver<Option<String>>), BusError> {
         let (lost, on_lost) = watch::channel(None);
@@ -290,17 +376,16 @@ impl Bus {
             .declare_subscriber(key)
             .history(true)
             .callback(move |sample| {
-                let taken = sample.kind() == SampleKind::Put
-                    && parse_claim_key(sample.key_expr().as_str())
-                        .is_some_and(|c| c.held && c.nonce < mine);
-                if taken {
-                    lost.send_if_modified(|l| {
-                        let first = l.is_none();
-                        if first {
-                            *l = Some(why.clone());
-                        }
-                        first
-                    });
+                let Some(other) = parse_claim_key(sample.key_expr().as_str()) else {
+                    return;
+                };
+                if sample.kind() != SampleKind::Put {
+                    return;
+                }
+                let mut standing = lock(&standing);
+                if !standing.lost && gives_way_to(mine, standing.settled, other) {
+                    standing.lost = true;
+                    lost.send_replace(Some(why.clone()));
                 }
             })
             .await
@@ -347,12 +432,7 @@ impl Bus {
     ) -> Result<(), BusError> {
         let mut free = 0;
         loop {
-            let holders: Vec<AliveKey> = self
-                .alive_now(&alive_key(run.into(), Some(kind)))
-                .await?
-                .into_iter()
-                .filter(|a| a.run == *run && id.is_none_or(|id| a.id == id))
-                .collect();
+            let holders = self.holders(run, kind, id).await?;
             match holders.first() {
                 None => {
                     free += 1;
@@ -363,19 +443,7 @@ impl Bus {
                 Some(holder) => {
                     free = 0;
                     if tokio::time::Instant::now() >= deadline {
-                        let what = match id {
-                            Some(id) => format!("a {} with the id {id}", kind.as_str()),
-                            None => format!("a {} ({})", kind.as_str(), holder.id),
-                        };
-                        return Err(BusError::Taken(format!(
-                            "run {run:?} already has {what}, alive on host {}: stop it first{}",
-                            holder.host,
-                            if id.is_some() {
-                                ", or give this one another --id"
-                            } else {
-                                ""
-                            }
-                        )));
+                        return Err(BusError::Taken(already_has(run, kind, id, Some(holder))));
                     }
                 }
             }
@@ -383,8 +451,31 @@ impl Bus {
         }
     }
 
+    /// The live agents of `kind` in `run` that hold the place of `id` (any of them when
+    /// `id` is `None`).
+    async fn holders(
+        &self,
+        run: &RunId,
+        kind: AgentKind,
+        id: Option<&str>,
+    ) -> Result<Vec<AliveKey>, BusError> {
+        Ok(self
+            .alive_now(&alive_key(run.into(), Some(kind)))
+            .await?
+            .into_iter()
+            .filter(|a| a.run == *run && id.is_none_or(|id| a.id == id))
+            .collect())
+    }
+
     /// The agents alive now under `key`.
     pub async fn alive_now(&self, key: &str) -> Result<Vec<AliveKey>, BusError> {
         self.tokens(key, parse_alive_key).await
     }
+}
+
+/// Locks a holder's standing (a poisoned lock still holds a consistent pair of flags).
+fn lock(standing: &std::sync::Mutex<Standing>) -> std::sync::MutexGuard<'_, Standing> {
+    standing
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }

@@ -12,6 +12,7 @@ use graspopt_protocol::{ContactClouds, DecodeError, Encoding, RunId, layout};
 use graspopt_shm::{ShmPublisher, ShmSubscriber};
 use tokio::sync::mpsc;
 
+use crate::task::OwnedTask;
 use crate::{Bus, BusError};
 
 /// Which path a cloud took.
@@ -99,13 +100,7 @@ pub struct ReceivedClouds {
 pub struct CloudReceiver {
     rx: mpsc::Receiver<ReceivedClouds>,
     _shm: Option<ShmSubscriber>,
-    task: tokio::task::JoinHandle<()>,
-}
-
-impl Drop for CloudReceiver {
-    fn drop(&mut self) {
-        self.task.abort();
-    }
+    _task: OwnedTask,
 }
 
 impl CloudReceiver {
@@ -135,7 +130,7 @@ impl CloudReceiver {
             None => None,
         };
         let sub = bus.subscribe(&CLOUDS.key(run.into())).await?;
-        let task = tokio::spawn(async move {
+        let task = OwnedTask::spawn(async move {
             while let Some(r) = sub.recv().await {
                 let received = ReceivedClouds {
                     path: CloudPath::Zenoh,
@@ -150,7 +145,7 @@ impl CloudReceiver {
         Ok(CloudReceiver {
             rx,
             _shm: shm,
-            task,
+            _task: task,
         })
     }
 

@@ -19,6 +19,7 @@ pub mod clouds;
 pub mod error;
 pub mod inbox;
 pub mod session;
+mod task;
 
 pub use alive::{AliveEvent, AliveWatch, Claim};
 pub use args::{BusArgs, BusMode};

@@ -1,12 +1,15 @@
 //! Taking a place in a run over real sessions on loopback: of agents that start at the same
 //! moment with one id, exactly one gets the place; a later one is refused while it is held
-//! and gets it once the holder is gone; a holder whose place is also held with a smaller
-//! nonce (liveliness that came too late to settle it while claiming) gives way.
+//! and gets it once the holder is gone; a holder whose place is also held by one that comes
+//! first (liveliness that came too late to settle it while claiming) gives way.
 
 use std::time::Duration;
 
+use graspopt_bus::alive::SETTLE_AFTER;
 use graspopt_bus::{Bus, BusError};
-use graspopt_protocol::keys::{Claim as ClaimKey, claim_token};
+use graspopt_protocol::keys::{
+    Claim as ClaimKey, ClaimPhase, claim_slot_key, claim_token, parse_claim_key,
+};
 use graspopt_protocol::{AgentKind, RunId};
 
 async fn hub_and_peers(n: usize) -> (Bus, String, Vec<Bus>) {
@@ -53,7 +56,11 @@ fn of_agents_starting_together_one_takes_the_place() {
             .err()
             .expect("the place is held");
         assert!(matches!(e, BusError::Taken(_)), "{e}");
-        assert!(e.to_string().contains("has just taken its place"), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "run \"uniquetest\" already has a hand with the id h1: stop it first, or give \
+             this one another --id"
+        );
         // One claimant a moment after another (the first is looking, or already holds it):
         // one place, one holder.
         for lag_ms in [100, 250, 400] {
@@ -89,30 +96,26 @@ fn of_agents_starting_together_one_takes_the_place() {
 }
 
 /// Two agents that both took a place because their claims reached each other too late
-/// (a loaded machine): the second's held claim is declared by hand, after the first holds
-/// the place, as the first would see it arrive. A held claim with a larger nonce leaves the
-/// holder in place; a starting one with a smaller nonce too (it waits for the holder); a
-/// held one with a smaller nonce takes the place: the holder's `lost` resolves within a
-/// second, with an error naming the place, and stays resolved. Another place's holder is
-/// not touched.
+/// (a loaded machine): the other's claims are declared by hand, after the holder holds the
+/// place, as the holder would see them arrive.
+/// - A holder that has not settled yet (it took the place less than `SETTLE_AFTER` ago)
+///   stays for a held claim with a larger nonce or a starting one with a smaller nonce, and
+///   gives way within a second to a held one with a smaller nonce (they took it at the same
+///   moment) or a settled one with any nonce (it is the newcomer whose view came late).
+/// - A settled holder stays for a held claim with a smaller nonce (a newcomer) and a
+///   settled one with a larger nonce, and gives way to a settled one with a smaller nonce
+///   (both settled before they saw each other).
+/// - Another place's holder is not touched.
 #[test]
-fn a_holder_gives_way_to_a_smaller_nonce_held_late() {
+fn a_holder_gives_way_to_who_comes_first() {
     let rt = tokio::runtime::Runtime::new().unwrap();
     rt.block_on(async {
         let run = RunId::new("uniquelate").unwrap();
         let (_hub, _endpoint, peers) = hub_and_peers(3).await;
         let wait = Duration::from_millis(500);
-        let holder = peers[0]
-            .wait_until_unique(&run, AgentKind::Hand, Some("h1"), wait)
-            .await
-            .unwrap();
-        let neighbour = peers[1]
-            .wait_until_unique(&run, AgentKind::Hand, Some("h2"), wait)
-            .await
-            .unwrap();
         let late = &peers[2];
-        let declare = |nonce: u64, held: bool| {
-            let key = claim_token(&run, AgentKind::Hand, "h1", ClaimKey { nonce, held });
+        let declare = |slot: &'static str, nonce: u64, phase: ClaimPhase| {
+            let key = claim_token(&run, AgentKind::Hand, slot, ClaimKey { nonce, phase });
             async move {
                 late.session()
                     .liveliness()
@@ -121,17 +124,26 @@ fn a_holder_gives_way_to_a_smaller_nonce_held_late() {
                     .unwrap()
             }
         };
-        let larger = declare(u64::MAX, true).await;
-        let starting = declare(0, false).await;
+        let established = peers[1]
+            .wait_until_unique(&run, AgentKind::Hand, Some("h3"), wait)
+            .await
+            .unwrap();
+        let holder = peers[0]
+            .wait_until_unique(&run, AgentKind::Hand, Some("h1"), wait)
+            .await
+            .unwrap();
+        let larger = declare("h1", u64::MAX, ClaimPhase::Held).await;
+        let starting = declare("h1", 0, ClaimPhase::Starting).await;
         // Agents await it inside spawned tasks.
         fn sendable(_: &impl Send) {}
         sendable(&holder.lost());
-        let settle = Duration::from_millis(1000);
         assert!(
-            tokio::time::timeout(settle, holder.lost()).await.is_err(),
+            tokio::time::timeout(Duration::from_millis(500), holder.lost())
+                .await
+                .is_err(),
             "a larger nonce or a claimant still starting takes no place"
         );
-        let smaller = declare(0, true).await;
+        let smaller = declare("h1", 0, ClaimPhase::Held).await;
         let e = tokio::time::timeout(Duration::from_secs(1), holder.lost())
             .await
             .expect("the holder gives way within a second");
@@ -146,12 +158,58 @@ fn a_holder_gives_way_to_a_smaller_nonce_held_late() {
         tokio::time::sleep(Duration::from_millis(300)).await;
         let again = tokio::time::timeout(Duration::from_millis(100), holder.lost()).await;
         assert!(again.is_ok(), "lost stays resolved");
+
+        // The holder of h3 has settled (it has held its place for SETTLE_AFTER).
+        let h3 = claim_slot_key(&run, AgentKind::Hand, "h3");
+        let deadline = tokio::time::Instant::now() + SETTLE_AFTER + Duration::from_secs(3);
+        loop {
+            let replies = late.session().liveliness().get(&h3).await.unwrap();
+            let mut phases = Vec::new();
+            while let Ok(reply) = replies.recv_async().await {
+                if let Ok(sample) = reply.result() {
+                    phases.extend(parse_claim_key(sample.key_expr().as_str()).map(|c| c.phase));
+                }
+            }
+            if phases.contains(&ClaimPhase::Settled) {
+                break;
+            }
+            assert!(
+                tokio::time::Instant::now() < deadline,
+                "the holder of h3 never settled: {phases:?}"
+            );
+            tokio::time::sleep(Duration::from_millis(100)).await;
+        }
         assert!(
-            tokio::time::timeout(Duration::from_millis(300), neighbour.lost())
+            tokio::time::timeout(Duration::from_millis(300), established.lost())
                 .await
                 .is_err(),
             "another id is another place"
         );
+        let newcomer = declare("h3", 0, ClaimPhase::Held).await;
+        let settled_larger = declare("h3", u64::MAX, ClaimPhase::Settled).await;
+        assert!(
+            tokio::time::timeout(Duration::from_secs(1), established.lost())
+                .await
+                .is_err(),
+            "a settled holder stays for a newcomer and for a larger nonce settled"
+        );
+        let settled_smaller = declare("h3", 0, ClaimPhase::Settled).await;
+        let e = tokio::time::timeout(Duration::from_secs(1), established.lost())
+            .await
+            .expect("a settled holder gives way to a smaller nonce settled within a second");
+        assert!(e.to_string().contains("a hand with the id h3"), "{e}");
+        drop((newcomer, settled_larger, settled_smaller));
+
+        // A holder that has not settled gives way to one settled, whatever the nonces.
+        let fresh = peers[0]
+            .wait_until_unique(&run, AgentKind::Hand, Some("h4"), wait)
+            .await
+            .unwrap();
+        let _settled = declare("h4", u64::MAX, ClaimPhase::Settled).await;
+        let e = tokio::time::timeout(Duration::from_secs(1), fresh.lost())
+            .await
+            .expect("a newcomer gives way to a settled holder within a second");
+        assert!(e.to_string().contains("a hand with the id h4"), "{e}");
     });
 }
 

@@ -143,15 +143,44 @@ impl From<RunId> for String {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Claim {
     pub nonce: u64,
-    pub held: bool,
+    pub phase: ClaimPhase,
+}
+
+/// How far an agent has got in taking its place; the key's last chunk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ClaimPhase {
+    /// Looking at the other claims before holding the place (`starting`).
+    Starting,
+    /// Holding the place (`held`).
+    Held,
+    /// Holding it and settled in it: held long enough that a claim seen later is a
+    /// newcomer's (`settled`, declared beside `held`).
+    Settled,
+}
+
+impl ClaimPhase {
+    /// The key chunk.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ClaimPhase::Starting => "starting",
+            ClaimPhase::Held => "held",
+            ClaimPhase::Settled => "settled",
+        }
+    }
+
+    /// Whether an agent in this phase holds the place.
+    pub fn holds(self) -> bool {
+        self != ClaimPhase::Starting
+    }
 }
 
 /// The claim a key names, if it is a claim key.
 pub fn parse_claim_key(key: &str) -> Option<Claim> {
     let mut chunks = key.rsplit('/');
-    let held = match chunks.next()? {
-        "held" => true,
-        "starting" => false,
+    let phase = match chunks.next()? {
+        "starting" => ClaimPhase::Starting,
+        "held" => ClaimPhase::Held,
+        "settled" => ClaimPhase::Settled,
         _ => return None,
     };
     let nonce = chunks.next()?;
@@ -165,7 +194,7 @@ pub fn parse_claim_key(key: &str) -> Option<Claim> {
     }
     Some(Claim {
         nonce: u64::from_str_radix(nonce, 16).ok()?,
-        held,
+        phase,
     })
 }
 

@@ -346,13 +346,14 @@ pub fn alive_key(runs: Runs, kind: Option<AgentKind>) -> String {
 /// `graspopt/<run>/claim/<kind>/<slot>/<nonce>/<phase>`: a liveliness token an agent holds
 /// while it makes sure it is alone in its place (`slot`: its id, or `any` for the run's one
 /// coordinator). `nonce` is 16 hex digits, random per agent; `phase` is `starting`, then
-/// `held` once the agent has its place (see [`Claim`], [`parse_claim_key`]).
+/// `held` once the agent has its place, and `settled` (beside `held`) once it has held it
+/// for a while (see [`Claim`], [`ClaimPhase`], [`parse_claim_key`]).
 pub fn claim_token(run: &RunId, kind: AgentKind, slot: &str, claim: Claim) -> String {
-    let phase = if claim.held { "held" } else { "starting" };
     format!(
-        "{}/{:016x}/{phase}",
+        "{}/{:016x}/{}",
         claim_base(run, kind, slot),
-        claim.nonce
+        claim.nonce,
+        claim.phase.as_str()
     )
 }
 

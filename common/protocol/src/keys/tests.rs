@@ -14,16 +14,12 @@ fn run_ids_are_single_chunks() {
 #[test]
 fn claim_keys_parse_back_and_nothing_else_does() {
     let run = RunId::new("r1").unwrap();
-    for claim in [
-        Claim {
-            nonce: 0x00ab_cdef_0123_4567,
-            held: false,
-        },
-        Claim {
-            nonce: u64::MAX,
-            held: true,
-        },
+    for (nonce, phase) in [
+        (0x00ab_cdef_0123_4567, ClaimPhase::Starting),
+        (u64::MAX, ClaimPhase::Held),
+        (7, ClaimPhase::Settled),
     ] {
+        let claim = Claim { nonce, phase };
         let key = claim_token(&run, AgentKind::Hand, "hand-1", claim);
         assert_eq!(parse_claim_key(&key), Some(claim), "{key}");
     }
@@ -34,10 +30,10 @@ fn claim_keys_parse_back_and_nothing_else_does() {
             "any",
             Claim {
                 nonce: 1,
-                held: true
+                phase: ClaimPhase::Settled
             }
         ),
-        "graspopt/r1/claim/coordinator/any/0000000000000001/held"
+        "graspopt/r1/claim/coordinator/any/0000000000000001/settled"
     );
     for bad in [
         "graspopt/r1/claim/hand/h/+000000000000000/held",
