@@ -5,11 +5,12 @@
 //!
 //! `run` appends one JSON line per (engine, function, seed) to the output file as each
 //! finishes, and skips those already there, so an interrupted run resumes where it stopped.
-//! `table` reads such files and prints the Markdown table of docs/benchmarks.md.
+//! `table` reads such files and prints the Markdown table of docs/benchmarks.md (of the
+//! seeds FIRST to LAST, both included, with `--seeds`; of all seeds otherwise).
 //!
 //! Usage:
 //!   graspopt-bo-suite run --engine ours|egobox [--functions a,b,..] [--seeds N] --out FILE
-//!   graspopt-bo-suite table FILE...
+//!   graspopt-bo-suite table [--seeds FIRST-LAST] FILE...
 //!   graspopt-bo-suite tuned
 //!
 //! `tuned` runs issue 4's figures for the settings (with `BO_SUITE_VARIANT` applied): Branin
@@ -120,7 +121,8 @@ fn run_ours(f: TestFunction, seed: u64) -> anyhow::Result<Record> {
 
 /// Changes to `recommended_settings()` for a comparison run, comma-separated (environment
 /// `BO_SUITE_VARIANT`): `norestart`, `nodiv`, `notail`, `nopm`, `rank`, `m52`, `se`, `pm32`, and
-/// `winN`, `tolX`, `tabuX`, `rinitN` (restart rule), `pmqX`, `divN`, `lsX` (length-scale
+/// `winN`, `tolX`, `tabuX`, `rinitN`, `reiX` / `norei` (restart rule; `rei` its
+/// `max_relative_ei`), `pmqX`, `divN`, `lsX` (length-scale
 /// prior median), `lssdX`, `directN`, `refitN`, `fitrN`, `xiX`, `nfixX` (noise held near X),
 /// `nfloorX` (noise floor), `sigsdX`, `lsminX`, `lsmaxX`, `itersN` (fit iterations),
 /// `polishN` (polish starts), `piterN` (polish iterations).
@@ -164,6 +166,8 @@ fn apply_variant(s: &mut Settings, variant: &str) -> anyhow::Result<()> {
             p if p.starts_with("polish") => s.polish_starts = num("polish")? as usize,
             p if p.starts_with("piter") => s.polish_iters = num("piter")? as usize,
             p if p.starts_with("iters") => s.fit.max_iter = num("iters")? as usize,
+            "norei" => rule(s, part)?.max_relative_ei = None,
+            p if p.starts_with("rei") => rule(s, part)?.max_relative_ei = Some(num("rei")?),
             other => bail!("unknown variant {other}"),
         }
     }
@@ -358,11 +362,25 @@ struct Group {
     budget: usize,
 }
 
-fn table(paths: &[String]) -> anyhow::Result<()> {
+fn table(args: &[String]) -> anyhow::Result<()> {
+    let (seeds, paths) = match args {
+        [flag, range, rest @ ..] if flag == "--seeds" => {
+            let (a, b) = range
+                .split_once('-')
+                .with_context(|| format!("--seeds FIRST-LAST, got {range}"))?;
+            let first: u64 = a.parse().context("--seeds: not a whole number")?;
+            let last: u64 = b.parse().context("--seeds: not a whole number")?;
+            (first..=last, rest)
+        }
+        _ => (0..=u64::MAX, args),
+    };
     ensure!(!paths.is_empty(), "table needs at least one results file");
     let mut by: BTreeMap<(String, String), Group> = BTreeMap::new();
     for p in paths {
-        for r in read_records(Path::new(p))? {
+        for r in read_records(Path::new(p))?
+            .into_iter()
+            .filter(|r| seeds.contains(&r.seed))
+        {
             let f = TestFunction::from_name(&r.function)?;
             let e = by
                 .entry((r.function.clone(), r.engine.clone()))
@@ -418,10 +436,11 @@ fn trace(args: &[String]) -> anyhow::Result<()> {
     let show = |opt: &Optimizer, x: &[f64], y: f64, best: f64, n: usize| {
         let xs: Vec<String> = x.iter().map(|v| format!("{v:.2}")).collect();
         println!(
-            "{n:3} epoch@{:3} y {y:12.5} best regret {:.2e} x [{}]",
+            "{n:3} epoch@{:3} y {y:12.5} best regret {:.2e} x [{}] rel_ei {:.1e}",
             opt.epoch_start(),
             f.regret(best),
-            xs.join(", ")
+            xs.join(", "),
+            opt.last_round().relative_ei.unwrap_or(f64::NAN)
         );
     };
     for x in initial_design(f, seed) {
@@ -518,7 +537,7 @@ fn main() -> anyhow::Result<()> {
         Some("tuned") => tuned(),
         Some("trace") => trace(&args[1..]),
         _ => bail!(
-            "usage: graspopt-bo-suite run --engine ours|egobox [--functions a,b] [--seeds N] --out FILE\n       graspopt-bo-suite table FILE...\n       graspopt-bo-suite tuned"
+            "usage: graspopt-bo-suite run --engine ours|egobox [--functions a,b] [--seeds N] --out FILE\n       graspopt-bo-suite table [--seeds FIRST-LAST] FILE...\n       graspopt-bo-suite tuned"
         ),
     }
 }

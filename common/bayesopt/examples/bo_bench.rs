@@ -88,13 +88,14 @@ fn main() {
         };
     }
     if let Some(v) = env("BO_RESTART") {
-        // window,tol,init,tabu_radius (anything else: off)
+        // window,tol,init,tabu_radius[,max_relative_ei] (anything else: off)
         let p: Vec<f64> = v.split(',').filter_map(|t| t.parse().ok()).collect();
-        settings.restart = (p.len() == 4).then(|| graspopt_bayesopt::RestartRule {
+        settings.restart = (p.len() == 4 || p.len() == 5).then(|| graspopt_bayesopt::RestartRule {
             window: p[0] as usize,
             tol: p[1],
             init: p[2] as usize,
             tabu_radius: p[3],
+            max_relative_ei: p.get(4).copied(),
         });
     }
     if let Some(v) = env("BO_LHS").and_then(|v| v.parse::<usize>().ok()) {

@@ -98,6 +98,7 @@ fn restarts_round_trip_and_continue_identically() {
             tol: 1.0,
             init: 2,
             tabu_radius: 0.1,
+            max_relative_ei: None,
         }),
         ..fast_settings()
     };

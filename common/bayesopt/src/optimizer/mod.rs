@@ -393,7 +393,9 @@ impl Optimizer {
         best.map(|i| (self.xs[i].clone(), self.ys[i]))
     }
 
-    /// Whether the current epoch stagnates under `rule` (after its initial design).
+    /// Whether the current epoch stagnates under `rule` (after its initial design): no
+    /// significant improvement over the window and, with [`RestartRule::max_relative_ei`], a
+    /// last round whose relative EI is below it.
     fn epoch_stagnates(&self, rule: &RestartRule) -> bool {
         let from = self.epoch_start.min(self.ys.len());
         let ys = &self.ys[from..];
@@ -411,7 +413,11 @@ impl Optimizer {
         let now = best_of(ys);
         let before = best_of(&ys[..ys.len() - w]);
         let lo = ys.iter().map(|y| sign * y).fold(f64::INFINITY, f64::min);
-        now - before <= rule.tol * (now - lo)
+        let model_expects_more = match (rule.max_relative_ei, self.last_round.relative_ei) {
+            (Some(th), Some(r)) => r.is_finite() && r >= th,
+            _ => false,
+        };
+        now - before <= rule.tol * (now - lo) && !model_expects_more
     }
 
     fn n_init(&self) -> usize {

@@ -76,7 +76,8 @@ impl Default for StopRule {
 /// `window` observations, a new epoch starts with `init` random points and a model of the new
 /// epoch's observations only, and the acquisition is penalised inside a ball of radius
 /// `tabu_radius * sqrt(d)` (unit cube) around the incumbent of every earlier epoch, so the
-/// search looks for another basin instead of polishing the old one.
+/// search looks for another basin instead of polishing the old one. With
+/// `max_relative_ei`, the epoch must also be one whose model expects little more.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RestartRule {
     /// Observations without significant improvement before restarting (>= 1).
@@ -87,6 +88,16 @@ pub struct RestartRule {
     pub init: usize,
     /// Radius of the balls around earlier incumbents, as a fraction of `sqrt(d)`.
     pub tabu_radius: f64,
+    /// Restart only when the model agrees that the epoch is stuck: the relative EI of the
+    /// last proposal round ([`RoundInfo::relative_ei`], the best EI over the epoch's observed
+    /// range of y) is below this as well (None: whatever the EI). An epoch that has not
+    /// improved for `window` observations while its model still expects sizeable
+    /// improvement is exploring other basins, not polishing a local optimum: a restart would
+    /// throw away the model it explores with. A round without a model proposal, or with a
+    /// relative EI that is not finite (an epoch of equal values), does not hold a restart
+    /// back. Must be finite and > 0.
+    #[serde(default)]
+    pub max_relative_ei: Option<f64>,
 }
 
 /// The large-n mode ([`Settings::model_cap`]): once the epoch holds more than `size`
@@ -281,6 +292,14 @@ impl Settings {
             return Err(BoError::InvalidSetting(
                 "restart tol and tabu_radius must be finite and >= 0".into(),
             ));
+        }
+        if let Some(r) = self.restart
+            && let Some(th) = r.max_relative_ei
+            && !(th > 0.0 && th.is_finite())
+        {
+            return Err(BoError::InvalidSetting(format!(
+                "restart max_relative_ei must be finite and > 0, got {th}"
+            )));
         }
         if let BatchStrategy::Qei { samples } = self.batch
             && !(1..=MAX_QEI_SAMPLES).contains(&samples)

@@ -282,3 +282,47 @@ fn the_large_n_mode_still_finds_the_branin_optimum() {
     // evaluations to reach 1e-3 (docs/benchmarks.md).
     assert!(regrets.iter().all(|r| *r < 1.5e-3), "{regrets:?}");
 }
+
+#[test]
+fn a_restart_waits_until_the_model_expects_little() {
+    // tol = 1: every epoch past its design and window stagnates by value alone.
+    let rule = RestartRule {
+        window: 2,
+        tol: 1.0,
+        init: 2,
+        tabu_radius: 0.1,
+        max_relative_ei: Some(1e-3),
+    };
+    let settings = Settings {
+        n_init: Some(5),
+        restart: Some(rule),
+        ..Settings::default()
+    };
+    let mut opt = branin_told(settings, 8, 3);
+    opt.last_round.relative_ei = Some(0.05);
+    assert!(!opt.epoch_stagnates(&rule));
+    opt.restart_if_stagnant();
+    assert_eq!((opt.restarts(), opt.epoch_start()), (0, 0));
+    let plain = RestartRule {
+        max_relative_ei: None,
+        ..rule
+    };
+    assert!(opt.epoch_stagnates(&plain));
+    for settled in [Some(5e-4), None, Some(f64::INFINITY)] {
+        opt.last_round.relative_ei = settled;
+        assert!(opt.epoch_stagnates(&rule), "{settled:?}");
+    }
+    opt.last_round.relative_ei = Some(5e-4);
+    opt.restart_if_stagnant();
+    assert_eq!((opt.restarts(), opt.epoch_start()), (1, 8));
+    for bad in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        let s = Settings {
+            restart: Some(RestartRule {
+                max_relative_ei: Some(bad),
+                ..rule
+            }),
+            ..Settings::default()
+        };
+        assert!(Optimizer::new(&[(0.0, 1.0)], s, 0).is_err(), "{bad}");
+    }
+}
