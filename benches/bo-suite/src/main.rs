@@ -27,7 +27,7 @@ use std::time::Instant;
 use anyhow::{Context, bail, ensure};
 use egobox_ego::{CorrelationSpec, EgorBuilder, InfillStrategy};
 use graspopt_bayesopt::benchmark::{
-    Benchmark, SeedSummary, aggregate, median, recommended_settings, summarize,
+    Benchmark, LevelSummary, SeedSummary, aggregate, median, recommended_settings, summarize,
 };
 use graspopt_bayesopt::rng::Rng;
 use graspopt_bayesopt::{
@@ -396,30 +396,41 @@ fn table(args: &[String]) -> anyhow::Result<()> {
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for f in TestFunction::ALL {
         let get = |e: &str| by.get(&(f.name().to_string(), e.to_string()));
-        let (Some(o), Some(g)) = (get("ours"), get("egobox")) else {
+        // A function run by one engine only gets "-" in the other's columns.
+        let (o, g) = (get("ours"), get("egobox"));
+        let Some(budget) = o.or(g).map(|e| e.budget) else {
             continue;
         };
-        let lo = aggregate(&o.seeds, o.budget, 1);
-        let lg = aggregate(&g.seeds, g.budget, 1);
-        let t = |v: &[f64]| median(v).map_or_else(|| "-".into(), |m| format!("{:.1}", 1e3 * m));
+        let levels = |e: Option<&Group>| e.map(|e| aggregate(&e.seeds, e.budget, 1));
+        let (lo, lg) = (levels(o), levels(g));
+        let reached = |l: &Option<Vec<LevelSummary>>, i: usize| {
+            l.as_ref().map_or_else(
+                || "-".to_string(),
+                |l| format!("{}/{}", l[i].reached, l[i].seeds),
+            )
+        };
+        let med = |l: &Option<Vec<LevelSummary>>| {
+            l.as_ref()
+                .map_or_else(|| "-".into(), |l| fmt_med(l[1].median_evals))
+        };
+        let t = |e: Option<&Group>| {
+            e.and_then(|e| median(&e.proposal_s))
+                .map_or_else(|| "-".into(), |m| format!("{:.1}", 1e3 * m))
+        };
         println!(
-            "| {} | {} | {} ({}) | {}/{} | {}/{} | {} | {} | {}/{} | {}/{} | {} | {} |",
+            "| {} | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} | {} |",
             f.name(),
             f.dim(),
-            o.budget,
+            budget,
             n_init(f),
-            lo[1].reached,
-            lo[1].seeds,
-            lg[1].reached,
-            lg[1].seeds,
-            fmt_med(lo[1].median_evals),
-            fmt_med(lg[1].median_evals),
-            lo[2].reached,
-            lo[2].seeds,
-            lg[2].reached,
-            lg[2].seeds,
-            t(&o.proposal_s),
-            t(&g.proposal_s),
+            reached(&lo, 1),
+            reached(&lg, 1),
+            med(&lo),
+            med(&lg),
+            reached(&lo, 2),
+            reached(&lg, 2),
+            t(o),
+            t(g),
         );
     }
     Ok(())
