@@ -140,6 +140,20 @@ class Place:
         self._held.undeclare()
 
 
+def gives_way(run, hand_id, what):
+    """The error of a hand that gives way to another with its id (the words of graspopt's
+    own agents)."""
+    return (f'run "{run}": another agent, a hand with the id {hand_id}, {what}: '
+            "this one gives way (give it another --id)")
+
+
+def already_has(run, hand_id, host):
+    """The error of a hand whose id is held by a running hand (on `host`, if known)."""
+    on = f", alive on host {host}" if host else ""
+    return (f'run "{run}" already has a hand with the id {hand_id}{on}: '
+            "stop it first, or give this one another --id")
+
+
 def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
     """Makes sure this is the run's only hand with this id, as graspopt's own agents do
     (docs/reliability.md), and returns the Place that holds it (keep it).
@@ -152,6 +166,7 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
     that came too late for these looks (a loaded machine) still leaves one hand with the id,
     and a newcomer whose view came late gives way to the hand that held the place before."""
     deadline = time.monotonic() + wait_s
+    run = prefix.split("/")[1]
 
     def keys(key_expr):
         return [str(r.ok.key_expr) for r in session.liveliness().get(key_expr) if r.ok]
@@ -161,8 +176,7 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
         holders = keys(f"{prefix}/alive/hand/*/{hand_id}/**")
         free = 0 if holders else free + 1
         if holders and time.monotonic() >= deadline:
-            sys.exit(f"{hand_id}: the run already has a hand with this id ({holders[0]}): "
-                     "stop it first, or give this one another --id")
+            sys.exit(already_has(run, hand_id, holders[0].split("/")[4]))
         time.sleep(0.2)
 
     claims_key = f"{prefix}/claim/hand/{hand_id}"
@@ -191,20 +205,16 @@ def take_place(session, prefix, hand_id, on_lost, wait_s=5.0):
             time.sleep(0.15)
             seen = next((c for c in claims() if gives_way_to(nonce, False, c)), None)
             if not seen:
-                place = Place(session, claims_key, nonce, held,
-                              f"{hand_id}: another hand with this id took the run's place at the "
-                              "same moment and keeps it: this one gives way (give it another --id)",
-                              on_lost)
+                why = gives_way(run, hand_id, "took its place at the same moment and keeps it")
+                place = Place(session, claims_key, nonce, held, why, on_lost)
                 starting.undeclare()
                 return place
             held.undeclare()
         if time.monotonic() >= deadline:
             starting.undeclare()
             if seen[1] != "starting":
-                sys.exit(f"{hand_id}: the run already has a hand with this id: "
-                         "stop it first, or give this one another --id")
-            sys.exit(f"{hand_id}: another hand with this id is taking the run's place at the "
-                     "same moment: this one gives way (give it another --id)")
+                sys.exit(already_has(run, hand_id, None))
+            sys.exit(gives_way(run, hand_id, "is taking its place at the same moment"))
 
 
 def clouds_of(grasps, command, worker):
