@@ -328,10 +328,8 @@ impl Bus {
                             standing.settled = true;
                         }
                         match settle.await {
-                            Ok(token) => {
-                                std::future::pending::<()>().await;
-                                drop(token);
-                            }
+                            // The token lives as long as the task: until the claim drops.
+                            Ok(_token) => std::future::pending::<()>().await,
                             Err(_) => lock(&standing).settled = false,
                         }
                     });
