@@ -342,6 +342,9 @@ impl CloudPoint {
     /// the point as `fingers[finger].points[index]`.
     #[inline]
     pub fn validate(&self, finger: usize, index: usize) -> Result<(), String> {
+        if self.is_valid() {
+            return Ok(());
+        }
         let (f, i) = (finger, index);
         // Field names are formatted only for the error: this runs on every point.
         let ok = self.p.iter().chain(&self.n).all(|v| v.is_finite());
@@ -355,15 +358,32 @@ impl CloudPoint {
                 self.w
             ));
         }
-        let n2 = self.n.iter().map(|v| v * v).sum::<f64>();
-        // |n| within 1e-3 of 1 (compared squared, without a square root).
-        if !((1.0 - 1e-3) * (1.0 - 1e-3)..=(1.0 + 1e-3) * (1.0 + 1e-3)).contains(&n2) {
-            return Err(format!(
-                "fingers[{f}].points[{i}].n is not a unit normal (norm {})",
-                n2.sqrt()
-            ));
-        }
-        Ok(())
+        Err(format!(
+            "fingers[{f}].points[{i}].n is not a unit normal (norm {})",
+            self.normal_norm2().sqrt()
+        ))
+    }
+
+    /// Whether [`CloudPoint::validate`] accepts the point, without a branch per condition
+    /// (`&` rather than `&&`), so that a loop over a cloud compiles to straight-line code;
+    /// bulk readers check every point with it and format an error only for the first one
+    /// that fails.
+    #[inline]
+    pub fn is_valid(&self) -> bool {
+        const LOW: f64 = (1.0 - 1e-3) * (1.0 - 1e-3);
+        const HIGH: f64 = (1.0 + 1e-3) * (1.0 + 1e-3);
+        // A NaN or an infinity in n makes n2 NaN or infinite, which fails the range; one in
+        // p makes the sum of p times zero NaN, which it is only then.
+        let p = self.p[0] * 0.0 + self.p[1] * 0.0 + self.p[2] * 0.0;
+        let n2 = self.normal_norm2();
+        (p == 0.0) & (LOW..=HIGH).contains(&n2) & (self.w > 0.0) & (self.w < f64::INFINITY)
+    }
+
+    /// `|n|²`: |n| is within 1e-3 of 1 when this is within the squared bounds (no square
+    /// root per point).
+    #[inline]
+    fn normal_norm2(&self) -> f64 {
+        self.n[0] * self.n[0] + self.n[1] * self.n[1] + self.n[2] * self.n[2]
     }
 }
 

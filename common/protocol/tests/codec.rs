@@ -600,6 +600,94 @@ fn the_shm_layout_refuses_bad_points_as_validate_does() {
     assert!(e.to_string().contains("worker"), "{e}");
 }
 
+/// The branch-free check (which `validate` and the bulk readers run first) accepts exactly
+/// the points the rule accepts, written here plainly: p and n finite, |n| within 1e-3 of 1,
+/// w finite and > 0; edge values included (infinities times zero, norms just inside and
+/// outside 1e-3, a norm whose square overflows). `validate` gives an error exactly then.
+#[test]
+fn the_fast_point_check_agrees_with_validate() {
+    let values = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        0.5,
+        0.9991,
+        0.9989,
+        1.0009,
+        1.0011,
+        1e-300,
+        1e200,
+        f64::MAX,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut checked = 0;
+    let mut accepted = 0;
+    for &a in &values {
+        for &b in &values {
+            for &c in &values {
+                for &w in &values {
+                    for pt in [
+                        CloudPoint {
+                            p: [a, b, c],
+                            n: [0.0, 0.0, 1.0],
+                            w,
+                        },
+                        CloudPoint {
+                            p: [w, 0.0, 0.0],
+                            n: [a, b, c],
+                            w: 1.0,
+                        },
+                        CloudPoint {
+                            p: [0.0; 3],
+                            n: [a, b, c],
+                            w,
+                        },
+                    ] {
+                        let norm = pt.n.iter().map(|v| v * v).sum::<f64>().sqrt();
+                        let rule = pt.p.iter().chain(&pt.n).all(|v| v.is_finite())
+                            && (norm - 1.0).abs() <= 1e-3
+                            && pt.w.is_finite()
+                            && pt.w > 0.0;
+                        assert_eq!(pt.is_valid(), rule, "{pt:?}");
+                        assert_eq!(pt.validate(0, 0).is_ok(), rule, "{pt:?}");
+                        checked += 1;
+                        accepted += usize::from(pt.is_valid());
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 3 * values.len().pow(4));
+    // Both outcomes occur: the comparison is not vacuous.
+    assert!(
+        accepted > 0 && accepted < checked,
+        "{accepted} of {checked}"
+    );
+}
+
+/// Of several bad points, the layout names the first, as `validate` does.
+#[test]
+fn the_shm_layout_names_the_first_bad_point() {
+    let mut c = full_clouds();
+    c.fingers[1].points[2].w = f64::INFINITY;
+    c.fingers[1].points[1].p[0] = f64::NEG_INFINITY;
+    let last = c.fingers.len() - 1;
+    c.fingers[last].points.push(CloudPoint {
+        p: [0.0; 3],
+        n: [0.0; 3],
+        w: 1.0,
+    });
+    let e = layout::read_clouds(&layout_bytes(&c)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("fingers[1].points[1].p[0] is not finite (-inf)"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_truncated_or_inconsistent_shm_layout_is_refused_naming_the_field() {
     let bytes = layout_bytes(&full_clouds());
