@@ -117,6 +117,51 @@ fn every_message_round_trips_exactly_in_both_encodings() {
     }
 }
 
+/// A planner question names the first value that is not finite, in the history or the
+/// pending trials.
+#[test]
+fn a_planner_question_names_its_first_value_not_finite() {
+    let question = || SuggestRequest {
+        run_id: run(),
+        request_id: 1,
+        method: PlannerMethod::Bo,
+        bounds: vec![[0.0, 1.0], [0.0, 1.0]],
+        seed: 0,
+        initial: None,
+        observations: (0..4)
+            .map(|i| Observation {
+                x: vec![0.1 * f64::from(i), 0.5],
+                y: f64::from(i),
+            })
+            .collect(),
+        pending: vec![vec![0.2, 0.3], vec![0.4, 0.6]],
+        count: 2,
+        engine_state: None,
+    };
+    assert_eq!(question().validate(), Ok(()));
+    type Spoil = fn(&mut SuggestRequest);
+    let cases: [(&str, Spoil); 4] = [
+        ("observations[2].x[1] is not finite (NaN)", |q| {
+            q.observations[2].x[1] = f64::NAN;
+            q.observations[3].y = f64::NAN;
+        }),
+        ("observations[1].y[0] is not finite (inf)", |q| {
+            q.observations[1].y = f64::INFINITY
+        }),
+        ("pending[1][0] is not finite (-inf)", |q| {
+            q.pending[1][0] = f64::NEG_INFINITY
+        }),
+        ("observations[3].x has 1 values, not 2", |q| {
+            q.observations[3].x.pop();
+        }),
+    ];
+    for (expected, spoil) in cases {
+        let mut q = question();
+        spoil(&mut q);
+        assert_eq!(q.validate(), Err(expected.to_string()));
+    }
+}
+
 #[test]
 fn bincode_payload_starts_with_the_wire_version() {
     let bytes = encode(&result(), Encoding::Bincode).unwrap();
