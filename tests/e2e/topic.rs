@@ -116,15 +116,17 @@ fn topic_tools_list_echo_and_time_a_running_pipeline() {
         assert!(text.contains(field), "{field} not in\n{text}");
     }
 
-    // hz: the coordinator publishes its status every 500 ms (2 Hz).
+    // hz: the coordinator publishes its status every 500 ms (2 Hz). On a loaded machine its
+    // timer ticks late, never early (CI measured 1.3 Hz while other runs shared the two
+    // cores), so the rate is at most 2 Hz plus jitter, and well above 0.
     let hz = topic(
         &endpoint,
         &["hz", "status", "--run", "tp", "--duration", "3"],
     );
     let rate = last_value(&hz, "average rate");
     assert!(
-        (rate - 2.0).abs() <= 0.4,
-        "status rate {rate} Hz, want 2 Hz\n{hz}"
+        (1.0..=2.4).contains(&rate),
+        "status rate {rate} Hz, want 2 Hz (1 Hz at worst under load)\n{hz}"
     );
     // bw: statuses are a few hundred bytes each, 2 per second.
     let bw = topic(

@@ -48,6 +48,8 @@ pub async fn run_embedded(
     e: &Embedded,
     progress: Option<watch::Sender<RunStatus>>,
 ) -> Result<RunStatus> {
+    // Before anything is written: a run refused for its open-file limit leaves no trace.
+    crate::open_files::ensure(e.workers)?;
     std::fs::create_dir_all(&e.out)
         .with_context(|| format!("cannot create the results folder {}", e.out.display()))?;
     let bus = Bus::open(&e.bus).await?;

@@ -10,6 +10,7 @@ pub mod bench;
 pub mod config;
 pub mod embedded;
 pub mod launch;
+pub mod open_files;
 pub mod run_settings;
 pub mod signal;
 

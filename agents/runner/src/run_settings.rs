@@ -246,6 +246,14 @@ impl RunSettings {
 
     fn assemble(&self, run: RunId, out: PathBuf) -> Result<Embedded> {
         anyhow::ensure!(self.workers >= 1, "--workers must be at least 1");
+        anyhow::ensure!(
+            self.workers <= graspopt_shm::DEFAULT_MAX_PUBLISHERS,
+            "--workers {} is more than the {} hand workers one process runs (the capacity of a \
+             host's shared-memory clouds service): run more hands as separate processes or on \
+             other hosts (graspopt launch, graspopt agent hand)",
+            self.workers,
+            graspopt_shm::DEFAULT_MAX_PUBLISHERS
+        );
         anyhow::ensure!(self.trials >= 1, "--trials must be at least 1");
         let evaluator = Evaluator::from_settings(&self.trial, &self.params)?;
         let object = evaluator.object.name().to_string();

@@ -137,6 +137,8 @@ const SUBSCRIBER_POLL: Duration = Duration::from_millis(20);
 const WAKE_LISTENER: &str = "graspopt-shm-wake";
 /// Port name of each publisher's listener for "connected" acknowledgements.
 const ACK_LISTENER: &str = "graspopt-shm-ack";
+/// Appended to a service's name to name its acknowledgement event service.
+const ACK_SERVICE_SUFFIX: &str = "/acks";
 /// Event id of a wake-up (publisher to subscribers).
 const WAKE: EventId = EventId::new(0);
 /// Event id of a "connected" acknowledgement (subscriber to one publisher).
@@ -361,10 +363,21 @@ fn port_name(service: &str, name: &str) -> Result<PortName> {
     PortName::new(name).map_err(service_err(service, "name port"))
 }
 
-/// The node and the two services (data and events) behind one name.
+/// The node and the three services behind one name: the data, the wake-ups
+/// (publishers notify, subscribers listen) and the acknowledgements
+/// (subscribers notify, publishers listen).
+///
+/// The two directions are two event services because an iceoryx2 notifier
+/// connects to every listener of its service (a socket and a mapped file
+/// each): with one service for both, each hand's notifier connected to every
+/// other hand's acknowledgement listener, and a run with 64 hands in one
+/// process held 2,800 descriptors at 32 hands and 9,700 at 64 (growing as
+/// the square of the hands), past a default limit of 1,024 open files at 20.
+/// Apart, a notifier connects only to the ports that listen to it.
 /// Field order is drop order.
 struct Endpoints {
-    events: EventFactory<Ipc>,
+    wakes: EventFactory<Ipc>,
+    acks: EventFactory<Ipc>,
     pubsub: PubSubFactory<Ipc, [u8], ()>,
     _node: Node<Ipc>,
 }
@@ -397,18 +410,29 @@ impl Endpoints {
             .enable_safe_overflow(false)
             .open_or_create()
             .map_err(service_err(service, "open publish-subscribe service"))?;
-        let events = node
-            .service_builder(&name)
-            .event()
-            // Each publisher and each subscriber has one notifier and one
-            // listener: wake-ups go one way, acknowledgements the other.
-            .max_notifiers(config.max_nodes())
-            .max_listeners(config.max_nodes())
-            .max_nodes(config.max_nodes())
-            .open_or_create()
-            .map_err(service_err(service, "open event service"))?;
+        // Port capacities as the data service's nodes: the publisher port,
+        // not one of its event ports, is what a full service refuses first.
+        let events = |name: &ServiceName, what| {
+            node.service_builder(name)
+                .event()
+                .max_notifiers(config.max_nodes())
+                .max_listeners(config.max_nodes())
+                .max_nodes(config.max_nodes())
+                .open_or_create()
+                .map_err(service_err(service, what))
+        };
+        let wakes = events(&name, "open wake-up event service")?;
+        let ack_name =
+            ServiceName::new(&format!("{service}{ACK_SERVICE_SUFFIX}")).map_err(|e| {
+                ShmError::InvalidServiceName {
+                    service: service.to_owned(),
+                    reason: format!("{e:?}"),
+                }
+            })?;
+        let acks = events(&ack_name, "open acknowledgement event service")?;
         Ok(Self {
-            events,
+            wakes,
+            acks,
             pubsub,
             _node: node,
         })
@@ -421,7 +445,6 @@ struct PublisherPorts {
     publisher: Publisher<Ipc, [u8], ()>,
     acks: Listener<Ipc>,
     endpoints: Endpoints,
-    wake_name: PortName,
     last_stale_scan: Instant,
 }
 
@@ -436,7 +459,7 @@ impl PublisherPorts {
         // Before the publisher port: a subscriber that sees the publisher
         // must find this listener to acknowledge to.
         let acks = endpoints
-            .events
+            .acks
             .listener_builder()
             .name(&port_name(service, ACK_LISTENER)?)
             .create()
@@ -461,7 +484,7 @@ impl PublisherPorts {
             .create()
             .map_err(service_err(service, "create publisher"))?;
         let notifier = endpoints
-            .events
+            .wakes
             .notifier_builder()
             .default_event_id(WAKE)
             .create()
@@ -471,24 +494,16 @@ impl PublisherPorts {
             publisher,
             acks,
             endpoints,
-            wake_name: port_name(service, WAKE_LISTENER)?,
             last_stale_scan: Instant::now(),
         };
         ports.wait_for_subscribers(config.delivery_timeout);
         Ok(ports)
     }
 
-    /// Wakes every subscriber thread on the service (not the publishers'
-    /// acknowledgement listeners).
+    /// Wakes every subscriber thread on the service. A failed wake-up only
+    /// delays delivery until the subscriber's next poll.
     fn wake_subscribers(&self) {
-        self.notifier.for_each_listener(|listener, details| {
-            if details.listener_name == self.wake_name {
-                // A failed wake-up only delays delivery until the
-                // subscriber's next poll.
-                let _ = listener.notify();
-            }
-            CallbackProgression::Continue
-        });
+        let _ = self.notifier.notify();
     }
 
     /// Waits until every subscriber on the service has connected to this

@@ -9,7 +9,6 @@ pub(crate) struct SubscriberPorts {
     acks: Notifier<Ipc>,
     pub(crate) subscriber: Subscriber<Ipc, [u8], ()>,
     endpoints: Endpoints,
-    ack_name: PortName,
     /// Publishers this subscriber has connected to and acknowledged.
     known_publishers: Vec<UniquePublisherId>,
 }
@@ -18,13 +17,13 @@ impl SubscriberPorts {
     pub(crate) fn open(config: &ShmConfig, service: &str) -> Result<Self> {
         let endpoints = Endpoints::open(config, service, "graspopt-shm-subscriber")?;
         let wake = endpoints
-            .events
+            .wakes
             .listener_builder()
             .name(&port_name(service, WAKE_LISTENER)?)
             .create()
             .map_err(service_err(service, "create listener"))?;
         let acks = endpoints
-            .events
+            .acks
             .notifier_builder()
             .default_event_id(ACK)
             .create()
@@ -40,7 +39,6 @@ impl SubscriberPorts {
             acks,
             subscriber,
             endpoints,
-            ack_name: port_name(service, ACK_LISTENER)?,
             known_publishers: Vec::new(),
         };
         // Connected to every existing publisher before `open` returns, so
@@ -77,7 +75,7 @@ impl SubscriberPorts {
             .collect();
         if !new_nodes.is_empty() {
             self.acks.for_each_listener(|listener, details| {
-                if details.listener_name == self.ack_name && new_nodes.contains(&details.node_id) {
+                if new_nodes.contains(&details.node_id) {
                     // Unacknowledged, the publisher only waits longer.
                     let _ = listener.notify();
                 }

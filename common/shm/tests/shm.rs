@@ -548,3 +548,43 @@ fn stale_nodes_of_an_earlier_run_are_found_by_prefix() {
     assert_eq!(clean_stale(&config).unwrap(), 0);
     assert_eq!(clean_stale_prefixes("no-such-prefix-").unwrap(), 0);
 }
+
+/// Descriptors this process holds on files of `prefix` (shared memory, sockets' paths).
+fn descriptors_of(prefix: &str) -> usize {
+    std::fs::read_dir("/proc/self/fd")
+        .unwrap()
+        .flatten()
+        .filter_map(|e| std::fs::read_link(e.path()).ok())
+        .filter(|target| target.to_string_lossy().contains(prefix))
+        .count()
+}
+
+/// A host's hands share one service: each hand's ports hold a fixed number of descriptors,
+/// not one per other hand (the wake-ups and acknowledgements are two event services, and a
+/// notifier connects only to the listeners of its own).
+#[test]
+fn descriptors_grow_linearly_with_publishers() {
+    let (config, _cleanup) = config("fds");
+    let service = "graspopt/test/fds";
+    let (tx, _rx) = channel::<usize>();
+    let _subscriber = ShmSubscriber::open(&config, service, move |b: &[u8]| {
+        let _ = tx.send(b.len());
+    })
+    .unwrap();
+    let base = descriptors_of(&config.prefix);
+    let mut publishers = Vec::new();
+    let mut counts = Vec::new();
+    for n in 1..=24 {
+        publishers.push(ShmPublisher::open(&config, service).unwrap());
+        if n == 8 || n == 24 {
+            counts.push(descriptors_of(&config.prefix) - base);
+        }
+    }
+    let (at8, at24) = (counts[0], counts[1]);
+    eprintln!("descriptors: subscriber {base}, 8 publishers {at8}, 24 publishers {at24}");
+    // Linear: 24 publishers hold three times what 8 hold (quadratic growth: nine times).
+    assert!(
+        at24 <= 3 * at8 + 8,
+        "8 publishers {at8}, 24 publishers {at24}"
+    );
+}

@@ -556,3 +556,92 @@ fn trial_refuses_picture_files_it_cannot_write() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "files written");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+// --- the open-file limit ---
+
+/// `graspopt args` under `ulimit` set to `limit` (e.g. `-n 300`: soft and hard; `-Sn 200`:
+/// soft only), through `sh`, since setting a child's limit from Rust needs `unsafe`.
+fn graspopt_under_ulimit(limit: &str, args: &[&str]) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit {limit} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_graspopt"))
+        .args(args)
+        .output()
+        .expect("run sh")
+}
+
+/// A run whose hand workers need more open files than the hard limit allows is refused before
+/// anything is written, with both numbers and what to do.
+#[test]
+fn run_refuses_more_workers_than_the_open_file_limit_allows() {
+    let dir = tempdir("nofile-refused");
+    let out = dir.join("r");
+    let args = [
+        "run",
+        "--workers",
+        "64",
+        "--trials",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = graspopt_under_ulimit("-n 300", &args);
+    assert_refused(
+        &o,
+        &args,
+        &[
+            "--workers 64 needs about 1920 open files",
+            "at most 300",
+            "use at most 6 workers",
+            "graspopt launch",
+        ],
+    );
+    assert!(!out.exists(), "a refused run wrote {}", out.display());
+    // More hands than one process runs, whatever the limit.
+    let args = ["run", "--workers", "100000", "--out", out.to_str().unwrap()];
+    refused(
+        &args,
+        &["--workers 100000 is more than the 1024 hand workers one process runs"],
+    );
+    assert!(!out.exists(), "a refused run wrote {}", out.display());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A soft limit below what the workers need is raised to the hard one: every trial completes
+/// and every hand sends its clouds through shared memory (under the soft limit of 200, eight
+/// hands ran out of descriptors: lease expiries and fallbacks to Zenoh).
+#[test]
+fn run_raises_a_soft_open_file_limit_its_workers_exceed() {
+    let dir = tempdir("nofile-raised");
+    let out = dir.join("r");
+    let args = [
+        "run",
+        "--object",
+        "sphere",
+        "--method",
+        "random",
+        "--workers",
+        "8",
+        "--trials",
+        "16",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = graspopt_under_ulimit("-Sn 200", &args);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("16 trials completed, 0 failed"),
+        "{stdout}\n{stderr}"
+    );
+    for warning in [
+        "shared memory unavailable",
+        "expired",
+        "Too many open files",
+    ] {
+        assert!(!stderr.contains(warning), "{warning}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
