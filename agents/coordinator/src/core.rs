@@ -537,7 +537,7 @@ fn log_disposition(result: &TrialResult, disposition: Disposition) {
 }
 
 /// A result as the journal records it.
-fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
+pub(crate) fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
     TrialResultRecord {
         run_id: r.run_id.as_str().to_string(),
         trial_id: r.trial_id,

@@ -298,16 +298,28 @@ fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<
     // Who each attempt went to, so that late results of attempts issued before a restart
     // are still accepted.
     let mut issued: BTreeMap<u64, BTreeMap<u32, String>> = BTreeMap::new();
+    // Where each completed trial's result stands in the journal's events.
+    let mut completed_at: BTreeMap<u64, i64> = BTreeMap::new();
     for e in journal.events(run.as_str())? {
         if e.kind == event_kind::ISSUED || e.kind == event_kind::REISSUED {
             issued
                 .entry(e.trial_id)
                 .or_default()
                 .insert(e.attempt, e.worker.clone());
+        } else if e.kind == event_kind::RESULT {
+            completed_at.entry(e.trial_id).or_insert(e.seq);
         }
     }
-    // Observations in completion order (as the planner first saw them).
-    rows.sort_by_key(|r| (r.completed_ms.unwrap_or(i64::MAX), r.trial_id));
+    // Observations in completion order, as the planner first saw them: the order the results
+    // were recorded in. Their millisecond times tie when workers answer together, and a tie
+    // broken otherwise (by trial id) gave the planner a history its saved engine was not
+    // told, which it then rebuilt.
+    rows.sort_by_key(|r| {
+        (
+            completed_at.get(&r.trial_id).copied().unwrap_or(i64::MAX),
+            r.trial_id,
+        )
+    });
     for row in &rows {
         let phase = match row.state {
             TrialState::Completed => TrialPhase::Completed {
@@ -459,6 +471,35 @@ mod tests {
         // The same budget again (or less) leaves the record as it is.
         let (again, _) = open_run(&mut journal, &run, &spec(3), true).unwrap();
         assert_eq!(again.trials, 8);
+    }
+
+    /// A resumed run gives the planner its observations in the order their results were
+    /// recorded, also when they were recorded in the same millisecond.
+    #[test]
+    fn a_resumed_run_keeps_the_order_results_were_recorded_in() {
+        let mut journal = Journal::open_in_memory().unwrap();
+        let run = RunId::new("r").unwrap();
+        let spec = spec(5);
+        open_run(&mut journal, &run, &spec, false).unwrap();
+        for id in 1..=4 {
+            journal
+                .record_issue(&TrialIssue {
+                    params: vec![0.01 * id as f64],
+                    ..issue(id)
+                })
+                .unwrap();
+        }
+        // Recorded in one millisecond, in another order than the trial ids.
+        for id in [3, 1, 4, 2] {
+            let r = crate::state::tests::result(id, "a", 0.1 * id as f64);
+            journal
+                .record_result(&crate::core::journal_result(&r, 50))
+                .unwrap();
+        }
+        let (_, state) = open_run(&mut journal, &run, &spec, true).unwrap();
+        let order: Vec<(f64, f64)> = state.observations().iter().map(|o| (o.x[0], o.y)).collect();
+        let recorded = [3, 1, 4, 2].map(|id: u64| (0.01 * id as f64, 0.1 * id as f64));
+        assert_eq!(order, recorded);
     }
 
     /// A trial issued for run `r`, attempt 1.
