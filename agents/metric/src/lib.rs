@@ -172,7 +172,7 @@ fn analysed(
         Ok(f) => Some(force_analysis(&f)),
         Err(e) => {
             tracing::warn!(
-                "metric {}: trial {}: no force analysis: {e}",
+                "{}: trial {}: no force analysis, the score stands without it: {e}",
                 result.scorer,
                 result.trial_id
             );

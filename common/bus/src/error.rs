@@ -44,15 +44,20 @@ pub(crate) fn without_source_locations(text: &str) -> String {
     while let Some(i) = rest.find(" at /") {
         let tail = &rest[i + 4..];
         let end = tail.find(char::is_whitespace).unwrap_or(tail.len());
-        let location = tail[..end].trim_end_matches('.');
+        // The location may be followed by a full stop and the brackets it closed: "...rs:61.]".
+        let location = tail[..end].trim_end_matches(['.', ']', ')']);
         let is_source = location
             .rsplit_once(".rs:")
             .is_some_and(|(_, line)| !line.is_empty() && line.bytes().all(|b| b.is_ascii_digit()));
         if is_source {
             out.push_str(&rest[..i]);
-            // A sentence's full stop after the location stays, unless it ends the text.
-            let after = if end == tail.len() {
+            let suffix = &tail[location.len()..end];
+            // A sentence's full stop after the location stays, unless it ends the text or
+            // comes before a closing bracket ("(os error 98)]", not "(os error 98).]").
+            let after = if end == tail.len() && suffix == "." {
                 end
+            } else if suffix.len() > 1 && suffix.starts_with('.') {
+                location.len() + 1
             } else {
                 location.len()
             };
@@ -81,6 +86,12 @@ mod tests {
         assert_eq!(
             without_source_locations("a at /x/y.rs:1. b at /u/v.rs:22"),
             "a. b"
+        );
+        assert_eq!(
+            without_source_locations(
+                "Can not create a new TCP listener bound to tcp/127.0.0.1:7447: [127.0.0.1:7447: Address already in use (os error 98) at /root/.cargo/registry/src/x/zenoh-link-commons-1.10.2/src/tcp.rs:61.]"
+            ),
+            "Can not create a new TCP listener bound to tcp/127.0.0.1:7447: [127.0.0.1:7447: Address already in use (os error 98)]"
         );
         assert_eq!(
             without_source_locations("cannot read at /etc/graspopt/agent.json5"),
