@@ -149,6 +149,12 @@ impl Bus {
     }
 
     /// This host's name (a key chunk).
+    /// Whether the session holds a link to a router or another peer: false while none of
+    /// its `--connect` endpoints answers (and no peer was scouted).
+    pub async fn is_linked(&self) -> bool {
+        linked(&self.session).await
+    }
+
     pub fn host(&self) -> &str {
         &self.host
     }

@@ -135,7 +135,7 @@ pub fn run(args: &TopicArgs) -> Result<ExitCode> {
         let bus = Bus::open(&bus_args).await?;
         let mut out = std::io::stdout();
         let result = match &plan {
-            Plan::List(run, format) => list(&bus, run.as_ref(), *format).await,
+            Plan::List(run, format) => list(&bus, &bus_args.connect, run.as_ref(), *format).await,
             Plan::Echo(s) => topic::echo(&bus, s, &mut out, shutdown_signal()).await,
             Plan::Rate(s) => topic::rate(&bus, s, &mut out, shutdown_signal()).await,
         };
@@ -144,8 +144,17 @@ pub fn run(args: &TopicArgs) -> Result<ExitCode> {
     })
 }
 
-async fn list(bus: &Bus, run: Option<&RunId>, format: Format) -> Result<()> {
+async fn list(bus: &Bus, connect: &[String], run: Option<&RunId>, format: Format) -> Result<()> {
     let rows = topic::list(bus, run).await?;
+    // An empty listing from an address where nothing answers is that address's fault, not
+    // an idle bus's.
+    if rows.is_empty() && !connect.is_empty() && !bus.is_linked().await {
+        anyhow::bail!(
+            "nothing answers at {}: check the address, and that the router runs and its port \
+             is open",
+            connect.join(", ")
+        );
+    }
     match format {
         Format::Json => outln!("{}", topic::rows_json(&rows))?,
         Format::Text if rows.is_empty() => {

@@ -645,3 +645,13 @@ fn run_raises_a_soft_open_file_limit_its_workers_exceed() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `topic list` at an address where nothing answers says so and fails, rather than listing no
+/// agents as an idle bus would.
+#[test]
+fn topic_list_names_an_address_where_nothing_answers() {
+    refused(
+        &["topic", "list", "--connect", "tcp/127.0.0.1:1"],
+        &["nothing answers at tcp/127.0.0.1:1"],
+    );
+}
