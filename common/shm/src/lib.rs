@@ -10,9 +10,9 @@
 //!   wakes the subscribers through an iceoryx2 event service of the same name.
 //! - [`ShmSubscriber`]: a dedicated thread that sleeps on that event service,
 //!   drains the samples and hands each payload to a callback.
-//! - The small protocol on that event service: wake-ups from publishers to
-//!   subscribers, and "connected" acknowledgements from each subscriber to a
-//!   new publisher.
+//! - The small protocol beside the data: wake-ups from publishers to
+//!   subscribers on that event service, and "connected" acknowledgements from
+//!   each subscriber to a new publisher on a second one (`<name>/acks`).
 //! - [`available`] and [`clean_stale`]: the start-up probe that decides
 //!   between shared memory and the network, and the removal of resources left
 //!   by processes that died.
