@@ -118,18 +118,23 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
         );
         bar
     };
+    // Said once the run has started (its first status), so that a run refused at start
+    // (its folder, its journal, the open-file limit) does not first announce itself.
     let endpoint = e.bus.listen.join(", ");
-    if !args.quiet && !endpoint.is_empty() {
-        eprintln!(
+    let mut announce = (!args.quiet && !endpoint.is_empty()).then(|| {
+        format!(
             "graspopt: run {:?} on {endpoint} (attach with --connect)",
             e.run
-        );
-    }
+        )
+    });
     let status = runtime.block_on(async {
         let follow = {
             let bar = bar.clone();
             tokio::spawn(async move {
                 while status_rx.changed().await.is_ok() {
+                    if let Some(line) = announce.take() {
+                        bar.suspend(|| eprintln!("{line}"));
+                    }
                     let s = status_rx.borrow().clone();
                     bar.set_position(s.completed + s.failed);
                     if let Some(b) = &s.best {

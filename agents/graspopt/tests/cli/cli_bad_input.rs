@@ -597,6 +597,9 @@ fn run_refuses_more_workers_than_the_open_file_limit_allows() {
             "graspopt launch",
         ],
     );
+    // A run refused at start does not first announce where to attach.
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("attach with"), "{stderr}");
     assert!(!out.exists(), "a refused run wrote {}", out.display());
     // More hands than one process runs, whatever the limit.
     let args = ["run", "--workers", "100000", "--out", out.to_str().unwrap()];
