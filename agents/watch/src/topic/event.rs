@@ -116,6 +116,11 @@ pub async fn echo(
 /// The line a window says at `now` seconds.
 fn rate_line(w: &Window, now: f64, key: &str, measure: Measure) -> String {
     match w.stats(now) {
+        None if w.is_empty() && key.ends_with("/clouds") => format!(
+            "no messages yet on {key} (a hand sends its clouds to a metric agent on its own \
+             machine through shared memory, which topic tools do not see; only clouds to \
+             other machines come here)"
+        ),
         None if w.is_empty() => format!("no messages yet on {key}"),
         None => format!(
             "{} message(s) on {key} so far; a rate needs {MIN_WINDOW}",
@@ -205,6 +210,10 @@ mod tests {
         assert_eq!(
             rate_line(&w, 0.0, key, Measure::Rate),
             "no messages yet on graspopt/r/status"
+        );
+        assert!(
+            rate_line(&w, 0.0, "graspopt/r/clouds", Measure::Bandwidth)
+                .contains("through shared memory, which topic tools do not see")
         );
         w.push(0.0, 1500);
         assert!(rate_line(&w, 1.0, key, Measure::Rate).starts_with("1 message(s) on"));
