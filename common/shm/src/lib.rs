@@ -359,6 +359,14 @@ fn init_logging() {
     ONCE.call_once(|| set_log_level_from_env_or(LogLevel::Error));
 }
 
+/// The iceoryx2 name `name` of one of `service`'s services.
+fn service_name(service: &str, name: &str) -> Result<ServiceName> {
+    ServiceName::new(name).map_err(|e| ShmError::InvalidServiceName {
+        service: service.to_owned(),
+        reason: format!("{e:?}"),
+    })
+}
+
 fn port_name(service: &str, name: &str) -> Result<PortName> {
     PortName::new(name).map_err(service_err(service, "name port"))
 }
@@ -370,8 +378,8 @@ fn port_name(service: &str, name: &str) -> Result<PortName> {
 /// The two directions are two event services because an iceoryx2 notifier
 /// connects to every listener of its service (a socket and a mapped file
 /// each): with one service for both, each hand's notifier connected to every
-/// other hand's acknowledgement listener, and a run with 64 hands in one
-/// process held 2,800 descriptors at 32 hands and 9,700 at 64 (growing as
+/// other hand's acknowledgement listener, and a run with every agent in one
+/// process held 2,800 descriptors with 32 hands and 9,700 with 64 (growing as
 /// the square of the hands), past a default limit of 1,024 open files at 20.
 /// Apart, a notifier connects only to the ports that listen to it.
 /// Field order is drop order.
@@ -386,10 +394,7 @@ impl Endpoints {
     fn open(config: &ShmConfig, service: &str, role: &str) -> Result<Self> {
         init_logging();
         let ice = config.iceoryx()?;
-        let name = ServiceName::new(service).map_err(|e| ShmError::InvalidServiceName {
-            service: service.to_owned(),
-            reason: format!("{e:?}"),
-        })?;
+        let name = service_name(service, service)?;
         let node_name = NodeName::new(role).map_err(service_err(service, "name node"))?;
         let node = NodeBuilder::new()
             .name(&node_name)
@@ -422,13 +427,7 @@ impl Endpoints {
                 .map_err(service_err(service, what))
         };
         let wakes = events(&name, "open wake-up event service")?;
-        let ack_name =
-            ServiceName::new(&format!("{service}{ACK_SERVICE_SUFFIX}")).map_err(|e| {
-                ShmError::InvalidServiceName {
-                    service: service.to_owned(),
-                    reason: format!("{e:?}"),
-                }
-            })?;
+        let ack_name = service_name(service, &format!("{service}{ACK_SERVICE_SUFFIX}"))?;
         let acks = events(&ack_name, "open acknowledgement event service")?;
         Ok(Self {
             wakes,
