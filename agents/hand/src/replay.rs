@@ -50,10 +50,12 @@ pub struct RecordedTrial {
 /// Why a recording cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordingError {
-    #[error("cannot read the recording {path}: {source}")]
+    /// The I/O error is in the message, so it is not a `source()` (a chain printed with
+    /// `{:#}` would say it twice).
+    #[error("cannot read the recording {path}: {error}")]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("recording {path}, line {line}: {detail}")]
     Line {
@@ -79,9 +81,9 @@ impl Recording {
     /// unit vector and every fingertip surface valid (the checks of the message the grasp is
     /// sent as), one parameter count and one kind of measurement throughout.
     pub fn load(path: &Path) -> Result<Recording, RecordingError> {
-        let io = |source| RecordingError::Io {
+        let io = |error| RecordingError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         };
         let file = std::fs::File::open(path).map_err(io)?;
         let mut trials = Vec::new();

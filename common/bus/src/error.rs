@@ -12,8 +12,10 @@ pub enum BusError {
     Encode(#[from] EncodeError),
     #[error(transparent)]
     Decode(#[from] DecodeError),
+    /// Its text is in the message, so it is not a `source()` (a chain printed with `{:#}`
+    /// would say it twice).
     #[error("shared memory: {0}")]
-    Shm(#[from] graspopt_shm::ShmError),
+    Shm(graspopt_shm::ShmError),
     #[error("no reply from {key} within {timeout_ms} ms")]
     NoReply { key: String, timeout_ms: u64 },
     /// Another agent already holds this agent's place in the run (its id, or the run's one
@@ -25,6 +27,12 @@ pub enum BusError {
     NoResponder { key: String },
     #[error("{key} replied with an error: {detail}")]
     ReplyError { key: String, detail: String },
+}
+
+impl From<graspopt_shm::ShmError> for BusError {
+    fn from(e: graspopt_shm::ShmError) -> Self {
+        BusError::Shm(e)
+    }
 }
 
 impl BusError {

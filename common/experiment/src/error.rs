@@ -2,17 +2,18 @@
 
 use thiserror::Error;
 
-/// Why an experiment could not run.
+/// Why an experiment could not run. A wrapped error named in the message is not also a
+/// `source()`: an error chain printed with `{:#}` would say it twice.
 #[derive(Debug, Error)]
 pub enum ExperimentError {
     /// The optimisation engine refused (bad bounds or settings).
     #[error("optimizer: {0}")]
-    Optimizer(#[from] graspopt_bayesopt::BoError),
+    Optimizer(graspopt_bayesopt::BoError),
     /// A trial could not be run or scored.
-    #[error("trial at {params:?}: {source}")]
+    #[error("trial at {params:?}: {error}")]
     Trial {
         params: Vec<f64>,
-        source: graspopt_trial::TrialError,
+        error: graspopt_trial::TrialError,
     },
     /// A trial scored a value that is not finite.
     #[error("trial at {params:?} scored {score}, not a finite number")]
@@ -32,4 +33,10 @@ pub enum ExperimentError {
     /// The experiment's own settings are wrong.
     #[error("{0}")]
     Settings(String),
+}
+
+impl From<graspopt_bayesopt::BoError> for ExperimentError {
+    fn from(e: graspopt_bayesopt::BoError) -> Self {
+        ExperimentError::Optimizer(e)
+    }
 }

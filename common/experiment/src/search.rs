@@ -92,9 +92,9 @@ impl Searcher {
 
 /// Scores `params`, refusing a score that is not finite.
 pub(crate) fn score(ev: &Evaluator, params: &[f64]) -> Result<f64, ExperimentError> {
-    let score = ev.score(params).map_err(|source| ExperimentError::Trial {
+    let score = ev.score(params).map_err(|error| ExperimentError::Trial {
         params: params.to_vec(),
-        source,
+        error,
     })?;
     if !score.is_finite() {
         return Err(ExperimentError::NonFinite {

@@ -11,20 +11,9 @@ pub fn trials_to_within(best_so_far: &[f64], reference: f64, fraction: f64) -> O
     best_so_far.iter().position(|b| *b >= goal).map(|i| i + 1)
 }
 
-/// Median (mean of the two middle values for an even count); None when empty.
-pub fn median(values: &[f64]) -> Option<f64> {
-    let mut v: Vec<f64> = values.to_vec();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
-}
+/// Median (mean of the two middle values for an even count); `None` when empty: the
+/// engine crate's, the one copy in the workspace.
+pub use graspopt_bayesopt::benchmark::median;
 
 #[cfg(test)]
 mod tests {

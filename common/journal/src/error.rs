@@ -4,11 +4,21 @@ use crate::types::TrialState;
 
 /// Everything that can go wrong in the journal. Each variant names the run,
 /// trial or field concerned so that a log line is enough to find the cause.
+///
+/// The wrapped errors (SQLite, JSON, I/O) are part of the message and not a `source()`:
+/// an error chain printed with `{:#}` would otherwise say them twice.
 #[derive(Debug, thiserror::Error)]
 pub enum JournalError {
     /// The database itself failed (I/O, lock timeout, constraint, ...).
     #[error("journal database error: {0}")]
-    Sqlite(#[from] rusqlite::Error),
+    Sqlite(rusqlite::Error),
+    /// The journal file cannot be opened or written; `reason` says why (a missing folder,
+    /// a permission, ...).
+    #[error("{reason}")]
+    Open {
+        path: std::path::PathBuf,
+        reason: String,
+    },
     /// The run id is not in the journal.
     #[error("unknown run {0:?}")]
     UnknownRun(String),
@@ -36,10 +46,10 @@ pub enum JournalError {
     JournalMode(String),
     /// JSON (de)serialisation failed.
     #[error("journal JSON error: {0}")]
-    Json(#[from] serde_json::Error),
+    Json(serde_json::Error),
     /// Writing an export failed.
     #[error("journal I/O error: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// An operation that requires an issued trial named one the run does not know.
     #[error("run {run_id:?} has no trial {trial_id}")]
     UnknownTrial { run_id: String, trial_id: u64 },
@@ -77,6 +87,24 @@ pub enum JournalError {
     /// Trial ids are stored as SQLite integers (i64); larger ids are refused.
     #[error("trial id {0} is too large for the journal (max {max})", max = i64::MAX)]
     TrialIdRange(u64),
+}
+
+impl From<rusqlite::Error> for JournalError {
+    fn from(e: rusqlite::Error) -> Self {
+        JournalError::Sqlite(e)
+    }
+}
+
+impl From<serde_json::Error> for JournalError {
+    fn from(e: serde_json::Error) -> Self {
+        JournalError::Json(e)
+    }
+}
+
+impl From<std::io::Error> for JournalError {
+    fn from(e: std::io::Error) -> Self {
+        JournalError::Io(e)
+    }
 }
 
 /// The journal's result type.

@@ -54,10 +54,25 @@ impl Journal {
     /// `synchronous=NORMAL` (survives a kill -9 of the process at any point;
     /// a power loss may lose the last transactions but never corrupts),
     /// foreign keys on, busy timeout 5 s, schema created or checked.
+    ///
+    /// A file SQLite cannot open or write (its only word for it is "unable to open
+    /// database file") is [`JournalError::Open`], saying why: a missing folder, a
+    /// permission, a folder where the file should be.
     pub fn open(path: &Path) -> Result<Journal> {
-        let conn = Connection::open(path)?;
-        conn.busy_timeout(BUSY_TIMEOUT)?;
-        let mode: String = conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get(0))?;
+        let opened = Connection::open(path).and_then(|conn| {
+            conn.busy_timeout(BUSY_TIMEOUT)?;
+            let mode: String = conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get(0))?;
+            Ok((conn, mode))
+        });
+        let (conn, mode) = opened.map_err(|e| match e.sqlite_error_code() {
+            Some(rusqlite::ErrorCode::CannotOpen | rusqlite::ErrorCode::ReadOnly) => {
+                JournalError::Open {
+                    path: path.to_path_buf(),
+                    reason: why_unopenable(path, &e),
+                }
+            }
+            _ => JournalError::Sqlite(e),
+        })?;
         if !mode.eq_ignore_ascii_case("wal") {
             return Err(JournalError::JournalMode(mode));
         }
@@ -792,6 +807,44 @@ fn insert_event(
     Ok(())
 }
 
+/// Why SQLite could not open or write the journal at `path` (it says only "unable to open
+/// database file"): the file system's own answer for the folder and the file, else
+/// SQLite's words (`e`).
+fn why_unopenable(path: &Path, e: &rusqlite::Error) -> String {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if path.is_dir() {
+        return format!("{} is a folder, not a journal file", path.display());
+    }
+    match std::fs::metadata(folder) {
+        Err(err) if err.kind() == std::io::ErrorKind::NotFound => {
+            return format!("its folder {} does not exist", folder.display());
+        }
+        Err(err) => return format!("its folder {}: {err}", folder.display()),
+        Ok(m) if !m.is_dir() => return format!("{} is not a folder", folder.display()),
+        Ok(_) => {}
+    }
+    if path.exists()
+        && let Err(err) = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+    {
+        return format!("cannot write it: {err}");
+    }
+    // The journal keeps its write-ahead log and index (`-wal`, `-shm`) beside the file.
+    if let Err(err) = tempfile::tempfile_in(folder) {
+        return format!(
+            "cannot create files in its folder {} ({err}); the journal keeps its \
+             write-ahead log beside it",
+            folder.display()
+        );
+    }
+    format!("SQLite: {e}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -806,5 +859,45 @@ mod tests {
             .unwrap();
         assert_eq!(pages, WAL_CHECKPOINT_PAGES);
         assert_eq!(pages, 10_000);
+    }
+
+    /// The message of `Journal::open(path)`'s error.
+    fn refusal(path: &Path) -> String {
+        match Journal::open(path) {
+            Ok(_) => panic!("{} opened", path.display()),
+            Err(e @ JournalError::Open { .. }) => e.to_string(),
+            Err(e) => panic!("{}: not an Open error: {e:?}", path.display()),
+        }
+    }
+
+    #[test]
+    fn a_journal_that_cannot_be_opened_says_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("no-such-folder");
+        assert_eq!(
+            refusal(&missing.join("j.sqlite")),
+            format!("its folder {} does not exist", missing.display())
+        );
+        assert_eq!(
+            refusal(dir.path()),
+            format!("{} is a folder, not a journal file", dir.path().display())
+        );
+        let file = dir.path().join("plain-file");
+        std::fs::write(&file, b"x").unwrap();
+        assert_eq!(
+            refusal(&file.join("j.sqlite")),
+            format!("{} is not a folder", file.display())
+        );
+    }
+
+    #[test]
+    fn a_wrapped_error_is_said_once() {
+        // In the message and not a `source()` too: `{:#}` would print it twice.
+        let e = JournalError::from(rusqlite::Error::QueryReturnedNoRows);
+        assert!(e.to_string().contains("no rows"), "{e}");
+        assert!(std::error::Error::source(&e).is_none());
+        let e = JournalError::from(std::io::Error::other("disk on fire"));
+        assert_eq!(e.to_string(), "journal I/O error: disk on fire");
+        assert!(std::error::Error::source(&e).is_none());
     }
 }

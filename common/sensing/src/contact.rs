@@ -202,9 +202,16 @@ pub enum NoContact {
         separation * 1e3
     )]
     Ambiguous { separation: f64 },
-    /// The surface, the settings or the reading is invalid.
+    /// The surface, the settings or the reading is invalid. (Its text is in the message,
+    /// so it is not a `source()`: a chain printed with `{:#}` would say it twice.)
     #[error("invalid input: {0}")]
-    Invalid(#[from] SensingError),
+    Invalid(SensingError),
+}
+
+impl From<SensingError> for NoContact {
+    fn from(e: SensingError) -> Self {
+        NoContact::Invalid(e)
+    }
 }
 
 /// Candidates closer than this (m) are one solution (a capsule seam gives the same
