@@ -58,7 +58,28 @@ impl Default for CoordinatorConfig {
     }
 }
 
+/// The longest lease and planner timeout accepted (a week, in milliseconds): longer ones
+/// would overflow the millisecond clock's arithmetic, and mean "never" anyway.
+pub const MAX_WAIT_MS: u64 = 7 * 24 * 3600 * 1000;
+
 impl CoordinatorConfig {
+    /// Refuses settings the coordinator cannot keep: a lease or planner timeout of 0 (every
+    /// trial would expire at once, every question time out) or over [`MAX_WAIT_MS`]. The
+    /// message names the setting.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [
+            ("lease_ms", self.lease_ms),
+            ("planner_timeout_ms", self.planner_timeout_ms),
+        ] {
+            if !(1..=MAX_WAIT_MS).contains(&v) {
+                return Err(format!(
+                    "{name} is {v}: it must be between 1 and {MAX_WAIT_MS} (a week)"
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The journal file of `run` (see [`CoordinatorConfig::journal`]).
     pub fn journal_path(&self, run: &RunId) -> PathBuf {
         if self.journal.as_os_str().is_empty() {
@@ -68,5 +89,32 @@ impl CoordinatorConfig {
         } else {
             self.journal.clone()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_a_coordinator_cannot_keep_are_refused_by_name() {
+        assert_eq!(CoordinatorConfig::default().validate(), Ok(()));
+        let zero = CoordinatorConfig {
+            lease_ms: 0,
+            ..Default::default()
+        };
+        assert_eq!(
+            zero.validate(),
+            Err("lease_ms is 0: it must be between 1 and 604800000 (a week)".into())
+        );
+        let forever = CoordinatorConfig {
+            planner_timeout_ms: u64::MAX,
+            ..Default::default()
+        };
+        let err = forever.validate().unwrap_err();
+        assert!(
+            err.starts_with("planner_timeout_ms is 18446744073709551615"),
+            "{err}"
+        );
     }
 }

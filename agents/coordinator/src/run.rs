@@ -49,6 +49,9 @@ pub async fn run_until(
     progress: Option<watch::Sender<RunStatus>>,
     stop: impl std::future::Future<Output = ()>,
 ) -> anyhow::Result<RunStatus> {
+    config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("coordinator settings: {e}"))?;
     // Two coordinators on one run would issue each trial twice and fight over the journal.
     let place = bus
         .wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))

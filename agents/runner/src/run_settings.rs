@@ -268,7 +268,18 @@ impl RunSettings {
             period_ms: 500,
             ..Default::default()
         };
+        let coordinator = CoordinatorConfig {
+            journal: out.join("journal.sqlite"),
+            lease_ms: self.lease_ms,
+            ..Default::default()
+        };
         // Checked before anything is written, so a refused run leaves no trace.
+        anyhow::ensure!(
+            (1..=graspopt_coordinator::MAX_WAIT_MS).contains(&self.lease_ms),
+            "--lease-ms is {}: it must be between 1 and {} (a week)",
+            self.lease_ms,
+            graspopt_coordinator::MAX_WAIT_MS
+        );
         perception
             .validate()
             .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
@@ -287,11 +298,7 @@ impl RunSettings {
                 trial_cost_ms: self.trial_cost_ms,
                 ..Default::default()
             },
-            coordinator: CoordinatorConfig {
-                journal: out.join("journal.sqlite"),
-                lease_ms: self.lease_ms,
-                ..Default::default()
-            },
+            coordinator,
             out,
             run,
             bus,

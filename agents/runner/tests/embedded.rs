@@ -139,3 +139,32 @@ async fn a_resumed_run_restores_its_recorded_settings_and_refuses_contrary_ones(
     let msg = format!("{:#}", other.embedded().err().expect("the folder is taken"));
     assert!(msg.contains("holds run \"again\" already"), "{msg}");
 }
+
+/// A lease of 0 (every trial expired at once) or beyond a week (the millisecond clock's
+/// arithmetic would overflow) is refused by its flag's name before anything is written.
+#[test]
+fn a_lease_out_of_range_is_refused_by_name() {
+    use graspopt_runner::RunSettings;
+
+    for lease_ms in [0, u64::MAX, graspopt_coordinator::MAX_WAIT_MS + 1] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("run");
+        let settings = RunSettings {
+            lease_ms,
+            out: Some(out.clone()),
+            ..RunSettings::default()
+        };
+        let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+        assert_eq!(
+            msg,
+            format!("--lease-ms is {lease_ms}: it must be between 1 and 604800000 (a week)")
+        );
+        assert!(!out.exists(), "a refused run wrote {}", out.display());
+    }
+    let settings = RunSettings {
+        lease_ms: graspopt_coordinator::MAX_WAIT_MS,
+        out: Some(tempfile::tempdir().unwrap().path().join("run")),
+        ..RunSettings::default()
+    };
+    assert!(settings.embedded().is_ok());
+}
