@@ -241,15 +241,9 @@ impl TriangleMesh {
                 what: format!("vertex {i} of mesh `{name}`"),
             });
         }
-        let n = self.vertices.len() as u32;
+        self.check_indices(name)?;
         let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(self.triangles.len() * 3);
         for (ti, t) in self.triangles.iter().enumerate() {
-            if t.iter().any(|&i| i >= n) {
-                return Err(SimError::MeshParse {
-                    name: name.to_string(),
-                    reason: format!("triangle {ti} has a vertex index out of range ({n} vertices)"),
-                });
-            }
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
                 return Err(SimError::NotWatertight {
                     name: name.to_string(),
@@ -294,9 +288,28 @@ impl TriangleMesh {
         Ok(())
     }
 
+    /// Refuses a triangle that names a vertex the mesh does not have.
+    fn check_indices(&self, name: &str) -> Result<()> {
+        let n = self.vertices.len();
+        match self
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            Some(ti) => Err(SimError::MeshParse {
+                name: name.to_string(),
+                reason: format!("triangle {ti} has a vertex index out of range ({n} vertices)"),
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Validates a user mesh ([`TriangleMesh::validate_closed`] after welding) and returns it
     /// oriented outward (flipped if its winding encloses a negative volume).
     pub fn into_closed_solid(self, name: &str) -> Result<Self> {
+        // Before welding, which drops a triangle it cannot map (the mesh would then be
+        // reported open instead of malformed).
+        self.check_indices(name)?;
         let mut mesh = self.welded();
         if mesh.triangles.is_empty() && !self.triangles.is_empty() {
             return Err(SimError::NotWatertight {
@@ -474,23 +487,34 @@ pub fn extrude_star_shaped(polygon: &[(f64, f64)], z0: f64, z1: f64) -> Triangle
     TriangleMesh::new(vertices, triangles).oriented_outward()
 }
 
-/// The convex hull of `points` as a closed mesh oriented outward, `None` when the points span
-/// no volume (fewer than four, or all in a plane).
-pub fn convex_hull(points: &[Point3<f64>]) -> Option<TriangleMesh> {
-    if points.len() < 4
-        || points
-            .iter()
-            .any(|p| !p.coords.iter().all(|c| c.is_finite()))
+/// The convex hull of `points` as a closed mesh oriented outward, or why there is none
+/// (fewer than four points, a coordinate not finite, points that span no volume, or parry
+/// unable to build it from degenerate input: its `convex_hull` would panic there).
+pub fn convex_hull(points: &[Point3<f64>]) -> Result<TriangleMesh, String> {
+    if points.len() < 4 {
+        return Err(format!(
+            "{} points are fewer than the four a volume needs",
+            points.len()
+        ));
+    }
+    if let Some(p) = points
+        .iter()
+        .find(|p| !p.coords.iter().all(|c| c.is_finite()))
     {
-        return None;
+        return Err(format!("a point is not finite ({p:?})"));
     }
     let pts: Vec<_> = points.iter().map(crate::convert::p2g).collect();
-    let (vertices, triangles) = parry3d_f64::transformation::convex_hull(&pts);
+    let (vertices, triangles) = parry3d_f64::transformation::try_convex_hull(&pts)
+        .map_err(|e| format!("its points are degenerate, no hull can be built ({e:?})"))?;
     let hull = TriangleMesh::new(
         vertices.into_iter().map(crate::convert::g2p).collect(),
         triangles,
     );
-    (hull.triangles.len() >= 4 && hull.signed_volume().abs() > 0.0).then(|| hull.oriented_outward())
+    if hull.triangles.len() >= 4 && hull.signed_volume().abs() > 0.0 {
+        Ok(hull.oriented_outward())
+    } else {
+        Err("its points are flat: they enclose no volume".into())
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -649,6 +673,36 @@ mod tests {
         );
         star.validate_closed("star").unwrap();
         assert!((star.signed_volume() - 0.0008 * 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_triangle_naming_a_missing_vertex_is_malformed_not_open() {
+        let mut cube = box_mesh(&Vector3::new(0.1, 0.1, 0.1));
+        cube.triangles[3][1] = 99;
+        let e = cube.into_closed_solid("cube").unwrap_err().to_string();
+        assert!(
+            e.contains("triangle 3 has a vertex index out of range (8 vertices)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_hull_of_degenerate_points_is_an_error_not_a_panic() {
+        let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+        let same = vec![p(0.1, 0.2, 0.3); 12];
+        let line: Vec<_> = (0..12).map(|i| p(f64::from(i) * 0.01, 0.0, 0.0)).collect();
+        let flat: Vec<_> = (0..12)
+            .map(|i| p(f64::from(i % 4) * 0.01, f64::from(i / 4) * 0.01, 0.0))
+            .collect();
+        for (what, points) in [("same", same), ("line", line), ("flat", flat)] {
+            assert!(convex_hull(&points).is_err(), "{what}: a hull");
+        }
+        let e = convex_hull(&[p(0.0, 0.0, 0.0); 3]).unwrap_err();
+        assert!(e.contains("3 points are fewer than the four"), "{e}");
+        let mut cube: Vec<_> = box_mesh(&Vector3::new(0.1, 0.1, 0.1)).vertices;
+        assert_eq!(convex_hull(&cube).unwrap().vertices.len(), 8);
+        cube[2].y = f64::NAN;
+        assert!(convex_hull(&cube).unwrap_err().contains("not finite"));
     }
 
     #[test]

@@ -307,6 +307,20 @@ fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
         e.contains("part.dae") && e.contains("expected .obj or .stl"),
         "{e}"
     );
+    // A flat link mesh (one square) has no hull: an error naming the link and the file,
+    // not parry's panic.
+    std::fs::write(
+        dir.join("plate.obj"),
+        "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nv 0.05 0.05 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let e = UrdfHand::from_strs("t.urdf", &urdf("plate.obj"), None, Some(&dir))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`palm`") && e.contains("plate.obj") && e.contains("flat"),
+        "{e}"
+    );
     // Parsed from a string with no folder to look in.
     let e = UrdfHand::from_strs("t.urdf", &urdf("cube.obj"), None, None)
         .unwrap_err()

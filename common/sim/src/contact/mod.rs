@@ -83,13 +83,16 @@ impl ContactCloud {
     }
 }
 
-/// Which contact model to use.
+/// Which contact model to use. Settings files and journals name it as `--contacts` does
+/// ([`ContactModel::name`]); the longer names of earlier versions are still read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactModel {
     /// One contact per finger at the cloud's mean.
+    #[serde(rename = "mean", alias = "mean_point")]
     MeanPoint,
     /// Grid points on a disc around the mean, all with the mean normal.
+    #[serde(rename = "patch", alias = "circular_patch")]
     CircularPatch,
     /// The surface model of thesis section 2.3.
     Surface,
@@ -381,6 +384,23 @@ pub(crate) use region::link_cloud;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_contact_model_has_one_name_in_flags_files_and_journals() {
+        for m in ContactModel::ALL {
+            let json = serde_json::to_string(&m).unwrap();
+            assert_eq!(json, format!("\"{}\"", m.name()));
+            assert_eq!(serde_json::from_str::<ContactModel>(&json).unwrap(), m);
+            assert_eq!(ContactModel::parse(m.name()).unwrap(), m);
+        }
+        // Journals and settings files written before still read.
+        for (old, m) in [
+            ("\"mean_point\"", ContactModel::MeanPoint),
+            ("\"circular_patch\"", ContactModel::CircularPatch),
+        ] {
+            assert_eq!(serde_json::from_str::<ContactModel>(old).unwrap(), m);
+        }
+    }
 
     #[test]
     fn default_grid_has_21_points_inside_the_disc() {

@@ -663,10 +663,6 @@ fn load_link_mesh(path: &Path, scale: [f64; 3], link: &str, file: &str) -> Resul
         .iter()
         .map(|v| Point3::new(v.x * scale[0], v.y * scale[1], v.z * scale[2]))
         .collect();
-    mesh::convex_hull(&points).ok_or_else(|| {
-        bad(
-            file,
-            format!("link `{link}`: the mesh `{shown}` encloses no volume (its points are flat or fewer than four)"),
-        )
-    })
+    mesh::convex_hull(&points)
+        .map_err(|why| bad(file, format!("link `{link}`: the mesh `{shown}`: {why}")))
 }
