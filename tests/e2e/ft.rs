@@ -8,16 +8,14 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use graspopt_bus::Bus;
-use graspopt_convert::{clouds_from_outcome, isometry, pose};
+use graspopt_hand::replay::RecordedTrial;
 use graspopt_hand::{HandConfig, HandDriver, HandError, HandReading, Sensing, SimulatedHand};
 use graspopt_journal::{Journal, TrialRow, TrialState};
 use graspopt_protocol::{FingertipSurface, ObjectEstimate, RunId, TrialCommand};
 use graspopt_sensing::SensorNoise;
-use graspopt_sim::{ContactModelSettings, Hand, Object, ParamKind, TrialSpace, run_trial};
-use graspopt_trial::ScoreSettings;
-use graspopt_trial::fingertips::{FingertipSettings, fingertip_score, simulate_readings};
-use graspopt_trial::forces::ForceSettings;
-use graspopt_trial::measured::{MeasuredTrial, score_measured};
+use graspopt_sim::ParamKind;
+use graspopt_trial::fingertips::FingertipSettings;
+use graspopt_trial::{Evaluator, TrialSettings};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
@@ -35,64 +33,36 @@ fn within_noise(score: f64, reference: f64) -> bool {
     (score - reference).abs() <= 0.02 * reference.abs() + 1e-3
 }
 
-/// The score of the true fingertip contacts of the trial at `params` (the run's parameters
-/// x, y on `object`), computed as the run computes it, without sensor noise: the palm pose as
-/// the coordinator sends it, the simulated trial, the fingertip contacts the simulated sensors
-/// read, scored as one-point clouds with the metric agent's default settings.
-fn true_score(object: &Object, hand: &dyn Hand, space: &TrialSpace, params: &[f64]) -> f64 {
-    let palm = isometry(&pose(&space.palm_pose(params).unwrap()));
-    let outcome = run_trial(object, hand, &palm, &ContactModelSettings::default()).unwrap();
+/// The mug with barrett_ft over the coordinator's default parameters x, y, scored with the
+/// metric agent's default settings.
+fn evaluator() -> Evaluator {
+    let settings = TrialSettings {
+        object: OBJECT.into(),
+        hand: HAND.into(),
+        ..TrialSettings::default()
+    };
+    let kinds = [
+        ParamKind::parse("x").unwrap(),
+        ParamKind::parse("y").unwrap(),
+    ];
+    Evaluator::from_settings(&settings, &kinds).unwrap()
+}
+
+/// The grasp at `params` as exact (noise-free) fingertip sensors read it: the metric
+/// agent's score of the readings (`score`) and the score of the true contacts they were
+/// simulated from (`true_score`).
+fn exact_grasp(ev: &Evaluator, params: &[f64]) -> RecordedTrial {
     let exact = FingertipSettings {
         noise: SensorNoise::NONE,
         ..Default::default()
     };
-    let tips = simulate_readings(
-        &outcome,
-        hand,
-        object,
-        &ScoreSettings::default(),
-        &ForceSettings::default(),
-        &exact,
-        &mut ChaCha8Rng::seed_from_u64(0),
-    )
-    .unwrap();
-    let contacts: Vec<_> = tips
-        .iter()
-        .map(|t| (t.sensor.finger, t.sensor.link.clone(), t.truth))
-        .collect();
-    let tag = graspopt_convert::TrialTag {
-        run_id: RunId::new("reference").unwrap(),
-        trial_id: 0,
-        attempt: 1,
-        worker: "reference".into(),
-    };
-    let clouds = clouds_from_outcome(&tag, &outcome, 0);
-    let measured = MeasuredTrial::from_fingertips(
-        &clouds.hand,
-        isometry(&clouds.palm_pose),
-        &contacts,
-        clouds.min_gap,
-    );
-    let (s, _) = score_measured(
-        &measured,
-        object,
-        &ContactModelSettings::default(),
-        &fingertip_score(&ScoreSettings::default()),
-    )
-    .unwrap();
-    s.score
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    graspopt_runner::record::fingertip_trial(ev, params.to_vec(), &exact, &mut rng).unwrap()
 }
 
-/// The trial space of the runs here (the coordinator's default parameters x, y).
-fn space(object: &Object) -> TrialSpace {
-    TrialSpace::with_params(
-        object,
-        &[
-            ParamKind::parse("x").unwrap(),
-            ParamKind::parse("y").unwrap(),
-        ],
-    )
-    .unwrap()
+/// The score of the true fingertip contacts of the trial at `params`.
+fn true_score(ev: &Evaluator, params: &[f64]) -> f64 {
+    exact_grasp(ev, params).true_score.unwrap()
 }
 
 /// The largest absolute and relative differences between scores and their references.
@@ -136,13 +106,11 @@ fn a_run_with_a_force_sensing_hand_scores_like_its_true_contacts() {
         &["hand", "--id", "ft-hand", "--hand", HAND, "--sensing", "ft"],
     );
     let rows = optimize_with(&c, hand, "ft-hand", 30);
-    let object = Object::by_name(OBJECT).unwrap();
-    let hand = graspopt_sim::hand_by_name(HAND).unwrap();
-    let space = space(&object);
+    let ev = evaluator();
     let mut pairs = Vec::new();
     for t in &rows {
         let score = t.score.unwrap();
-        let reference = true_score(&object, hand.as_ref(), &space, &t.params);
+        let reference = true_score(&ev, &t.params);
         assert!(
             within_noise(score, reference),
             "trial {} at {:?}: score {score}, true contacts {reference}",
@@ -205,19 +173,30 @@ fn record(dir: &Path) -> (PathBuf, Vec<Recorded>) {
         })
         .collect();
     assert_eq!(grasps.len(), 49);
-    // The recorded true scores are the true contacts' scores recomputed here.
-    let object = Object::by_name(OBJECT).unwrap();
-    let hand = graspopt_sim::hand_by_name(HAND).unwrap();
-    let space = space(&object);
-    for g in grasps.iter().step_by(8) {
-        let reference = true_score(&object, hand.as_ref(), &space, &g.params);
+    // Exact sensors recover the true contacts: their readings score as the contacts do.
+    // And the recording's true scores do not depend on its sensors' noise.
+    let ev = evaluator();
+    let mut touching = 0;
+    for g in grasps.iter().step_by(4) {
+        let exact = exact_grasp(&ev, &g.params);
+        let (read, truth) = (exact.score.unwrap(), exact.true_score.unwrap());
         assert!(
-            (g.true_score - reference).abs() <= 1e-9 * (1.0 + reference.abs()),
-            "grasp at {:?}: recorded true score {}, recomputed {reference}",
+            (read - truth).abs() <= 1e-6 * (1.0 + truth.abs()),
+            "grasp at {:?}: exact readings score {read}, their true contacts {truth}",
+            g.params
+        );
+        assert!(
+            (g.true_score - truth).abs() <= 1e-9 * (1.0 + truth.abs()),
+            "grasp at {:?}: recorded true score {}, with exact sensors {truth}",
             g.params,
             g.true_score
         );
+        touching += usize::from(exact.fingertips.is_some_and(|f| f.len() >= 2));
     }
+    assert!(
+        touching > 0,
+        "no checked grasp with two fingertips touching"
+    );
     (path, grasps)
 }
 

@@ -66,13 +66,7 @@ pub struct DimFigures {
 impl DimFigures {
     /// Median of the timed rounds (ms).
     pub fn median_ms(&self) -> f64 {
-        let mut v = self.rounds_ms.clone();
-        v.sort_by(f64::total_cmp);
-        match v.len() {
-            0 => f64::NAN,
-            n if n % 2 == 1 => v[n / 2],
-            n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-        }
+        graspopt_bayesopt::benchmark::median(&self.rounds_ms).unwrap_or(f64::NAN)
     }
 
     /// Slowest timed round (ms).

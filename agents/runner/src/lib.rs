@@ -1,7 +1,8 @@
 //! Runs graspopt's agents: every agent of a run in this process ([`embedded`]), from
 //! settings resolved for a new or a resumed run ([`run_settings`]); the pipeline
-//! benchmarks ([`bench`]); launch files and their processes ([`launch`]); an agent's settings file ([`config`]); and the signals that
-//! stop them ([`signal`]).
+//! benchmarks ([`bench`]); launch files and their processes ([`launch`]); recordings for
+//! the replay hand ([`record`]); an agent's settings file ([`config`]); and the signals
+//! that stop them ([`signal`]).
 //!
 //! Tests call it in-process. It knows nothing of command-line flags: the `graspopt` binary
 //! fills a [`RunSettings`] from them.
@@ -11,6 +12,7 @@ pub mod config;
 pub mod embedded;
 pub mod launch;
 pub mod open_files;
+pub mod record;
 pub mod run_settings;
 pub mod signal;
 
