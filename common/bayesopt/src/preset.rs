@@ -83,14 +83,15 @@ pub enum Method {
 
 impl Method {
     /// The methods users name: `bo` (the engine with [`Preset::Benchmark`]), `bo-thesis`
-    /// ([`Preset::Thesis`]) and `random`.
-    pub const NAMED: [Method; 3] = [
+    /// ([`Preset::Thesis`]), `bo-grasp` ([`Preset::Grasp`], the planner agent's) and `random`.
+    pub const NAMED: [Method; 4] = [
         Method::Bo(Preset::Benchmark),
         Method::Bo(Preset::Thesis),
+        Method::Bo(Preset::Grasp),
         Method::Random,
     ];
 
-    /// Parses `bo`, `bo-thesis` (or `thesis`) or `random`, in any case.
+    /// Parses `bo`, `bo-thesis` (or `thesis`), `bo-grasp` or `random`, in any case.
     pub fn from_name(name: &str) -> Result<Self, BoError> {
         match name.to_ascii_lowercase().as_str() {
             "bo" => Ok(Method::Bo(Preset::Benchmark)),
@@ -98,7 +99,8 @@ impl Method {
             "bo-grasp" => Ok(Method::Bo(Preset::Grasp)),
             "random" => Ok(Method::Random),
             other => Err(BoError::InvalidSetting(format!(
-                "unknown method '{other}' (known: bo, bo-thesis, random)"
+                "unknown method '{other}' (known: {})",
+                Method::NAMED.map(Method::name).join(", ")
             ))),
         }
     }
@@ -148,7 +150,7 @@ mod tests {
         for p in Preset::ALL {
             assert_eq!(p.name().parse::<Preset>().unwrap(), p);
         }
-        for m in Method::NAMED.into_iter().chain([Method::Bo(Preset::Grasp)]) {
+        for m in Method::NAMED {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
         }
         assert_eq!(
@@ -157,7 +159,7 @@ mod tests {
         );
         assert_eq!(
             "bo-x".parse::<Method>().unwrap_err().to_string(),
-            "invalid setting: unknown method 'bo-x' (known: bo, bo-thesis, random)"
+            "invalid setting: unknown method 'bo-x' (known: bo, bo-thesis, bo-grasp, random)"
         );
         assert!("Grasp".parse::<Preset>().is_err());
     }
