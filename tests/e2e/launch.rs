@@ -1,6 +1,7 @@
 //! `graspopt launch deploy/local.toml`: the example launch file starts a router and every agent
 //! as processes, the run completes, and nothing is left running.
 
+use std::os::unix::process::CommandExt;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
@@ -64,7 +65,9 @@ fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
 
 /// A launch stopped by Ctrl-C is continued by `graspopt launch --resume FILE`: the trials
 /// completed before the stop are kept and the run finishes its budget. The same launch
-/// without `--resume` is refused by the coordinator, which says how to resume.
+/// without `--resume` is refused by the coordinator, which says how to resume. Ctrl-C is
+/// sent as a terminal sends it, to launch's whole process group: the coordinator stops
+/// first, without seeing its workers leave.
 #[test]
 fn a_stopped_launch_is_continued_by_launch_resume() {
     let dir = tempdir("launch-resume");
@@ -105,12 +108,13 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journ
         c
     };
     let journal = dir.join("results/lr/journal.sqlite");
-    let first = launch(&[]).spawn().unwrap();
+    // In a process group of its own, as a shell runs a foreground job.
+    let first = launch(&[]).process_group(0).spawn().unwrap();
     wait_until("three trials", Duration::from_secs(60), || {
         completed_now(&journal, "lr") >= 3
     });
     let ok = Command::new("kill")
-        .args(["-INT", &first.id().to_string()])
+        .args(["-INT", "--", &format!("-{}", first.id())])
         .status()
         .unwrap()
         .success();
@@ -137,6 +141,11 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journ
         "{} completed",
         before.len()
     );
+    let log = std::fs::read_to_string(dir.join("logs/lr/coordinator.log")).unwrap();
+    assert!(!log.contains("lost with trial"), "{log}");
+    let j = Journal::open(&journal).unwrap();
+    assert_eq!(j.run("lr").unwrap().unwrap().status, RunLifecycle::Stopped);
+    drop(j);
 
     // Launched again as it was: the coordinator refuses, naming the way to resume.
     let out = launch(&[]).output().unwrap();

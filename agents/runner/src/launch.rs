@@ -12,10 +12,16 @@
 //! (the coordinator prints the final status there). When the coordinator exits, the others
 //! are stopped (SIGTERM, then SIGKILL) and launch exits with the coordinator's status; if
 //! another process exits first, launch stops everything and names it. Ctrl-C stops all.
-
+//!
+//! Each process runs in its own process group, so a terminal's Ctrl-C (or hang-up), sent to
+//! the foreground group, reaches launch alone, which stops the processes in order: the
+//! coordinator first (it records the run as stopped, every result in), then the agents,
+//! the router last. Signalled all at once, the coordinator would see its workers leave and
+//! re-issue their trials on its way out.
 //!
 //! Processes are signalled with `nix::sys::signal::kill` (SIGTERM, then SIGKILL after 5 s).
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -251,6 +257,7 @@ fn reachable_addr(endpoint: &str) -> Option<String> {
 struct Running {
     name: String,
     coordinator: bool,
+    router: bool,
     child: Child,
     log: PathBuf,
 }
@@ -297,12 +304,14 @@ impl Children {
                 .args(&p.args)
                 .stdin(Stdio::null())
                 .stderr(err)
+                .process_group(0)
                 .spawn()
                 .with_context(|| format!("cannot start {}", p.name))?;
             started(&p.name, &log);
             children.0.push(Running {
                 name: p.name.clone(),
                 coordinator: p.coordinator,
+                router: p.wait_addr.is_some(),
                 child,
                 log,
             });
@@ -360,25 +369,56 @@ impl Children {
         all_done.then_some(Outcome::Coordinator(Some(0), None))
     }
 
-    /// Stops every process still running: SIGTERM first (agents close their sessions and
-    /// release shared memory), SIGKILL for those still running 5 s later.
+    /// Stops every process still running, in three waves: the coordinator, then the other
+    /// agents, then the router (see the module documentation). Each wave gets SIGTERM
+    /// (agents close their sessions and release shared memory), then SIGKILL for what still
+    /// runs 5 s later.
     pub fn terminate(&mut self) {
-        for c in self.0.iter_mut() {
-            if matches!(c.child.try_wait(), Ok(None))
-                && let Ok(pid) = i32::try_from(c.child.id())
-            {
-                let _ = kill(Pid::from_raw(pid), Signal::SIGTERM);
-            }
+        for wave in [Wave::Coordinator, Wave::Agents, Wave::Router] {
+            let members: Vec<&mut Running> =
+                self.0.iter_mut().filter(|c| c.wave() == wave).collect();
+            stop(members);
         }
-        let deadline = Instant::now() + Duration::from_secs(5);
-        for c in self.0.iter_mut() {
-            while matches!(c.child.try_wait(), Ok(None)) && Instant::now() < deadline {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            if matches!(c.child.try_wait(), Ok(None)) {
-                let _ = c.child.kill();
-                let _ = c.child.wait();
-            }
+    }
+}
+
+/// When a process is stopped (see [`Children::terminate`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Wave {
+    Coordinator,
+    Agents,
+    Router,
+}
+
+impl Running {
+    fn wave(&self) -> Wave {
+        if self.coordinator {
+            Wave::Coordinator
+        } else if self.router {
+            Wave::Router
+        } else {
+            Wave::Agents
+        }
+    }
+}
+
+/// SIGTERM to every one of `members` still running, SIGKILL to those running 5 s later.
+fn stop(mut members: Vec<&mut Running>) {
+    for c in members.iter_mut() {
+        if matches!(c.child.try_wait(), Ok(None))
+            && let Ok(pid) = i32::try_from(c.child.id())
+        {
+            let _ = kill(Pid::from_raw(pid), Signal::SIGTERM);
+        }
+    }
+    let deadline = Instant::now() + Duration::from_secs(5);
+    for c in members {
+        while matches!(c.child.try_wait(), Ok(None)) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        if matches!(c.child.try_wait(), Ok(None)) {
+            let _ = c.child.kill();
+            let _ = c.child.wait();
         }
     }
 }
@@ -558,6 +598,41 @@ mod tests {
                 .all(|c| c.child.try_wait().unwrap().is_some())
         );
         assert_eq!(tail(&logs.path().join("worker.log"), 5), "up");
+    }
+
+    /// Each process is the leader of its own group (a terminal's Ctrl-C reaches launch
+    /// only), and a stop goes coordinator first, then the agents, the router last: each
+    /// one here notes its SIGTERM in a shared file as it gets it.
+    #[test]
+    fn processes_have_their_own_groups_and_stop_coordinator_first_router_last() {
+        let logs = tempfile::tempdir().unwrap();
+        let order = logs.path().join("order");
+        let script = |name: &str| {
+            format!(
+                "trap 'echo {name} >> {}; exit 0' TERM; while :; do sleep 0.02; done",
+                order.display()
+            )
+        };
+        let plan = shell_plan(&[
+            ("router", false, &script("router")),
+            ("hand-1", false, &script("hand-1")),
+            ("coordinator", true, &script("coordinator")),
+        ]);
+        let mut children =
+            Children::start(&plan, Path::new("/bin/sh"), logs.path(), |_, _| {}).unwrap();
+        // The router, without a port to wait for.
+        children.0[0].router = true;
+        for c in &children.0 {
+            let pid = Pid::from_raw(i32::try_from(c.child.id()).unwrap());
+            assert_eq!(nix::unistd::getpgid(Some(pid)).unwrap(), pid, "{}", c.name);
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        children.terminate();
+        let stopped = std::fs::read_to_string(&order).unwrap();
+        assert_eq!(
+            stopped.lines().collect::<Vec<_>>(),
+            ["coordinator", "hand-1", "router"]
+        );
     }
 
     #[tokio::test]

@@ -2,16 +2,17 @@
 
 use std::future::Future;
 
-/// A future that resolves on Ctrl-C (SIGINT) or SIGTERM. The handlers are registered when
-/// this is called, not when the future is first polled: a signal that arrives in between (a
-/// run that has just recorded itself, say) is not lost, and does not kill the process with
-/// the default action.
+/// A future that resolves on Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal closed). The
+/// handlers are registered when this is called, not when the future is first polled: a
+/// signal that arrives in between (a run that has just recorded itself, say) is not lost,
+/// and does not kill the process with the default action.
 pub fn shutdown_signal() -> impl Future<Output = ()> + Send + 'static {
     #[cfg(unix)]
     {
         use tokio::signal::unix::{Signal, SignalKind, signal};
         let interrupt = signal(SignalKind::interrupt()).ok();
         let terminate = signal(SignalKind::terminate()).ok();
+        let hangup = signal(SignalKind::hangup()).ok();
         async fn wait(signal: Option<Signal>) {
             match signal {
                 Some(mut s) => {
@@ -24,6 +25,7 @@ pub fn shutdown_signal() -> impl Future<Output = ()> + Send + 'static {
             tokio::select! {
                 _ = wait(interrupt) => {},
                 _ = wait(terminate) => {},
+                _ = wait(hangup) => {},
             }
         }
     }
