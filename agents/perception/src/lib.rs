@@ -59,19 +59,37 @@ impl PerceptionConfig {
     /// Checks the settings: the noise levels must be finite and non-negative (an infinite
     /// one would put the object nowhere).
     pub fn validate(&self) -> anyhow::Result<()> {
-        for (name, v) in [
-            ("position_noise", self.position_noise),
-            ("rotation_noise", self.rotation_noise),
+        // Beyond these an estimate means nothing (a rotation's standard deviation past a half
+        // turn, a position's past a metre around objects of centimetres), and the pose of a
+        // huge one is not even finite.
+        for (name, v, max, unit) in [
+            (
+                "position_noise",
+                self.position_noise,
+                MAX_POSITION_NOISE,
+                "m",
+            ),
+            (
+                "rotation_noise",
+                self.rotation_noise,
+                MAX_ROTATION_NOISE,
+                "rad",
+            ),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=max).contains(&v)) {
                 anyhow::bail!(
-                    "perception: {name} must be a finite standard deviation >= 0, got {v}"
+                    "perception: {name} must be a standard deviation between 0 and {max} {unit}, got {v}"
                 );
             }
         }
         Ok(())
     }
 }
+
+/// The largest accepted `position_noise` (m).
+pub const MAX_POSITION_NOISE: f64 = 1.0;
+/// The largest accepted `rotation_noise` (rad): half a turn.
+pub const MAX_ROTATION_NOISE: f64 = std::f64::consts::PI;
 
 /// The scene's object (at its true pose).
 pub fn scene_object(config: &PerceptionConfig) -> anyhow::Result<Object> {
@@ -152,13 +170,16 @@ mod tests {
     }
 
     #[test]
-    fn infinite_or_negative_noise_is_refused_by_name() {
+    fn noise_not_finite_negative_or_meaningless_is_refused_by_name() {
         let run = RunId::new("r").unwrap();
         for (position_noise, rotation_noise, name) in [
             (f64::INFINITY, 0.0, "position_noise"),
             (0.0, f64::NAN, "rotation_noise"),
             (0.0, -0.1, "rotation_noise"),
             (0.0, f64::MAX * 2.0, "rotation_noise"),
+            // Finite but past any meaning: a rotation of 1e300 rad is not even a pose.
+            (0.0, 1e300, "rotation_noise"),
+            (1.5, 0.0, "position_noise"),
         ] {
             let config = PerceptionConfig {
                 position_noise,
@@ -169,5 +190,12 @@ mod tests {
             assert!(e.contains(name), "{e}");
         }
         assert!(PerceptionConfig::default().validate().is_ok());
+        let widest = PerceptionConfig {
+            position_noise: MAX_POSITION_NOISE,
+            rotation_noise: MAX_ROTATION_NOISE,
+            ..PerceptionConfig::default()
+        };
+        assert!(widest.validate().is_ok());
+        assert!(estimate(&run, &widest).is_ok());
     }
 }

@@ -141,10 +141,25 @@ impl LaunchFile {
                     a.kind
                 );
             }
+            // As many hands as one process may run (`graspopt run --workers`): the host's
+            // shared-memory service admits no more.
+            if a.count as usize > graspopt_shm::DEFAULT_MAX_PUBLISHERS {
+                bail!(
+                    "launch file {}: agent {:?} has count {}, more than the {} processes of \
+                     one kind a machine runs",
+                    origin.display(),
+                    a.kind,
+                    a.count,
+                    graspopt_shm::DEFAULT_MAX_PUBLISHERS
+                );
+            }
         }
         let mut names = std::collections::HashSet::new();
         for a in &file.agents {
             for name in a.names() {
+                // The id names the agent on the bus and its log file.
+                graspopt_protocol::keys::check_agent_id(&name)
+                    .with_context(|| format!("launch file {}", origin.display()))?;
                 if !names.insert(name.clone()) {
                     bail!(
                         "launch file {}: two agents named {name:?} (ids are unique in a run, across hosts)",
@@ -548,6 +563,18 @@ mod tests {
             err(two).contains("two agents named \"hand\""),
             "{}",
             err(two)
+        );
+        let e =
+            err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\ncount = 100000");
+        assert!(
+            e.contains("agent \"hand\" has count 100000, more than the 1024"),
+            "{e}"
+        );
+        let e =
+            err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"hand\"\nid = \"a/b\"");
+        assert!(
+            e.contains("x.toml") && e.contains("invalid agent id \"a/b\""),
+            "{e}"
         );
     }
 

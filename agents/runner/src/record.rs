@@ -24,6 +24,25 @@ use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
+/// Refuses `out` as a recording's file if it holds an SQLite database (a run's journal,
+/// say): writing the recording would replace it.
+pub fn refuse_database(out: &std::path::Path) -> Result<()> {
+    use std::io::Read;
+    let mut head = [0u8; 16];
+    let is_database = std::fs::File::open(out)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && head == *b"SQLite format 3\0";
+    if is_database {
+        bail!(
+            "{} is an SQLite database (a run's journal?): a recording would replace it; \
+             write it elsewhere",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 /// The tag of every recorded grasp (a recording belongs to no run).
 fn tag() -> Result<TrialTag> {
     Ok(TrialTag {
@@ -157,5 +176,23 @@ fn readings(
         min_gap: clouds.min_gap,
         error: None,
         executed_ms: 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_recording_does_not_replace_a_journal() {
+        let dir = tempfile::tempdir().unwrap();
+        let journal = dir.path().join("journal.sqlite");
+        drop(graspopt_journal::Journal::open(&journal).unwrap());
+        let e = refuse_database(&journal).unwrap_err().to_string();
+        assert!(e.contains("journal.sqlite is an SQLite database"), "{e}");
+        let text = dir.path().join("old.jsonl");
+        std::fs::write(&text, "{}\n").unwrap();
+        assert!(refuse_database(&text).is_ok());
+        assert!(refuse_database(&dir.path().join("new.jsonl")).is_ok());
     }
 }

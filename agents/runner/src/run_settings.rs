@@ -280,6 +280,14 @@ impl RunSettings {
             self.lease_ms,
             graspopt_coordinator::MAX_WAIT_MS
         );
+        // A trial that outlasts its lease is re-issued before it can end, again and again.
+        anyhow::ensure!(
+            self.trial_cost_ms < self.lease_ms,
+            "--trial-cost-ms {} is not shorter than the lease of a trial (--lease-ms {}): every \
+             trial would expire before it ends and be issued again forever; raise --lease-ms",
+            self.trial_cost_ms,
+            self.lease_ms
+        );
         perception
             .validate()
             .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;

@@ -167,4 +167,17 @@ fn a_lease_out_of_range_is_refused_by_name() {
         ..RunSettings::default()
     };
     assert!(settings.embedded().is_ok());
+    // A trial longer than its lease would be re-issued forever.
+    let settings = RunSettings {
+        trial_cost_ms: 40_000,
+        out: Some(tempfile::tempdir().unwrap().path().join("run")),
+        ..RunSettings::default()
+    };
+    let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+    assert!(
+        msg.starts_with(
+            "--trial-cost-ms 40000 is not shorter than the lease of a trial (--lease-ms 30000)"
+        ),
+        "{msg}"
+    );
 }

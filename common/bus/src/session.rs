@@ -101,15 +101,6 @@ impl Bus {
     /// Opens a session from the flags.
     pub async fn open(args: &BusArgs) -> Result<Bus, BusError> {
         let config = args.zenoh_config()?;
-        let session = zenoh::open(config)
-            .await
-            .map_err(|e| BusError::zenoh("opening the session", e))?;
-        // A peer does not fail when its `--connect` endpoints are unreachable: Zenoh keeps
-        // trying in the background, in silence. Say which cannot be reached, and when they
-        // are.
-        if !args.connect.is_empty() && args.mode != Some(crate::BusMode::Client) {
-            tokio::spawn(watch_reach(session.clone(), args.connect.clone()));
-        }
         let shm = if args.no_shm {
             None
         } else {
@@ -122,12 +113,28 @@ impl Bus {
                 probe_service: graspopt_protocol::keys::shm_probe_service(),
                 ..graspopt_shm::ShmConfig::default()
             };
-            // Resources of processes that died under this prefix (a killed worker).
-            if let Err(e) = graspopt_shm::clean_stale(&config) {
-                tracing::warn!("shared memory: stale-resource cleanup failed: {e}");
-            }
+            // A prefix given that cannot be used is the user's mistake, not a reason to fall
+            // back to the network in silence.
+            config
+                .validate()
+                .map_err(|e| BusError::Config(format!("--shm-prefix: {e}")))?;
             Some(config)
         };
+        let session = zenoh::open(config)
+            .await
+            .map_err(|e| BusError::zenoh("opening the session", e))?;
+        // A peer does not fail when its `--connect` endpoints are unreachable: Zenoh keeps
+        // trying in the background, in silence. Say which cannot be reached, and when they
+        // are.
+        if !args.connect.is_empty() && args.mode != Some(crate::BusMode::Client) {
+            tokio::spawn(watch_reach(session.clone(), args.connect.clone()));
+        }
+        // Resources of processes that died under this prefix (a killed worker).
+        if let Some(config) = &shm
+            && let Err(e) = graspopt_shm::clean_stale(config)
+        {
+            tracing::warn!("shared memory: stale-resource cleanup failed: {e}");
+        }
         Ok(Bus {
             session,
             host: host_name(),

@@ -24,8 +24,8 @@ pub enum ExperimentError {
     /// An object or a trial space could not be built.
     #[error(transparent)]
     Sim(#[from] graspopt_sim::SimError),
-    /// The hand could not be loaded.
-    #[error("cannot load the hand {name:?}")]
+    /// The hand could not be loaded (the source names it: its file, or the unknown name).
+    #[error("cannot load the hand")]
     Hand {
         name: String,
         source: graspopt_sim::SimError,

@@ -79,6 +79,21 @@ impl Journal {
         Self::init(conn, Some(path.to_path_buf()))
     }
 
+    /// Opens the journal at `path` to read it (an export, say): a file that does not exist
+    /// or is empty is an error, where [`Journal::open`] would make it a new journal.
+    pub fn open_existing(path: &Path) -> Result<Journal> {
+        match std::fs::metadata(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(JournalError::Open {
+                path: path.to_path_buf(),
+                reason: "there is no such file".into(),
+            }),
+            Ok(m) if m.is_file() && m.len() == 0 => Err(JournalError::Schema(
+                "the file is empty (a journal holds at least its tables)".into(),
+            )),
+            _ => Self::open(path),
+        }
+    }
+
     /// A journal that lives only as long as this value (for tests and dry runs).
     pub fn open_in_memory() -> Result<Journal> {
         let conn = Connection::open_in_memory()?;
@@ -888,6 +903,26 @@ mod tests {
             refusal(&file.join("j.sqlite")),
             format!("{} is not a folder", file.display())
         );
+    }
+
+    #[test]
+    fn an_export_does_not_make_a_journal_of_an_empty_or_missing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let empty = dir.path().join("empty.sqlite");
+        std::fs::write(&empty, b"").unwrap();
+        let e = Journal::open_existing(&empty).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "not a graspopt journal: the file is empty (a journal holds at least its tables)"
+        );
+        assert_eq!(std::fs::metadata(&empty).unwrap().len(), 0);
+        let missing = dir.path().join("missing.sqlite");
+        let e = Journal::open_existing(&missing).unwrap_err().to_string();
+        assert_eq!(e, "there is no such file");
+        assert!(!missing.exists());
+        let made = dir.path().join("made.sqlite");
+        drop(Journal::open(&made).unwrap());
+        assert!(Journal::open_existing(&made).is_ok());
     }
 
     #[test]

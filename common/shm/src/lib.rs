@@ -269,13 +269,13 @@ impl ShmConfig {
         }
         if p.len() > MAX_PREFIX_LEN {
             return Err(ShmError::InvalidConfig(format!(
-                "the prefix {p:?} has {} bytes, more than {MAX_PREFIX_LEN} (use run_prefix to shorten it)",
+                "the prefix {p:?} has {} bytes, more than {MAX_PREFIX_LEN}",
                 p.len()
             )));
         }
         if let Some(c) = p.chars().find(|&c| !is_prefix_char(c)) {
             return Err(ShmError::InvalidConfig(format!(
-                "the prefix {p:?} contains {c:?}; only ASCII letters, digits, '_', '-' and '.' are allowed (use run_prefix to sanitise it)"
+                "the prefix {p:?} contains {c:?}; only ASCII letters, digits, '_', '-' and '.' are allowed"
             )));
         }
         if p.starts_with('.') {

@@ -319,7 +319,10 @@ impl TriangleMesh {
         }
         mesh.validate_closed(name)?;
         let vol = mesh.signed_volume();
-        if vol.abs() < 1e-15 {
+        // Flat relative to its own size (a tiny but solid mesh is refused later, by size,
+        // with the unit scale that fits).
+        let diagonal = mesh.bounds().map_or(0.0, |(lo, hi)| (hi - lo).norm());
+        if vol.is_nan() || vol.abs() <= 1e-12 * diagonal.powi(3) {
             return Err(SimError::NotWatertight {
                 name: name.to_string(),
                 reason: "the mesh encloses no volume".to_string(),

@@ -287,6 +287,30 @@ fn bad_urdf_gives_errors_that_name_the_joint_link_or_file() {
 }
 
 #[test]
+fn a_file_that_is_not_urdf_says_so() {
+    for text in ["", "not xml at all", "<robot name=\"r\"><link"] {
+        let e = parse_err(text, None);
+        assert!(e.starts_with("hand `t.urdf`: "), "{e}");
+        assert!(!e.contains("custom:"), "{e}");
+    }
+    assert_eq!(
+        parse_err("", None),
+        "hand `t.urdf`: the file is empty or not XML (no element found): not a URDF robot"
+    );
+    // A joint limit without its velocity: urdf-rs's serde message, without its prefix.
+    let e = parse_err(
+        &one_joint(
+            r#"<joint name="j" type="revolute"><parent link="palm"/><child link="f"/><axis xyz="0 0 1"/><limit lower="0" upper="1" effort="1"/></joint>"#,
+        ),
+        None,
+    );
+    assert!(
+        e.contains("not a valid URDF robot: missing field `velocity`"),
+        "{e}"
+    );
+}
+
+#[test]
 fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().to_path_buf();

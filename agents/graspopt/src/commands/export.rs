@@ -45,7 +45,7 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
     if let Some(out) = &args.output {
         output::refuse_journal(&path, out).context("--output")?;
     }
-    let journal = graspopt_journal::Journal::open(&path)
+    let journal = graspopt_journal::Journal::open_existing(&path)
         .with_context(|| format!("cannot open the journal {}", path.display()))?;
     // The whole export, in memory: the journal is read before any output exists.
     let mut bytes = Vec::new();

@@ -1,7 +1,7 @@
 //! `graspopt hands`: the built-in hands (name, fingers, joints, source file), or one hand's
 //! joints and links (`graspopt hands NAME|FILE.urdf`).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use graspopt_sim::{Hand, builtin_hands, hand_by_name};
 
@@ -15,8 +15,8 @@ pub fn run(args: &HandsArgs) -> Result<std::process::ExitCode> {
     match &args.hand {
         None => crate::out::print(format_args!("{}", table()?))?,
         Some(name) => {
-            let hand =
-                hand_by_name(name).with_context(|| format!("cannot load the hand {name:?}"))?;
+            // Its errors name the hand (the file, or the unknown name).
+            let hand = hand_by_name(name)?;
             crate::out::print(format_args!("{}", describe(hand.as_ref())))?;
         }
     }

@@ -67,6 +67,7 @@ pub fn run(args: &RecordArgs) -> Result<ExitCode> {
     } else if args.force_resolution.is_some() || args.torque_resolution.is_some() {
         bail!("--force-resolution and --torque-resolution need --sensing ft");
     }
+    graspopt_runner::record::refuse_database(&args.out).context("--out")?;
     let graspopt_trial::scan::Grid { ev, axes, .. } = grid(&args.sim, &args.axes, &args.steps)?;
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;

@@ -123,22 +123,20 @@ pub(super) fn check_plausible_size(mesh: &TriangleMesh, name: &str, scale: f64) 
     if (min..=max).contains(&radius) {
         return Ok(());
     }
+    // The factor from a unit to metres is the scale the file needs if it is in that unit:
+    // the one whose scaling of the file's own size (`radius / scale`) is plausible.
     let units = [
         (0.001, "millimetres"),
         (0.01, "centimetres"),
         (0.0254, "inches"),
+        (1.0, "metres"),
         (1000.0, "kilometres"),
     ];
+    let in_file = radius / scale;
     let advice = units
         .iter()
-        .find(|(f, _)| (min..=max).contains(&(radius * f)))
-        .map(|(f, unit)| {
-            format!(
-                "if the file is in {unit}, scale it by {} (--mesh-scale {})",
-                f * scale,
-                f * scale
-            )
-        })
+        .find(|(f, _)| *f != scale && (min..=max).contains(&(in_file * f)))
+        .map(|(f, unit)| format!("if the file is in {unit}, scale it by {f} (--mesh-scale {f})"))
         .unwrap_or_else(|| {
             "give the factor from the file's units to metres (--mesh-scale S)".to_string()
         });

@@ -116,11 +116,38 @@ fn a_mesh_in_millimetres_is_refused_with_the_scale_that_fits() {
     let o = Object::from_file_scaled(&path, 0.001).unwrap();
     let (lo, hi) = o.aabb();
     assert!((hi - lo - Vector3::repeat(0.04)).norm() < 1e-9, "{lo} {hi}");
+    // A wrong factor: the advice is the factor for the file, not one on top of the given one.
+    let msg = Object::from_file_scaled(&path, 1000.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("after scaling by 1000")
+            && msg
+                .contains("if the file is in millimetres, scale it by 0.001 (--mesh-scale 0.001)"),
+        "{msg}"
+    );
+    // A file in metres scaled as if in millimetres.
+    let metres = mesh::box_mesh(&Vector3::new(0.02, 0.02, 0.02));
+    let path_m = write(&dir, "cube_m.stl", &binary_stl(&metres, b"m", |_, _| 0));
+    let msg = Object::from_file_scaled(&path_m, 0.001)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("if the file is in metres, scale it by 1 (--mesh-scale 1)"),
+        "{msg}"
+    );
     // Too small: 0.2 mm across.
     let tiny = mesh::box_mesh(&Vector3::new(1e-4, 1e-4, 1e-4));
     let path = write(&dir, "tiny.stl", &binary_stl(&tiny, b"tiny", |_, _| 0));
     let e = Object::from_file(&path).unwrap_err();
     assert!(matches!(e, SimError::ImplausibleSize { .. }), "{e}");
+    // Far too small, but solid: refused for its size, not as a mesh that encloses nothing.
+    for half in [1e-8, 5e-12] {
+        let speck = mesh::box_mesh(&Vector3::new(half, half, half));
+        let path = write(&dir, "speck.stl", &binary_stl(&speck, b"speck", |_, _| 0));
+        let e = Object::from_file(&path).unwrap_err();
+        assert!(matches!(e, SimError::ImplausibleSize { .. }), "{half}: {e}");
+    }
     // A bad factor is named.
     for bad in [0.0, -1.0, f64::NAN] {
         let e = Object::from_file_scaled(&path, bad).unwrap_err();

@@ -198,10 +198,23 @@ fn pose_of(p: &urdf_rs::Pose) -> Isometry3<f64> {
     )
 }
 
+/// urdf-rs's error in a user's words: its XML reader says "No elements found" for an empty
+/// or non-XML file, and its serde errors start with "custom: ".
+fn urdf_error(e: &urdf_rs::UrdfError) -> String {
+    let text = e.to_string();
+    if text.trim() == "No elements found" {
+        return "the file is empty or not XML (no element found): not a URDF robot".into();
+    }
+    match text.strip_prefix("custom: ") {
+        Some(rest) => format!("not a valid URDF robot: {rest}"),
+        None => text,
+    }
+}
+
 impl HandDescription {
     /// Parses URDF text and optional settings; `file` names the URDF in errors.
     pub fn parse(file: &str, urdf: &str, settings: Option<&HandSettings>) -> Result<Self> {
-        let robot = urdf_rs::read_from_string(urdf).map_err(|e| bad(file, e.to_string()))?;
+        let robot = urdf_rs::read_from_string(urdf).map_err(|e| bad(file, urdf_error(&e)))?;
         let default_settings = HandSettings::default();
         let settings = settings.unwrap_or(&default_settings);
         let link_names: Vec<String> = robot.links.iter().map(|l| l.name.clone()).collect();
