@@ -55,6 +55,9 @@ pub fn inner_distance_with_basis<const D: usize>(
     try_inner_distance_with_basis(points, basis).ok().flatten()
 }
 
+/// The largest relative joggle the expanding polytope tries before the full hull.
+const MAX_JOGGLE: f64 = 1e-6;
+
 /// As [`inner_distance_with_basis`], but a search that would need more than
 /// [`quickhull::FACET_LIMIT`] facets is an error rather than `None`. Degenerate
 /// geometry that neither the joggled points nor the full hull overcome is still `None`.
@@ -72,8 +75,9 @@ pub fn try_inner_distance_with_basis<const D: usize>(
         Err(PolytopeError::Degenerate) => {}
     }
     // Floating-point degeneracy (near-coplanar contact grids): retry on slightly
-    // joggled copies, then fall back to the full hull, which has its own recovery.
-    for joggle in quickhull::JOGGLES {
+    // joggled copies (at most `MAX_JOGGLE`: the radius keeps its accuracy), then fall
+    // back to the full hull, which has its own recovery, with larger joggles.
+    for joggle in quickhull::JOGGLES.into_iter().filter(|&j| j <= MAX_JOGGLE) {
         match expand(&quickhull::joggled(points, joggle), &basis.indices, scale) {
             Ok(r) => return Ok(Some(r)),
             Err(PolytopeError::TooManyFacets) => {

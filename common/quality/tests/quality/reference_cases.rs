@@ -177,8 +177,9 @@ fn expanding_polytope_terminates_on_a_near_degenerate_surface_model() {
     }
     // Sampled directions only bound epsilon from above: it must not exceed them.
     assert!(m.epsilon <= tightest + 1e-6 * scale * 6.0);
-    // The volume is requested: the hull of these points cannot be built, and that is
-    // an error naming the problem, not a silent 0.
+    // The volume is requested: the hull of these points needs a joggle beyond 1e-6 (it
+    // failed before the larger ones); were it not built, that is an error naming the
+    // problem, never a silent 0.
     match evaluate(
         &GraspMap::from_wrenches(w).unwrap(),
         &MetricsOptions::default(),

@@ -134,3 +134,36 @@ fn measured_clouds_score_like_the_whole_trial() {
     }
     assert!((2..4).contains(&touched), "{touched} of 4 trials touched");
 }
+
+/// A full-rank grasp whose dense wrench set defeated the hull's small joggles (the star
+/// prism's edges under barrett_ft's fingertips, surface and patch models): its volume is
+/// available, and holds the ball of radius epsilon when it is force-closure.
+#[test]
+fn a_full_rank_grasp_whose_hull_needs_a_joggle_has_a_volume() {
+    use graspopt_sim::ContactModel;
+    use graspopt_trial::TrialSettings;
+
+    for contacts in [ContactModel::Surface, ContactModel::CircularPatch] {
+        let settings = TrialSettings {
+            object: "star_prism".into(),
+            hand: "barrett_ft".into(),
+            contacts,
+            metric: Metric::Volume,
+            ..TrialSettings::default()
+        };
+        let ev = Evaluator::from_settings(&settings, &[]).unwrap();
+        let e = ev
+            .evaluate(&[])
+            .unwrap_or_else(|err| panic!("{contacts}: {err}"));
+        let m = e.score.metrics.unwrap();
+        assert_eq!(m.rank, 6, "{contacts}");
+        let volume = m.volume.expect("a volume");
+        assert!(volume.is_finite() && volume > 0.0, "{contacts}: {volume}");
+        assert_eq!(e.score.score, volume);
+        if m.force_closure {
+            // The 6-ball of radius epsilon lies inside the hull: pi^3 / 6 r^6.
+            let ball = std::f64::consts::PI.powi(3) / 6.0 * m.epsilon.powi(6);
+            assert!(volume > ball, "{contacts}: {volume} <= {ball}");
+        }
+    }
+}
