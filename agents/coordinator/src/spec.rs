@@ -358,6 +358,8 @@ fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<
 /// (contrary explicit settings refused). A run not recorded yet is started, so that a
 /// supervised coordinator can be restarted with one command line. The journal's folder is
 /// created.
+///
+/// The budget `trials` must be 1 to [`MAX_TRIALS`].
 pub fn standalone_run(
     run: &str,
     config: &crate::CoordinatorConfig,
@@ -365,7 +367,7 @@ pub fn standalone_run(
     resume: bool,
     explicit: &dyn Fn(&str) -> bool,
 ) -> anyhow::Result<(RunId, RunSpec)> {
-    anyhow::ensure!(given.trials >= 1, "--trials must be at least 1");
+    check_trials(given.trials)?;
     let mut run_id = RunId::new(run)?;
     if resume
         && !explicit("run")
@@ -390,6 +392,20 @@ pub fn standalone_run(
             .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     }
     Ok((run_id, spec))
+}
+
+/// The largest trial budget of a run: a billion trials, days of the fastest pipeline
+/// measured (`graspopt bench coordinator`); larger numbers are typos, and trial ids are
+/// SQLite integers.
+pub const MAX_TRIALS: u64 = 1_000_000_000;
+
+/// Refuses a trial budget of 0 or over [`MAX_TRIALS`], naming `--trials`.
+pub fn check_trials(trials: u64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        (1..=MAX_TRIALS).contains(&trials),
+        "--trials is {trials}: it must be between 1 and {MAX_TRIALS}"
+    );
+    Ok(())
 }
 
 #[cfg(test)]

@@ -254,7 +254,7 @@ impl RunSettings {
             self.workers,
             graspopt_shm::DEFAULT_MAX_PUBLISHERS
         );
-        anyhow::ensure!(self.trials >= 1, "--trials must be at least 1");
+        graspopt_coordinator::check_trials(self.trials)?;
         let evaluator = Evaluator::from_settings(&self.trial, &self.params)?;
         let object = evaluator.object.name().to_string();
         let bus = own_bus(self.bus.clone(), &run)?;

@@ -167,6 +167,19 @@ fn a_lease_out_of_range_is_refused_by_name() {
         ..RunSettings::default()
     };
     assert!(settings.embedded().is_ok());
+    // A budget past a billion trials is a typo (2^64 - 1 ran until killed).
+    for trials in [0, u64::MAX] {
+        let settings = RunSettings {
+            trials,
+            out: Some(tempfile::tempdir().unwrap().path().join("run")),
+            ..RunSettings::default()
+        };
+        let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+        assert_eq!(
+            msg,
+            format!("--trials is {trials}: it must be between 1 and 1000000000")
+        );
+    }
     // A trial longer than its lease would be re-issued forever.
     let settings = RunSettings {
         trial_cost_ms: 40_000,

@@ -71,6 +71,21 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     if args.resume {
         resume_coordinator(&mut plan, &host)?;
     }
+    // Every process's flags, parsed as it will parse them, before any starts: a typo in
+    // one entry's `args` would otherwise stop the launch after the router and the agents
+    // before it have started.
+    for p in &plan {
+        let argv = std::iter::once("graspopt").chain(p.args.iter().map(String::as_str));
+        if let Err(e) = <crate::Cli as clap::Parser>::try_parse_from(argv) {
+            let rendered = e.render().to_string();
+            let why = rendered
+                .lines()
+                .next()
+                .unwrap_or("")
+                .trim_start_matches("error: ");
+            bail!("launch file {}: {}: {why}", args.file.display(), p.name);
+        }
+    }
     if args.dry_run {
         for p in &plan {
             outln!("graspopt {}", p.args.join(" "))?;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use graspopt_bus::{Bus, BusArgs, BusMode};
 
@@ -52,7 +52,14 @@ pub fn run(args: &RouterArgs) -> Result<ExitCode> {
     let bus = args.bus();
     let runtime = tokio::runtime::Runtime::new()?;
     runtime.block_on(async {
-        let session = Bus::open(&bus).await?;
+        // Zenoh's error does not say which endpoint it could not listen on.
+        let session = Bus::open(&bus).await.with_context(|| {
+            if bus.listen.is_empty() {
+                "cannot listen on the Zenoh configuration's endpoints".to_string()
+            } else {
+                format!("cannot listen on {}", bus.listen.join(", "))
+            }
+        })?;
         if bus.listen.is_empty() {
             eprintln!("graspopt router listening on the Zenoh configuration's endpoints");
         } else {

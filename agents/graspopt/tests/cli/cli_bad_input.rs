@@ -506,6 +506,14 @@ fn router_has_no_agent_flags() {
         assert!(stderr.contains(flags[0]), "{args:?}: {stderr}");
         assert!(!stderr.contains("listening"), "{args:?}: {stderr}");
     }
+    // An address it cannot listen on is named (Zenoh's own error does not name it).
+    let args = ["router", "--listen", "tcp/nosuchhost.invalid:7447"];
+    let out = graspopt_within(&args, Duration::from_secs(30)).expect("the router kept running");
+    assert_refused(
+        &out,
+        &args,
+        &["cannot listen on tcp/nosuchhost.invalid:7447"],
+    );
 }
 
 // --- trial ---
@@ -657,4 +665,28 @@ fn topic_list_names_an_address_where_nothing_answers() {
         &["topic", "list", "--connect", "tcp/127.0.0.1:1"],
         &["nothing answers at tcp/127.0.0.1:1"],
     );
+}
+
+/// A launch file whose agent has a flag its command does not know is refused before
+/// anything starts (with --dry-run too), naming the file, the agent and the flag.
+#[test]
+fn launch_checks_every_agent_s_flags_before_starting_any() {
+    let dir = tempdir("launch-args");
+    let file = dir.join("typo.toml");
+    std::fs::write(
+        &file,
+        "run = \"r\"\nendpoint = \"tcp/127.0.0.1:7449\"\n[router]\n[[agent]]\nkind = \"planner\"\n\
+         [[agent]]\nkind = \"hand\"\nargs = [\"--trial-cost\", \"5\"]\n",
+    )
+    .unwrap();
+    let path = file.to_str().unwrap();
+    let logs = dir.join("logs");
+    for extra in [&["--dry-run"][..], &[]] {
+        let mut args = vec!["launch", path, "--logs", logs.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let out = refused(&args, &["typo.toml: hand:", "'--trial-cost'"]);
+        // Nothing started: no log folder.
+        assert!(!logs.exists());
+        assert!(out.stdout.is_empty());
+    }
 }
