@@ -27,13 +27,7 @@ use rand_chacha::rand_core::SeedableRng;
 /// Refuses `out` as a recording's file if it holds an SQLite database (a run's journal,
 /// say): writing the recording would replace it.
 pub fn refuse_database(out: &std::path::Path) -> Result<()> {
-    use std::io::Read;
-    let mut head = [0u8; 16];
-    let is_database = std::fs::File::open(out)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok()
-        && head == *b"SQLite format 3\0";
-    if is_database {
+    if graspopt_journal::output::holds_database(out) {
         bail!(
             "{} is an SQLite database (a run's journal?): a recording would replace it; \
              write it elsewhere",

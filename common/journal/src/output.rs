@@ -43,6 +43,17 @@ fn same_file(_: &Path, _: &Path) -> bool {
     false
 }
 
+/// Whether the file at `path` is an SQLite database (a journal, or another program's): it
+/// starts with SQLite's 16-byte header. A file that cannot be read is not one.
+pub fn holds_database(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 16];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && head == *b"SQLite format 3\0"
+}
+
 /// Refuses an `output` that is the journal or one of its SQLite side files (`-wal`,
 /// `-shm`, `-journal`), compared after resolving `./`, `..`, symlinks and hard links.
 pub fn refuse_journal(journal: &Path, output: &Path) -> Result<()> {
