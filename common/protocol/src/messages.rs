@@ -166,7 +166,23 @@ impl Message for TrialCommand {
 /// One raw contact point: a position on the object's surface, the unit normal pointing
 /// into the object (world frame) and the area it stands for (`w`, > 0; 1 when absent, so that
 /// clouds of equal points need not send it).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+///
+/// `repr(C)`, seven `f64` without padding: on a little-endian host a point's 56 bytes in
+/// memory are its 56 bytes in the shared-memory layout ([`crate::layout`]), which copies a
+/// finger's points as one block.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Serialize,
+    Deserialize,
+    zerocopy::FromBytes,
+    zerocopy::IntoBytes,
+    zerocopy::Immutable,
+    zerocopy::KnownLayout,
+)]
+#[repr(C)]
 pub struct CloudPoint {
     pub p: [f64; 3],
     pub n: [f64; 3],

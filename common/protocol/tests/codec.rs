@@ -594,6 +594,19 @@ fn clouds_round_trip_through_the_shm_layout() {
         f64::from_le_bytes(bytes[184 + 32..184 + 40].try_into().unwrap()),
         0.6
     );
+    // Points are copied as one block when the payload is aligned for f64 (a shared-memory
+    // sample is) and through an aligned buffer when not: both read the same clouds.
+    let full = full_clouds();
+    let bytes = layout_bytes(&full);
+    let mut words = vec![0u64; bytes.len() / 8 + 1];
+    let aligned = zerocopy::IntoBytes::as_mut_bytes(words.as_mut_slice());
+    aligned[..bytes.len()].copy_from_slice(&bytes);
+    assert_eq!(layout::read_clouds(&aligned[..bytes.len()]).unwrap(), full);
+    aligned[1..=bytes.len()].copy_from_slice(&bytes);
+    assert_eq!(
+        layout::read_clouds(&aligned[1..=bytes.len()]).unwrap(),
+        full
+    );
     // A buffer of the wrong size is refused, not overrun.
     let c = clouds();
     let mut short = vec![0; layout::clouds_len(&c).unwrap() - 1];
