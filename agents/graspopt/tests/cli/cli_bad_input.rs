@@ -424,6 +424,30 @@ fn experiment_metrics_refuses_fewer_than_two_steps() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `experiment sensing` runs `--trials` per object twice over seven objects and averages
+/// `--samples` per reading: both bounded, refused as usage errors (exit 2) before anything
+/// runs.
+#[test]
+fn experiment_sensing_bounds_its_trials_and_samples() {
+    for (flag, value, range) in [
+        ("--trials", "0", "1..=100000"),
+        ("--trials", "100001", "1..=100000"),
+        ("--samples", "0", "1..=10000"),
+        ("--samples", "10001", "1..=10000"),
+    ] {
+        let out = graspopt(&["experiment", "sensing", flag, value]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {stderr}");
+        for part in [flag, value, range] {
+            assert!(
+                stderr.contains(part),
+                "{flag} {value}: {part:?} not in {stderr}"
+            );
+        }
+        assert!(out.stdout.is_empty(), "{flag} {value}");
+    }
+}
+
 #[test]
 fn experiment_metrics_report_tables_each_have_a_header() {
     let dir = tempdir("metrics-report");

@@ -11,9 +11,9 @@ use crate::out::outln;
 
 #[derive(Args, Debug)]
 pub struct SensingArgs {
-    /// Random trials per object (approach distance and height).
-    #[arg(long, default_value_t = 200)]
-    trials: usize,
+    /// Random trials per object (approach distance and height; 1 to 100000).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    trials: u32,
     /// Seed of the trials and the noise.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -23,8 +23,9 @@ pub struct SensingArgs {
     /// Torque resolution of the noisy run (N m; default 1.5625e-5, 1/64 N mm).
     #[arg(long)]
     torque_resolution: Option<f64>,
-    /// Sensor samples averaged per reading (1: single samples).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
+    /// Sensor samples averaged per reading (1: single samples; at most 10000, 10 s of a
+    /// 1 kHz sensor).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     samples: u32,
 }
 
@@ -38,7 +39,7 @@ pub fn sensing(args: &SensingArgs) -> Result<()> {
         ("with sensor noise", noise),
     ] {
         let settings = SensingStudySettings {
-            trials: args.trials,
+            trials: args.trials as usize,
             seed: args.seed,
             noise,
             samples: args.samples,
