@@ -89,17 +89,6 @@ pub struct EncodeError {
     pub detail: String,
 }
 
-/// A bincode writer that appends to a vector.
-struct Append<'a>(&'a mut Vec<u8>);
-
-impl bincode::enc::write::Writer for Append<'_> {
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) -> Result<(), bincode::error::EncodeError> {
-        self.0.extend_from_slice(bytes);
-        Ok(())
-    }
-}
-
 fn bincode_config() -> impl bincode::config::Config {
     bincode::config::standard().with_limit::<MAX_PAYLOAD>()
 }
@@ -127,8 +116,7 @@ pub fn encode<T: Message>(msg: &T, encoding: Encoding) -> Result<Vec<u8>, Encode
             bincode::serde::encode_into_writer(msg, &mut size, bincode_config()).map_err(err)?;
             let mut out = Vec::with_capacity(WIRE_VERSION.to_le_bytes().len() + size.bytes_written);
             out.extend_from_slice(&WIRE_VERSION.to_le_bytes());
-            bincode::serde::encode_into_writer(msg, Append(&mut out), bincode_config())
-                .map_err(err)?;
+            bincode::serde::encode_into_std_write(msg, &mut out, bincode_config()).map_err(err)?;
             Ok(out)
         }
         Encoding::Json => {
