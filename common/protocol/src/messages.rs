@@ -886,7 +886,12 @@ impl Message for RunStatus {
     fn run_id(&self) -> &RunId {
         &self.run_id
     }
+    /// The best trial's forces are checked as a result's are (the coordinator copies them
+    /// from a validated result); the rest is left as sent.
     fn validate(&self) -> Result<(), String> {
+        if let Some(f) = &self.best_forces {
+            f.validate("best_forces")?;
+        }
         Ok(())
     }
     /// Two older layouts: before `best_forces` (the fields up to `waiting`, which bincode

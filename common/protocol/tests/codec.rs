@@ -406,6 +406,16 @@ fn a_status_from_before_best_forces_still_decodes() {
             s
         );
     }
+    // Forces that are not numbers are refused as a result's are, in both encodings (JSON
+    // cannot carry them: fuzzing found a status that decoded from bincode and not from its
+    // own JSON).
+    let mut bad = s.clone();
+    if let Some(f) = bad.best_forces.as_mut() {
+        f.external[1] = f64::NAN;
+    }
+    let e = decode::<RunStatus>(&encode(&bad, Encoding::Bincode).unwrap(), Encoding::Bincode)
+        .unwrap_err();
+    assert!(e.to_string().contains("best_forces.external"), "{e}");
     // Before best_forces: the layout ends after `waiting` (`None` is one 0 byte).
     s.best_forces = None;
     let mut old = encode(&s, Encoding::Bincode).unwrap();
