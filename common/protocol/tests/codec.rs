@@ -406,9 +406,8 @@ fn a_status_from_before_best_forces_still_decodes() {
             s
         );
     }
-    // Forces that are not numbers are refused as a result's are, in both encodings (JSON
-    // cannot carry them: fuzzing found a status that decoded from bincode and not from its
-    // own JSON).
+    // Forces that are not numbers are refused as a result's are (JSON cannot carry them:
+    // fuzzing found a status that decoded from bincode and not from its own JSON).
     let mut bad = s.clone();
     if let Some(f) = bad.best_forces.as_mut() {
         f.external[1] = f64::NAN;
