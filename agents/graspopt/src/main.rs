@@ -84,9 +84,9 @@ const DEFAULT_LOG: &str = "warn,zenoh::net::runtime::orchestrator=error,\
 /// (71,084 in one `graspopt bench clouds` run, 1,373 with mimalloc): hand to metric agent over
 /// shared memory took a median of 468-558 µs, against 87-155 µs with mimalloc in the same
 /// alternating runs. Built without transparent huge pages (feature `no_thp`): a fresh 2 MB
-/// page is zeroed whole at its first touch, which made the clouds 1.6 times slower (medians) and a run's
-/// resident memory 114-127 MB instead of 66-69 MB (glibc: 46-47 MB). docs/benchmarks.md,
-/// "Contact clouds", has the runs.
+/// page is zeroed whole at its first touch, which made the clouds 1.6 times slower (medians)
+/// and a run's resident memory 114-127 MB instead of 66-69 MB (glibc: 46-47 MB).
+/// docs/benchmarks.md, "Contact clouds", has the runs.
 #[cfg(feature = "mimalloc")]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;

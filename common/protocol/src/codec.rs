@@ -114,8 +114,9 @@ pub fn encode<T: Message>(msg: &T, encoding: Encoding) -> Result<Vec<u8>, Encode
             // after the wire version (`graspopt bench clouds`, encoding 10,000 points).
             let mut size = bincode::enc::write::SizeWriter::default();
             bincode::serde::encode_into_writer(msg, &mut size, bincode_config()).map_err(err)?;
-            let mut out = Vec::with_capacity(WIRE_VERSION.to_le_bytes().len() + size.bytes_written);
-            out.extend_from_slice(&WIRE_VERSION.to_le_bytes());
+            let version = WIRE_VERSION.to_le_bytes();
+            let mut out = Vec::with_capacity(version.len() + size.bytes_written);
+            out.extend_from_slice(&version);
             bincode::serde::encode_into_std_write(msg, &mut out, bincode_config()).map_err(err)?;
             Ok(out)
         }

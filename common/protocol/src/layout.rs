@@ -150,11 +150,9 @@ pub fn write_clouds(msg: &ContactClouds, out: &mut [u8]) -> Result<(), EncodeErr
         at = put(out, at, &len_u32("link", link.len())?.to_le_bytes());
         at = put(out, at, link.as_bytes());
     }
-    let mut at = {
-        let start = at.next_multiple_of(8);
-        out[at..start].fill(0);
-        start
-    };
+    let start = at.next_multiple_of(8);
+    out[at..start].fill(0);
+    let mut at = start;
     for f in &msg.fingers {
         let block = &mut out[at..at + POINT_BYTES * f.points.len()];
         block.copy_from_slice(f.points.as_bytes());

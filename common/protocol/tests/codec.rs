@@ -272,6 +272,13 @@ fn a_topic_decodes_to_its_message_fields() {
     }
 }
 
+/// `msg` encoded with bincode (which carries any number) is refused on decoding, naming
+/// `field`.
+fn refused_naming<T: Message + std::fmt::Debug>(msg: &T, field: &str) {
+    let e = decode::<T>(&encode(msg, Encoding::Bincode).unwrap(), Encoding::Bincode).unwrap_err();
+    assert!(e.to_string().contains(field), "{e}");
+}
+
 fn status(waiting: Vec<Waiting>) -> RunStatus {
     RunStatus {
         run_id: run(),
@@ -380,9 +387,7 @@ fn a_result_from_before_forces_still_decodes() {
     if let Some(f) = bad.forces.as_mut() {
         f.slip_margins[1] = f64::NAN;
     }
-    let err = decode::<TrialResult>(&encode(&bad, Encoding::Bincode).unwrap(), Encoding::Bincode)
-        .unwrap_err();
-    assert!(err.to_string().contains("forces.slip_margins[1]"), "{err}");
+    refused_naming(&bad, "forces.slip_margins[1]");
 }
 
 /// `RunStatus.best_forces` was appended after `waiting`: a status written before it still
@@ -412,9 +417,7 @@ fn a_status_from_before_best_forces_still_decodes() {
     if let Some(f) = bad.best_forces.as_mut() {
         f.external[1] = f64::NAN;
     }
-    let e = decode::<RunStatus>(&encode(&bad, Encoding::Bincode).unwrap(), Encoding::Bincode)
-        .unwrap_err();
-    assert!(e.to_string().contains("best_forces.external"), "{e}");
+    refused_naming(&bad, "best_forces.external");
     // Before best_forces: the layout ends after `waiting` (`None` is one 0 byte).
     s.best_forces = None;
     let mut old = encode(&s, Encoding::Bincode).unwrap();
@@ -603,7 +606,7 @@ fn clouds_round_trip_through_the_shm_layout() {
         f64::from_le_bytes(bytes[184 + 32..184 + 40].try_into().unwrap()),
         0.6
     );
-    // Points are copied as one block when the payload is aligned for f64 (a shared-memory
+    // Points are copied as one block when the payload is aligned for f64 (an iceoryx2 0.10
     // sample is) and through an aligned buffer when not: both read the same clouds.
     let full = full_clouds();
     let bytes = layout_bytes(&full);
