@@ -14,6 +14,8 @@ use super::ui::draw;
 
 /// How long a new session waits for the liveliness tokens already on the bus.
 const SETTLE: Duration = Duration::from_millis(300);
+/// How long [`once`] keeps looking for a live coordinator before it says there is none.
+const ONCE_PATIENCE: Duration = Duration::from_secs(3);
 
 /// `only` this run, or every run.
 fn runs(only: Option<&RunId>) -> Runs<'_> {
@@ -54,7 +56,16 @@ pub async fn ask_states(bus: &Bus, m: &mut Monitor) {
 pub async fn once(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
     tokio::time::sleep(SETTLE).await;
     let mut m = Monitor::default();
-    m.set_alive(&live_runs(bus, only).await);
+    // Through a router, a coordinator's token can reach a session that just connected a
+    // moment later than the settling time (seen on a loaded 2-core machine): look again for
+    // a while before saying there is none.
+    let deadline = Instant::now() + ONCE_PATIENCE;
+    let mut alive = live_runs(bus, only).await;
+    while alive.is_empty() && Instant::now() < deadline {
+        tokio::time::sleep(SETTLE).await;
+        alive = live_runs(bus, only).await;
+    }
+    m.set_alive(&alive);
     ask_states(bus, &mut m).await;
     if m.runs.is_empty() {
         return vec!["no runs: no live coordinator (check --connect)".into()];
