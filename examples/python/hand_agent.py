@@ -244,6 +244,9 @@ def argument_parser(description):
     ap.add_argument("--id", default="py-hand-1", help="this worker's id (unique in the run)")
     ap.add_argument("--recording", required=True, help="JSON lines of recorded grasps")
     ap.add_argument("--trial-cost-ms", type=int, default=0, help="minimum duration of a trial")
+    ap.add_argument("--zenoh-config", help="a Zenoh settings file (JSON5), e.g. a role's file of "
+                    "deploy/zenoh/secure/ with its user name and password; --connect still "
+                    "names the endpoint")
     return ap
 
 
@@ -251,8 +254,11 @@ def serve(args, grasps, answer):
     """Joins the run as hand `args.id` and answers each trial command sent to it with
     `answer(grasps, command, worker)`, which returns the topic (below `graspopt/<run>/`) and
     the JSON message to put there, until interrupted."""
-    conf = zenoh.Config()
-    conf.insert_json5("mode", '"peer"')
+    if args.zenoh_config:
+        conf = zenoh.Config.from_file(args.zenoh_config)
+    else:
+        conf = zenoh.Config()
+        conf.insert_json5("mode", '"peer"')
     conf.insert_json5("connect/endpoints", json.dumps([args.connect]))
     conf.insert_json5("scouting/multicast/enabled", "false")
     session = zenoh.open(conf)

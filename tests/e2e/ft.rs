@@ -24,12 +24,12 @@ use crate::support::{Cluster, Proc, graspopt};
 
 /// The mug. (The star prism's sharp edges, where its fingertip contacts often lie, make the
 /// score jump between noise-free readings and their true contacts.)
-const OBJECT: &str = "mug";
-const HAND: &str = "barrett_ft";
+pub(crate) const OBJECT: &str = "mug";
+pub(crate) const HAND: &str = "barrett_ft";
 
 /// Whether `score` is within the noise bound of `reference`, the score of the true contacts:
 /// Nano17 noise moves a sensed contact by hundredths of a millimetre.
-fn within_noise(score: f64, reference: f64) -> bool {
+pub(crate) fn within_noise(score: f64, reference: f64) -> bool {
     (score - reference).abs() <= 0.02 * reference.abs() + 1e-3
 }
 
@@ -51,7 +51,7 @@ fn evaluator() -> Evaluator {
 /// The grasp at `params` as exact (noise-free) fingertip sensors read it: the metric
 /// agent's score of the readings (`score`) and the score of the true contacts they were
 /// simulated from (`true_score`).
-fn exact_grasp(ev: &Evaluator, params: &[f64]) -> RecordedTrial {
+pub(crate) fn exact_grasp(ev: &Evaluator, params: &[f64]) -> RecordedTrial {
     let exact = FingertipSettings {
         noise: SensorNoise::NONE,
         ..Default::default()
@@ -61,7 +61,7 @@ fn exact_grasp(ev: &Evaluator, params: &[f64]) -> RecordedTrial {
 }
 
 /// The score of the true fingertip contacts of the trial at `params`.
-fn true_score(ev: &Evaluator, params: &[f64]) -> f64 {
+pub(crate) fn true_score(ev: &Evaluator, params: &[f64]) -> f64 {
     exact_grasp(ev, params).true_score.unwrap()
 }
 
@@ -128,14 +128,14 @@ fn a_run_with_a_force_sensing_hand_scores_like_its_true_contacts() {
 }
 
 /// One recorded grasp of a recording of fingertip readings.
-struct Recorded {
+pub(crate) struct Recorded {
     params: Vec<f64>,
     score: f64,
     true_score: f64,
 }
 
 /// Records a 7 x 7 grid of mug grasps of barrett_ft's fingertip readings.
-fn record(dir: &Path) -> (PathBuf, Vec<Recorded>) {
+pub(crate) fn record(dir: &Path) -> (PathBuf, Vec<Recorded>) {
     let path = dir.join("mug-ft.jsonl");
     let o = graspopt(&[
         "record",
@@ -202,7 +202,7 @@ fn record(dir: &Path) -> (PathBuf, Vec<Recorded>) {
 
 /// Every trial's score is the recorded score of the nearest recorded grasp (its readings are
 /// replayed exactly) and within the noise bound of that grasp's true-contact score.
-fn check_replayed(rows: &[TrialRow], grasps: &[Recorded]) -> (f64, f64) {
+pub(crate) fn check_replayed(rows: &[TrialRow], grasps: &[Recorded]) -> (f64, f64) {
     let mut pairs = Vec::new();
     for t in rows {
         let nearest = grasps

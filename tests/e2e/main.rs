@@ -14,6 +14,7 @@ mod equivalence;
 mod faults;
 mod ft;
 mod fuzz;
+mod journeys;
 mod launch;
 mod lifecycle;
 mod monitor;

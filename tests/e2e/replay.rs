@@ -14,7 +14,7 @@ use crate::support::{Cluster, Proc, check_journal, graspopt, repo_root};
 const TRIALS: usize = 10;
 
 /// Records a 7 x 7 grid of cuboid grasps; returns (params, score) of each.
-fn record(dir: &Path) -> (PathBuf, Vec<(Vec<f64>, f64)>) {
+pub(crate) fn record(dir: &Path) -> (PathBuf, Vec<(Vec<f64>, f64)>) {
     let path = dir.join("cuboid.jsonl");
     let o = graspopt(&[
         "record",
@@ -48,7 +48,12 @@ fn record(dir: &Path) -> (PathBuf, Vec<(Vec<f64>, f64)>) {
 /// the nearest recorded grasp's and that `worker` did them.
 fn optimize_with(c: &Cluster, hand: Proc, worker: &str, grasps: &[(Vec<f64>, f64)]) {
     let trials = run_with_only(c, hand, worker, "cuboid", TRIALS, "3", &[]);
-    for t in &trials {
+    check_replayed(&trials, grasps);
+}
+
+/// Every trial's score is the recorded score of the grasp nearest to its parameters.
+pub(crate) fn check_replayed(trials: &[TrialRow], grasps: &[(Vec<f64>, f64)]) {
+    for t in trials {
         let nearest = grasps
             .iter()
             .min_by(|a, b| dist(&a.0, &t.params).total_cmp(&dist(&b.0, &t.params)))
@@ -143,22 +148,40 @@ fn python_hand(c: &Cluster, rec: &Path, name: &str, id: &str) -> Proc {
 /// The Python hand `script` of `examples/python/` as worker `id`, answering from the
 /// recording `rec`; its stderr goes to `<dir>/<name>.log`.
 pub(crate) fn python_agent(c: &Cluster, script: &str, rec: &Path, name: &str, id: &str) -> Proc {
+    python_agent_at(&c.dir, &c.endpoint, &c.run, script, rec, name, id, &[])
+}
+
+/// The Python hand `script` of `examples/python/` as worker `id` of `run`, connecting to
+/// `endpoint` with `extra` flags, answering from the recording `rec`; its stderr goes to
+/// `<dir>/<name>.log`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn python_agent_at(
+    dir: &Path,
+    endpoint: &str,
+    run: &str,
+    script: &str,
+    rec: &Path,
+    name: &str,
+    id: &str,
+    extra: &[&str],
+) -> Proc {
     let python = std::env::var("GRASPOPT_PYTHON")
         .expect("set GRASPOPT_PYTHON to a Python with eclipse-zenoh (see .ci/run)");
     let script = repo_root().join("examples/python").join(script);
-    let log = std::fs::File::create(c.dir.join(format!("{name}.log"))).unwrap();
+    let log = std::fs::File::create(dir.join(format!("{name}.log"))).unwrap();
     let child = std::process::Command::new(python)
         .arg(&script)
         .args([
             "--connect",
-            &c.endpoint,
+            endpoint,
             "--run",
-            &c.run,
+            run,
             "--id",
             id,
             "--recording",
             rec.to_str().unwrap(),
         ])
+        .args(extra)
         .stderr(log)
         .spawn()
         .unwrap_or_else(|e| panic!("start the Python hand {}: {e}", script.display()));

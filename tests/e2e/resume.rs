@@ -365,3 +365,59 @@ fn a_run_stopped_mid_trial_and_resumed_proposes_what_the_uninterrupted_run_does(
         );
     }
 }
+
+/// A run of a hand from a URDF file, given relative to the folder it started in, resumes
+/// from another folder with a larger budget: the journal keeps the hand's name, the run's
+/// settings its file. Its force-sensing flag is kept too, and contradicting it is refused.
+#[test]
+fn a_run_of_a_hand_from_a_file_resumes_from_another_folder() {
+    let dir = tempdir("resumefile");
+    let hand = crate::journeys::copy_test_hand(&dir);
+    assert!(hand.starts_with(&*dir));
+    let out = dir.join("results");
+    let shm = format!("gpe2e_rsf_{}_", std::process::id());
+    let run = |cwd: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "--object",
+            "cylinder",
+            "--workers",
+            "1",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--shm-prefix",
+            &shm,
+        ];
+        args.extend_from_slice(extra);
+        std::process::Command::new(crate::support::graspopt_bin())
+            .current_dir(cwd)
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let first = run(&dir, &["--hand", "hands/claw/claw.urdf", "--trials", "3"]);
+    assert!(first.status.success(), "{first:?}");
+    let journal = Journal::open(&out.join("journal.sqlite")).unwrap();
+    let spec: serde_json::Value =
+        serde_json::from_str(&journal.run("run").unwrap().unwrap().config_json).unwrap();
+    assert_eq!(spec["hand"], "claw", "the run knows the hand by its name");
+    drop(journal);
+    let elsewhere = tempdir("resumefile-elsewhere");
+    let resumed = run(&elsewhere, &["--resume", "--trials", "5"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let said = String::from_utf8_lossy(&resumed.stdout);
+    assert!(said.contains("5 trials completed, 0 failed"), "{said}");
+    check_journal(&out.join("journal.sqlite"), "run", 5);
+    let refused = run(
+        &elsewhere,
+        &["--resume", "--trials", "6", "--sensing", "ft"],
+    );
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("--sensing ft (the run has clouds)"), "{err}");
+}

@@ -9,19 +9,19 @@ use std::time::Duration;
 
 use crate::support::{Cluster, check_journal, cloud_transport, repo_root, report};
 use graspopt_bus::Bus;
-use graspopt_protocol::keys::{RESULT, Runs, alive_key};
+use graspopt_protocol::keys::{RESULT, Runs, TABLE, alive_key, alive_token};
 use graspopt_protocol::{AgentKind, Encoding, RunId, TrialResult};
 use serde_json::json;
 
 const TRIALS: u64 = 8;
 
-fn secure(file: &str) -> PathBuf {
+pub(crate) fn secure(file: &str) -> PathBuf {
     repo_root().join("deploy/zenoh/secure").join(file)
 }
 
 /// The router's configuration with the dictionary's path made absolute (the file names it
 /// relative to the repository root), written to `dir`.
-fn router_config(dir: &Path) -> Vec<String> {
+pub(crate) fn router_config(dir: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(secure("router.json5")).unwrap();
     let relative = "deploy/zenoh/secure/credentials.txt";
     assert!(text.contains(relative));
@@ -179,4 +179,102 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
         "forged_results_reaching_the_coordinator": reached, "real_results_seen_by_observer": observed,
         "trials": TRIALS,
     }));
+}
+
+/// The router's access list as Zenoh reads it: per role, the rules it may use, as
+/// `(messages, key expressions)` of the rules that allow ingress.
+fn ingress_rules(role: &str) -> Vec<(Vec<String>, Vec<String>)> {
+    let config = zenoh::Config::from_file(secure("router.json5")).unwrap();
+    let acl: serde_json::Value =
+        serde_json::from_str(&config.get_json("access_control").unwrap()).unwrap();
+    let subjects: Vec<&str> = acl["subjects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["usernames"].as_array().unwrap().iter().any(|u| u == role))
+        .map(|s| s["id"].as_str().unwrap())
+        .collect();
+    let granted: Vec<&str> = acl["policies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| {
+            p["subjects"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| subjects.contains(&s.as_str().unwrap()))
+        })
+        .flat_map(|p| p["rules"].as_array().unwrap().iter())
+        .map(|r| r.as_str().unwrap())
+        .collect();
+    let strings = |v: &serde_json::Value| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap().to_string())
+            .collect()
+    };
+    acl["rules"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| granted.contains(&r["id"].as_str().unwrap()))
+        .filter(|r| {
+            r["permission"] == "allow" && strings(&r["flows"]).iter().any(|f| f == "ingress")
+        })
+        .map(|r| (strings(&r["messages"]), strings(&r["key_exprs"])))
+        .collect()
+}
+
+/// Whether `role` may send `message` on every key of `key` (a key expression).
+fn allowed(rules: &[(Vec<String>, Vec<String>)], message: &str, key: &str) -> bool {
+    let key = zenoh::key_expr::KeyExpr::try_from(key.to_string()).unwrap();
+    rules.iter().any(|(messages, exprs)| {
+        messages.iter().any(|m| m == message)
+            && exprs.iter().any(|e| {
+                zenoh::key_expr::KeyExpr::try_from(e.clone())
+                    .unwrap()
+                    .includes(&key)
+            })
+    })
+}
+
+/// The access list of `router.json5` against the key table: every topic may be put by the
+/// role that publishes it and by no other, every query served by its role, and every agent
+/// kind may declare its liveliness token. (A topic added to the table without its rule
+/// here: its hand, say, would be silently dropped by the router.)
+#[test]
+fn the_routers_access_list_lets_each_role_publish_what_the_key_table_says() {
+    use graspopt_protocol::AgentKind;
+    let roles: Vec<&str> = AgentKind::ALL.iter().map(|k| k.as_str()).collect();
+    let mut missing = Vec::new();
+    let mut extra = Vec::new();
+    for entry in TABLE {
+        let key = entry.key_expr(Runs::All);
+        for role in roles.iter().copied().chain(["observer"]) {
+            let rules = ingress_rules(role);
+            let publishes = role == entry.by.as_str();
+            let needs: &[&str] = if entry.is_query() {
+                &["declare_queryable", "reply"]
+            } else {
+                &["put"]
+            };
+            for message in needs {
+                match (publishes, allowed(&rules, message, &key)) {
+                    (true, false) => missing.push(format!("{role} may not {message} on {key}")),
+                    (false, true) => extra.push(format!("{role} may {message} on {key}")),
+                    _ => {}
+                }
+            }
+        }
+    }
+    for kind in AgentKind::ALL {
+        let token = alive_token(&RunId::new("r").unwrap(), kind, "host", "agent-1");
+        if !allowed(&ingress_rules(kind.as_str()), "liveliness_token", &token) {
+            missing.push(format!("{} may not declare {token}", kind.as_str()));
+        }
+    }
+    assert!(missing.is_empty(), "router.json5 lacks rules: {missing:#?}");
+    assert!(extra.is_empty(), "router.json5 allows too much: {extra:#?}");
 }

@@ -126,7 +126,7 @@ async fn execute<D: HandDriver>(
     id: &str,
 ) -> anyhow::Result<(D, Result<HandReading, HandError>)> {
     if let Some(hand) = driver.hand()
-        && hand != command.hand
+        && !graspopt_sim::same_hand(hand, &command.hand)
     {
         let why = format!(
             "worker {id} has a {hand} hand, the trial asks for {}",

@@ -22,8 +22,10 @@ pub struct RunSettings {
     pub run: String,
     /// Object, hand and scoring.
     pub trial: TrialSettings,
-    /// Simulated hand workers.
+    /// Simulated hand workers (0: only hands that attach from outside).
     pub workers: usize,
+    /// What the simulated hands measure.
+    pub sensing: graspopt_hand::Sensing,
     /// Trial budget.
     pub trials: u64,
     /// The trial parameters, in order.
@@ -54,6 +56,7 @@ impl Default for RunSettings {
             run: "run".into(),
             trial: TrialSettings::default(),
             workers: 3,
+            sensing: graspopt_hand::Sensing::Clouds,
             trials: 60,
             params: vec![ParamKind::Approach, ParamKind::Vertical],
             method: PlannerMethod::Bo,
@@ -94,20 +97,29 @@ struct RecordedSettings {
     trial_cost_ms: Option<u64>,
     #[serde(default)]
     lease_ms: Option<u64>,
+    /// The hand's URDF file, when the run's hand came from one (the spec records the hand's
+    /// name, which no simulated worker can build from): absent for built-in hands.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hand_file: Option<PathBuf>,
+    /// What the simulated hands measured (absent: clouds, as before hands could sense
+    /// forces).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sensing: Option<String>,
 }
 
 fn unit_scale() -> f64 {
     1.0
 }
 
+/// `path` made absolute where it exists, so that a run resumed from another folder finds it.
+fn canonical(path: &Path) -> PathBuf {
+    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
 impl RecordedSettings {
     fn of(s: &RunSettings) -> RecordedSettings {
         RecordedSettings {
-            mesh: s
-                .trial
-                .mesh
-                .as_ref()
-                .map(|m| std::fs::canonicalize(m).unwrap_or_else(|_| m.clone())),
+            mesh: s.trial.mesh.as_deref().map(canonical),
             mesh_scale: s.trial.mesh_scale,
             contacts: s.trial.contacts.name().into(),
             metric: s.trial.metric.name().into(),
@@ -118,6 +130,11 @@ impl RecordedSettings {
             workers: Some(s.workers),
             trial_cost_ms: Some(s.trial_cost_ms),
             lease_ms: Some(s.lease_ms),
+            hand_file: graspopt_sim::builtin_hand(&s.trial.hand)
+                .is_none()
+                .then(|| canonical(Path::new(s.trial.hand.trim()))),
+            sensing: (s.sensing != graspopt_hand::Sensing::Clouds)
+                .then(|| s.sensing.name().to_string()),
         }
     }
 
@@ -144,6 +161,13 @@ impl RecordedSettings {
             metric(&self.metric),
         );
         c.check(explicit, "frame", &given.frame, &self.frame);
+        let sensing = |s: &Option<String>| s.clone().unwrap_or_else(|| "clouds".into());
+        c.check(
+            explicit,
+            "sensing",
+            sensing(&given.sensing),
+            sensing(&self.sensing),
+        );
         let scale = |t: Option<f64>| t.map_or("the object's radius".into(), |v| v.to_string());
         c.check(
             explicit,
@@ -174,6 +198,14 @@ impl RecordedSettings {
     ) -> Result<()> {
         s.trial.mesh = self.mesh.clone();
         s.trial.mesh_scale = self.mesh_scale;
+        if let Some(file) = self.hand_file.as_ref().filter(|_| !explicit("hand")) {
+            s.trial.hand = file.display().to_string();
+        }
+        s.sensing = match &self.sensing {
+            None => graspopt_hand::Sensing::Clouds,
+            Some(name) => graspopt_hand::Sensing::parse(name)
+                .with_context(|| format!("run {run:?}: recorded sensing {name:?}"))?,
+        };
         s.trial.contacts = ContactModel::parse(&self.contacts)
             .with_context(|| format!("run {run:?}: recorded contact model"))?;
         s.trial.metric =
@@ -201,7 +233,7 @@ impl RunSettings {
     fn spec(&self, object: String, bounds: Option<Vec<[f64; 2]>>) -> Result<RunSpec> {
         Ok(RunSpec {
             object,
-            hand: self.trial.hand.clone(),
+            hand: graspopt_sim::hand_name(&self.trial.hand)?,
             params: self.params.clone(),
             bounds,
             trials: self.trials,
@@ -245,7 +277,6 @@ impl RunSettings {
     }
 
     fn assemble(&self, run: RunId, out: PathBuf) -> Result<Embedded> {
-        anyhow::ensure!(self.workers >= 1, "--workers must be at least 1");
         anyhow::ensure!(
             self.workers <= graspopt_shm::DEFAULT_MAX_PUBLISHERS,
             "--workers {} is more than the {} hand workers one process runs (the capacity of a \
@@ -303,6 +334,7 @@ impl RunSettings {
             },
             hand: graspopt_hand::HandConfig {
                 hand: self.trial.hand.clone(),
+                sensing: self.sensing,
                 trial_cost_ms: self.trial_cost_ms,
                 ..Default::default()
             },
@@ -359,7 +391,11 @@ impl RunSettings {
         let spec = graspopt_coordinator::reconcile(run, &recorded, &given, explicit)?;
         let mut s = self.clone();
         s.run = run.as_str().to_string();
-        s.trial.hand = spec.hand.clone();
+        // The recorded name; a hand given again (a file moved, say) is taken as given: its
+        // name agreed with the record.
+        if !explicit("hand") {
+            s.trial.hand = spec.hand.clone();
+        }
         s.params = spec.params.clone();
         s.trials = spec.trials;
         s.seed = spec.seed;

@@ -45,7 +45,8 @@ pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint
 pub use error::SimError;
 pub use hand::{
     BarrettHand, BuiltinHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec,
-    ParallelJawGripper, UrdfHand, builtin_hands, hand_by_name, hand_names,
+    ParallelJawGripper, UrdfHand, builtin_hand, builtin_hands, hand_by_name, hand_name, hand_names,
+    same_hand,
 };
 pub use mesh::TriangleMesh;
 pub use object::{Object, ObjectKind, RayHit, SurfacePoint};

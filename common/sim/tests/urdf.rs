@@ -356,3 +356,32 @@ fn missing_and_unsupported_meshes_are_errors_that_name_the_file() {
         .to_string();
     assert!(e.contains("nope.urdf"), "{e}");
 }
+
+/// The name a run knows a hand by: a built-in hand's own name for any alias, the name a
+/// URDF file's settings give (the test hand of the journeys test says `claw`, its robot
+/// `claw_urdf`), any other text unchanged (a hand only its agent knows); a file that cannot
+/// be read is an error naming it.
+#[test]
+fn a_hand_is_known_by_its_name_whether_given_by_name_alias_or_file() {
+    let claw = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/data/hands/claw/claw.urdf"
+    );
+    assert_eq!(graspopt_sim::hand_name("bh8").unwrap(), "barrett");
+    assert_eq!(
+        graspopt_sim::hand_name("Franka-Hand").unwrap(),
+        "franka_hand"
+    );
+    assert_eq!(graspopt_sim::hand_name(claw).unwrap(), "claw");
+    assert_eq!(
+        graspopt_sim::hand_name("my_robot_hand").unwrap(),
+        "my_robot_hand"
+    );
+    let missing = graspopt_sim::hand_name("no/such/hand.urdf")
+        .unwrap_err()
+        .to_string();
+    assert!(missing.contains("no/such/hand.urdf"), "{missing}");
+    assert!(graspopt_sim::same_hand("gripper", "parallel_jaw"));
+    assert!(graspopt_sim::same_hand("claw", "claw"));
+    assert!(!graspopt_sim::same_hand("claw", "barrett"));
+}

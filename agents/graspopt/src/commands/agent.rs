@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
@@ -248,7 +248,13 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
             c.lease_ms = lease_ms.unwrap_or(c.lease_ms);
             let given = RunSpec {
                 object: sim.object()?.name().to_string(),
-                hand: sim.hand.clone(),
+                hand: graspopt_sim::hand_name(&sim.hand).with_context(|| {
+                    format!(
+                        "--hand {}: the coordinator knows a hand by its name; where its file \
+                         is not on this host, give the name `graspopt hands FILE` prints",
+                        sim.hand
+                    )
+                })?,
                 params: params.clone(),
                 bounds: None,
                 trials: *trials,

@@ -15,7 +15,7 @@ use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
-use super::setup::{SimArgs, planner_method, trial_param};
+use super::setup::{SimArgs, planner_method, sensing, trial_param};
 use crate::out::outln;
 use graspopt_protocol::named_params;
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
@@ -27,9 +27,14 @@ pub struct RunArgs {
     /// Run id (one key chunk: letters, digits, '-', '_', '.').
     #[arg(long, default_value = "run")]
     pub run: String,
-    /// Number of simulated hand workers.
+    /// Number of simulated hand workers (0: none, the run waits for hands that attach to
+    /// its endpoint, `--listen`, such as a real hand's agent).
     #[arg(long, default_value_t = 3)]
     pub workers: usize,
+    /// What the simulated hands measure: clouds (contact clouds) or ft (fingertip
+    /// force/torque readings; a hand with sensing fingertips, barrett_ft).
+    #[arg(long, default_value = "clouds", value_parser = sensing())]
+    pub sensing: graspopt_hand::Sensing,
     /// Number of trials.
     #[arg(long, default_value_t = 60)]
     pub trials: u64,
@@ -87,6 +92,7 @@ impl RunArgs {
             run: self.run.clone(),
             trial: self.sim.settings(),
             workers: self.workers,
+            sensing: self.sensing,
             trials: self.trials,
             params: self.params.clone(),
             method: self.method,

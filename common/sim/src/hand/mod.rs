@@ -288,26 +288,57 @@ pub fn hand_names() -> Vec<&'static str> {
     BUILTIN_HANDS.iter().map(|h| h.name).collect()
 }
 
-/// A built-in hand by name (see [`builtin_hands`]; `-` and `_` alike, any case), or a hand read
-/// from a URDF file (a name ending in `.urdf`, see [`urdf`]).
+/// Whether `hand` names a URDF file (it ends in `.urdf`, any case) rather than a hand.
+fn is_urdf_file(hand: &str) -> bool {
+    hand.to_ascii_lowercase().ends_with(".urdf")
+}
+
+/// The built-in hand called `name` or one of its aliases (`-` and `_` alike, any case).
+pub fn builtin_hand(name: &str) -> Option<&'static BuiltinHand> {
+    let key = name.trim().to_ascii_lowercase().replace('-', "_");
+    BUILTIN_HANDS
+        .iter()
+        .find(|h| h.name == key || h.aliases.contains(&key.as_str()))
+}
+
+/// A built-in hand by name (see [`builtin_hand`]), or a hand read from a URDF file (a name
+/// ending in `.urdf`, see [`urdf`]).
 pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
     let trimmed = name.trim();
-    if trimmed.to_ascii_lowercase().ends_with(".urdf") {
+    if is_urdf_file(trimmed) {
         return Ok(Box::new(UrdfHand::from_file(std::path::Path::new(
             trimmed,
         ))?));
     }
-    let key = trimmed.to_ascii_lowercase().replace('-', "_");
-    match BUILTIN_HANDS
-        .iter()
-        .find(|h| h.name == key || h.aliases.contains(&key.as_str()))
-    {
+    match builtin_hand(trimmed) {
         Some(h) => Ok(Box::new(h.build()?)),
         None => Err(SimError::UnknownHand {
             name: name.to_string(),
             valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
         }),
     }
+}
+
+/// The name a run knows the hand `hand` by, in its trial commands, its journal and its
+/// workers' answers: a built-in hand's own name for its name or any alias; for a URDF file,
+/// the name of the hand it describes (its settings' `name`, else the robot's), so that a
+/// worker given the file and a coordinator given the same file, or the hand's name, agree;
+/// any other text is the name of a hand that only its own agent knows (a real hand),
+/// unchanged.
+pub fn hand_name(hand: &str) -> Result<String> {
+    let trimmed = hand.trim();
+    if is_urdf_file(trimmed) {
+        return Ok(UrdfHand::from_file(std::path::Path::new(trimmed))?
+            .name()
+            .to_string());
+    }
+    Ok(builtin_hand(trimmed).map_or_else(|| trimmed.to_string(), |h| h.name.to_string()))
+}
+
+/// Whether two hand names are the same hand (a built-in hand's aliases are its name).
+pub fn same_hand(a: &str, b: &str) -> bool {
+    let own = |n: &str| builtin_hand(n).map_or_else(|| n.trim().to_string(), |h| h.name.into());
+    own(a) == own(b)
 }
 
 /// parry shapes of a hand's links, built once.
