@@ -29,8 +29,8 @@ use graspopt_trial::{Evaluator, TrialSettings};
 
 use crate::security::{router_config, secure};
 use crate::support::{
-    Cluster, Proc, check_journal, cloud_transport, free_port, graspopt_bin, log, repo_root,
-    tempdir, wait_for_port,
+    Cluster, Proc, check_journal, cloud_transport, free_port, graspopt, graspopt_bin, log,
+    repo_root, tempdir, wait_for_port,
 };
 use crate::{ft, replay};
 
@@ -427,6 +427,37 @@ fn journey(source: Source, deployment: Deployment) {
         }
     }
     hand.check_scores(&rows);
+    check_export(&journal, &run, &rows);
+    if deployment == Deployment::Embedded {
+        // The run's pictures, as `graspopt run` leaves them.
+        for picture in ["best.png", "trials.svg", "best.svg", "trials.csv"] {
+            let path = journal.with_file_name(picture);
+            assert!(path.exists(), "{} is missing", path.display());
+        }
+    }
+}
+
+/// `graspopt export` reads the journey's trials with the journal's scores.
+fn check_export(journal: &Path, run: &str, rows: &[TrialRow]) {
+    let o = graspopt(&[
+        "export",
+        run,
+        "--journal",
+        journal.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let exported: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let trials = exported
+        .as_array()
+        .or_else(|| exported["trials"].as_array())
+        .unwrap();
+    assert_eq!(trials.len(), rows.len(), "{exported}");
+    for (e, t) in trials.iter().zip(rows) {
+        assert_eq!(e["trial_id"].as_u64(), Some(t.trial_id), "{e}");
+        assert_eq!(e["score"].as_f64(), t.score, "{e}");
+    }
 }
 
 macro_rules! journeys {
