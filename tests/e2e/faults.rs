@@ -8,7 +8,7 @@ use crate::support::{
 };
 use graspopt_bus::{Bus, CongestionControl};
 use graspopt_journal::{Journal, TrialState};
-use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs};
+use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, WRENCHES};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Pose, RunId, TrialResult, encode,
 };
@@ -244,8 +244,8 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         )
         .await
         .unwrap();
-        // Object estimate (coordinator, metric and hands listen), clouds (metric), a command
-        // (hand-1), each garbage or NaN.
+        // Object estimate (coordinator, metric and hands listen), clouds and fingertip
+        // readings (metric), a command (hand-1), each garbage or NaN.
         put_raw(
             OBJECT.key(Runs::One(&run)).to_string(),
             garbage.clone(),
@@ -255,6 +255,12 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         put_raw(
             CLOUDS.key(Runs::One(&run)).to_string(),
             encode(&nan_clouds(&run), Encoding::Bincode).unwrap(),
+            Encoding::Bincode,
+        )
+        .await;
+        put_raw(
+            WRENCHES.key(Runs::One(&run)).to_string(),
+            garbage.clone(),
             Encoding::Bincode,
         )
         .await;
@@ -293,6 +299,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
         "{metric}"
     );
     assert!(metric.contains("bad object estimate"), "{metric}");
+    assert!(metric.contains("bad fingertip readings"), "{metric}");
     let hand = c.log("hand-1");
     assert!(
         hand.contains("bad command") && hand.contains("bad messages"),
@@ -306,7 +313,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     let (lost, _) = lost_and_recorded_twice(&journal, "bad", 10);
     report(json!({
         "test": "one bad message of each kind on every topic",
-        "sent": 8, "counted_by_coordinator": counted, "trials": 10, "lost": lost,
+        "sent": 9, "counted_by_coordinator": counted, "trials": 10, "lost": lost,
     }));
 }
 

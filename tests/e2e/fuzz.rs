@@ -1,22 +1,29 @@
 //! Malformed traffic during a run (issue 7): more than 10,000 random and mutated messages on
-//! every input topic of every agent (results and object estimates to the coordinator, object
-//! estimates and clouds to the metric agent, object estimates and commands to the hand,
-//! queries to the planner). No agent crashes, every message is counted as bad by the agents
-//! that receive it, and the run gives exactly the trials of the same run without the noise.
+//! every input topic of every agent, one stream per row of the key table (`keys::TABLE`, so a
+//! new topic cannot be left out: a row without a stream here fails the test): object
+//! estimates (to the coordinator, the hands and the metric agent), commands (to the hand),
+//! contact clouds and fingertip readings (to the metric agent), results (to the coordinator)
+//! and queries (to the planner). No agent crashes, every message is counted as bad by the
+//! agents that receive it, and the run gives exactly the trials of the same run without the
+//! noise.
 //!
 //! A mutant that still decodes into a plausible message of this very run is not sent: that
 //! is a well-formed message from a stranger, which access control keeps out (see
 //! `tests/e2e/security.rs`), not malformed traffic.
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 use crate::support::{Cluster, check_journal, report, wait_until};
 use graspopt_bus::{Bus, CongestionControl, zenoh_encoding};
 use graspopt_journal::TrialRow;
-use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, SUGGEST};
+use graspopt_protocol::keys::{
+    CLOUDS, COMMAND, Entry, OBJECT, RESULT, Runs, SUGGEST, TABLE, WRENCHES,
+};
 use graspopt_protocol::{
-    CloudPoint, ContactClouds, Encoding, FingerCloud, Message, MetricValues, ObjectEstimate,
-    PlannerMethod, Pose, RunId, SuggestRequest, TrialCommand, TrialResult, decode, encode,
+    CloudPoint, ContactClouds, Encoding, FingerCloud, FingertipSurface, FingertipWrench,
+    FingertipWrenches, Message, MetricValues, ObjectEstimate, PlannerMethod, Pose, RunId,
+    SuggestRequest, TrialCommand, TrialResult, decode, encode,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -25,7 +32,7 @@ use serde_json::json;
 const RUN: &str = "fz";
 const TRIALS: usize = 16;
 const SEED: &str = "9";
-/// Messages per stream (six streams).
+/// Messages per stream (seven streams).
 const PER_STREAM: usize = 1_800;
 
 /// A seeded generator (ChaCha8), so a failure replays.
@@ -99,13 +106,17 @@ fn elsewhere() -> RunId {
     RunId::new("elsewhere").unwrap()
 }
 
-fn templates() -> (
-    TrialResult,
-    ObjectEstimate,
-    ContactClouds,
-    TrialCommand,
-    SuggestRequest,
-) {
+/// A message of each type the agents receive, of another run or of trials never issued.
+struct Templates {
+    result: TrialResult,
+    object: ObjectEstimate,
+    clouds: ContactClouds,
+    wrenches: FingertipWrenches,
+    command: TrialCommand,
+    suggest: SuggestRequest,
+}
+
+fn templates() -> Templates {
     let result = TrialResult {
         // This run, but a trial and worker it never issued: if a mutant still decodes, the
         // coordinator counts it as an unknown trial or a result it never issued.
@@ -161,6 +172,32 @@ fn templates() -> (
         error: None,
         executed_ms: 0,
     };
+    let wrenches = FingertipWrenches {
+        run_id: elsewhere(),
+        trial_id: 1,
+        attempt: 1,
+        worker: "hand-1".into(),
+        hand: "barrett_ft".into(),
+        palm_pose: Pose::IDENTITY,
+        fingertips: (0..3)
+            .map(|k| FingertipWrench {
+                finger: k,
+                link: format!("f{k}_tip"),
+                sensor_pose: Pose::IDENTITY,
+                surface: FingertipSurface::Sphere {
+                    center: [0.0, 0.0, 0.015],
+                    radius: 0.012,
+                    base_z: None,
+                },
+                force: [0.0, 0.0, -1.5],
+                torque: [0.0, 0.0, 0.0],
+                stamp_ms: 0,
+            })
+            .collect(),
+        min_gap: None,
+        error: None,
+        executed_ms: 0,
+    };
     let command = TrialCommand {
         run_id: elsewhere(),
         trial_id: 1,
@@ -184,7 +221,14 @@ fn templates() -> (
         count: 1,
         engine_state: None,
     };
-    (result, object, clouds, command, suggest)
+    Templates {
+        result,
+        object,
+        clouds,
+        wrenches,
+        command,
+        suggest,
+    }
 }
 
 /// The largest `(N bad messages)` count an agent logged.
@@ -197,6 +241,152 @@ fn bad_count(log: &str) -> u64 {
         })
         .max()
         .unwrap_or(0)
+}
+
+/// An agent of the run that counts the bad messages it receives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Agent {
+    Coordinator,
+    Hand,
+    Metric,
+    Planner,
+}
+
+/// The rows of the key table that no agent of a run receives, and why: no noise on them.
+const NOT_RECEIVED: &[(&str, &str)] = &[
+    (
+        "status",
+        "the coordinator publishes it for monitors; no agent of a run reads it",
+    ),
+    (
+        "state",
+        "a query without payload that the coordinator answers: nothing to decode",
+    ),
+];
+
+/// One stream of noise: a row of the key table, the key it is sent on, its payloads, and
+/// the agents that receive (and count) each of them.
+struct Stream {
+    topic: &'static str,
+    key: String,
+    query: bool,
+    payloads: Payloads,
+    counted_by: &'static [Agent],
+}
+
+/// The streams of noise: one per row of the key table an agent of the run receives, and one
+/// of well-formed results the run never issued.
+fn streams(rng: &mut Rng) -> Vec<Stream> {
+    let run = RunId::new(RUN).unwrap();
+    let runs = Runs::One(&run);
+    let t = templates();
+    let mut out = Vec::new();
+    for entry in TABLE {
+        let Entry { name, .. } = entry;
+        let (key, payloads, counted_by): (String, Payloads, &'static [Agent]) = match name {
+            "object" => (
+                OBJECT.key(runs).to_string(),
+                mutants(rng, &t.object, PER_STREAM),
+                &[Agent::Coordinator, Agent::Hand, Agent::Metric],
+            ),
+            "command" => (
+                COMMAND.worker_key(runs, "hand-1").to_string(),
+                mutants(rng, &t.command, PER_STREAM),
+                &[Agent::Hand],
+            ),
+            "clouds" => (
+                CLOUDS.key(runs).to_string(),
+                mutants(rng, &t.clouds, PER_STREAM),
+                &[Agent::Metric],
+            ),
+            "wrenches" => (
+                WRENCHES.key(runs).to_string(),
+                mutants(rng, &t.wrenches, PER_STREAM),
+                &[Agent::Metric],
+            ),
+            "result" => (
+                RESULT.key(runs).to_string(),
+                mutants(rng, &t.result, PER_STREAM),
+                &[Agent::Coordinator],
+            ),
+            // Each answered with an error.
+            "suggest" => (
+                SUGGEST.key(&run).to_string(),
+                mutants(rng, &t.suggest, PER_STREAM),
+                &[Agent::Planner],
+            ),
+            _ => {
+                assert!(
+                    NOT_RECEIVED.iter().any(|(n, _)| *n == name),
+                    "the key table's row `{name}` has no stream of noise: add one, or say in \
+                     NOT_RECEIVED why no agent receives it"
+                );
+                continue;
+            }
+        };
+        let query = entry.is_query();
+        out.push(Stream {
+            topic: name,
+            key,
+            query,
+            payloads,
+            counted_by,
+        });
+    }
+    // Well-formed results this run never issued (a trial id out of range, a stranger).
+    let strangers = (0..PER_STREAM as u64)
+        .map(|i| {
+            let mut r = t.result.clone();
+            r.trial_id = if i % 2 == 0 {
+                1 + i % TRIALS as u64
+            } else {
+                5_000 + i
+            };
+            r.worker = format!("stranger-{}", i % 7);
+            let e = if i % 3 == 0 {
+                Encoding::Json
+            } else {
+                Encoding::Bincode
+            };
+            (encode(&r, e).unwrap(), e)
+        })
+        .collect();
+    out.push(Stream {
+        topic: "result",
+        key: RESULT.key(runs).to_string(),
+        query: false,
+        payloads: strangers,
+        counted_by: &[Agent::Coordinator],
+    });
+    out
+}
+
+/// Messages sent: per stream, its topic, the agents that count it and how many.
+#[derive(Debug, Default)]
+struct Sent(Vec<(&'static str, &'static [Agent], u64)>);
+
+impl Sent {
+    fn total(&self) -> u64 {
+        self.0.iter().map(|(_, _, n)| n).sum()
+    }
+
+    /// The messages that reached `agent`.
+    fn to(&self, agent: Agent) -> u64 {
+        self.0
+            .iter()
+            .filter(|(_, by, _)| by.contains(&agent))
+            .map(|(_, _, n)| n)
+            .sum()
+    }
+
+    /// The messages sent on each topic.
+    fn per_topic(&self) -> BTreeMap<&'static str, u64> {
+        let mut out = BTreeMap::new();
+        for (topic, _, n) in &self.0 {
+            *out.entry(*topic).or_default() += n;
+        }
+        out
+    }
 }
 
 /// One run of `TRIALS` trials with one hand (nothing depends on timing); with `fuzz`, the
@@ -222,9 +412,9 @@ fn run(name: &str, fuzz: bool) -> (Vec<TrialRow>, serde_json::Value, Option<(Clu
         // logged as many rejections as it was sent (more would fail the test's equality).
         if let Some(s) = &sent {
             wait_until("every bad message logged", Duration::from_secs(60), || {
-                bad_count(&c.log("hand-1")) >= s.objects + s.commands
-                    && bad_count(&c.log("metric")) >= s.objects + s.clouds
-                    && bad_count(&c.log("planner")) >= s.queries
+                bad_count(&c.log("hand-1")) >= s.to(Agent::Hand)
+                    && bad_count(&c.log("metric")) >= s.to(Agent::Metric)
+                    && bad_count(&c.log("planner")) >= s.to(Agent::Planner)
             });
         }
         let trials = check_journal(&c.journal(), RUN, TRIALS);
@@ -237,20 +427,10 @@ fn run(name: &str, fuzz: bool) -> (Vec<TrialRow>, serde_json::Value, Option<(Clu
     (trials, status, sent.map(|s| (c, s)))
 }
 
-/// Messages sent per receiving stream.
-#[derive(Debug, Default)]
-struct Sent {
-    results: u64,
-    objects: u64,
-    clouds: u64,
-    commands: u64,
-    queries: u64,
-}
-
 fn send_noise(c: &Cluster) -> Sent {
     let run = RunId::new(RUN).unwrap();
     let mut rng = Rng::seeded(0x9E37_79B9_7F4A_7C15);
-    let (result, object, clouds, command, suggest) = templates();
+    let streams = streams(&mut rng);
     let runtime = tokio::runtime::Runtime::new().unwrap();
     runtime.block_on(async {
         let bus = Bus::open(&c.client_args(None)).await.unwrap();
@@ -264,82 +444,68 @@ fn send_noise(c: &Cluster) -> Sent {
             .expect("a first result");
         // Not read any more: a full subscription queue would block this session's own puts.
         drop(results);
-        let mut sent = Sent::default();
-        let mut streams: Vec<(String, Payloads, &str)> = vec![
-            (
-                RESULT.key(Runs::One(&run)).to_string(),
-                mutants(&mut rng, &result, PER_STREAM),
-                "results",
-            ),
-            (
-                OBJECT.key(Runs::One(&run)).to_string(),
-                mutants(&mut rng, &object, PER_STREAM),
-                "objects",
-            ),
-            (
-                CLOUDS.key(Runs::One(&run)).to_string(),
-                mutants(&mut rng, &clouds, PER_STREAM),
-                "clouds",
-            ),
-            (
-                COMMAND.worker_key(Runs::One(&run), "hand-1").to_string(),
-                mutants(&mut rng, &command, PER_STREAM),
-                "commands",
-            ),
-        ];
-        // Well-formed results this run never issued (a trial id out of range, a stranger).
-        let mut strangers = Vec::new();
-        for i in 0..PER_STREAM as u64 {
-            let mut r = result.clone();
-            r.trial_id = if i % 2 == 0 {
-                1 + i % TRIALS as u64
-            } else {
-                5_000 + i
-            };
-            r.worker = format!("stranger-{}", i % 7);
-            let e = if i % 3 == 0 {
-                Encoding::Json
-            } else {
-                Encoding::Bincode
-            };
-            strangers.push((encode(&r, e).unwrap(), e));
-        }
-        streams.push((
-            RESULT.key(Runs::One(&run)).to_string(),
-            strangers,
-            "results",
-        ));
-        // Interleave the streams message by message.
+        let mut sent: Vec<u64> = vec![0; streams.len()];
+        // The topics, interleaved message by message.
         for i in 0..PER_STREAM {
-            for (key, msgs, what) in &streams {
-                let (bytes, encoding) = &msgs[i];
-                bus.put_bytes(key, bytes.clone(), *encoding, CongestionControl::Block)
+            for (k, s) in streams.iter().enumerate().filter(|(_, s)| !s.query) {
+                let (bytes, encoding) = &s.payloads[i];
+                bus.put_bytes(&s.key, bytes.clone(), *encoding, CongestionControl::Block)
                     .await
                     .unwrap();
-                match *what {
-                    "results" => sent.results += 1,
-                    "objects" => sent.objects += 1,
-                    "clouds" => sent.clouds += 1,
-                    _ => sent.commands += 1,
-                }
+                sent[k] += 1;
             }
         }
-        // Planner queries, each answered with an error.
-        for (bytes, encoding) in mutants(&mut rng, &suggest, PER_STREAM) {
-            let replies = bus
-                .session()
-                .get(SUGGEST.key(&run).to_string())
-                .payload(bytes)
-                .encoding(zenoh_encoding(encoding))
-                .timeout(Duration::from_secs(10))
-                .await
-                .unwrap();
-            while replies.recv_async().await.is_ok() {}
-            sent.queries += 1;
+        // The queries, one after the other.
+        for (k, s) in streams.iter().enumerate().filter(|(_, s)| s.query) {
+            for (bytes, encoding) in &s.payloads {
+                let replies = bus
+                    .session()
+                    .get(&s.key)
+                    .payload(bytes.clone())
+                    .encoding(zenoh_encoding(*encoding))
+                    .timeout(Duration::from_secs(10))
+                    .await
+                    .unwrap();
+                while replies.recv_async().await.is_ok() {}
+                sent[k] += 1;
+            }
         }
         let _ = bus.close().await;
-        sent
+        Sent(
+            streams
+                .iter()
+                .zip(sent)
+                .map(|(s, n)| (s.topic, s.counted_by, n))
+                .collect(),
+        )
     })
+}
+
+/// Each row of the key table gets its noise, or a reason in `NOT_RECEIVED`; the noise on a
+/// topic is of its message type and goes to the agents that subscribe to it.
+#[test]
+fn every_row_of_the_key_table_has_its_noise() {
+    let streams = streams(&mut Rng::seeded(1));
+    for entry in TABLE {
+        let noise = streams.iter().filter(|s| s.topic == entry.name).count();
+        let reason = NOT_RECEIVED.iter().any(|(n, _)| *n == entry.name);
+        assert!(
+            (noise > 0) != reason,
+            "{}: {noise} streams, a reason: {reason}",
+            entry.name
+        );
+    }
+    let wrenches = streams.iter().find(|s| s.topic == "wrenches").unwrap();
+    assert_eq!(wrenches.key, format!("graspopt/{RUN}/wrenches"));
+    assert_eq!(wrenches.counted_by, &[Agent::Metric]);
+    assert_eq!(wrenches.payloads.len(), PER_STREAM);
+    // Mutants of fingertip readings: none decodes into readings of this run.
+    let run = RunId::new(RUN).unwrap();
+    for (bytes, encoding) in &wrenches.payloads {
+        if let Ok(w) = decode::<FingertipWrenches>(bytes, *encoding) {
+            assert_ne!(w.run_id, run);
+        }
+    }
 }
 
 #[test]
@@ -348,8 +514,17 @@ fn ten_thousand_bad_messages_change_nothing_and_are_all_counted() {
     let (clean, _, _) = run("fuzzclean", false);
     let (noisy, status, fuzzed) = run("fuzznoisy", true);
     let (c, sent) = fuzzed.unwrap();
-    let total = sent.results + sent.objects + sent.clouds + sent.commands + sent.queries;
-    assert!(total >= 10_000, "{sent:?}");
+    assert!(sent.total() >= 10_000, "{sent:?}");
+    // Every topic an agent receives had its noise, fingertip readings included.
+    let per_topic = sent.per_topic();
+    for topic in [
+        "object", "command", "clouds", "wrenches", "result", "suggest",
+    ] {
+        assert!(
+            per_topic.get(topic) >= Some(&(PER_STREAM as u64)),
+            "{sent:?}"
+        );
+    }
     // Same trials, bit for bit.
     let differing: Vec<u64> = clean
         .iter()
@@ -369,23 +544,20 @@ fn ten_thousand_bad_messages_change_nothing_and_are_all_counted() {
         .sum::<u64>();
     assert_eq!(
         coordinator,
-        sent.results + sent.objects,
+        sent.to(Agent::Coordinator),
         "{status} {sent:?}"
     );
     assert_eq!(e["duplicates"], 0);
     let hand = bad_count(&c.log("hand-1"));
     let metric = bad_count(&c.log("metric"));
     let planner = bad_count(&c.log("planner"));
-    assert_eq!(hand, sent.objects + sent.commands, "hand {sent:?}");
-    assert_eq!(metric, sent.objects + sent.clouds, "metric {sent:?}");
-    assert_eq!(planner, sent.queries, "planner {sent:?}");
+    assert_eq!(hand, sent.to(Agent::Hand), "hand {sent:?}");
+    assert_eq!(metric, sent.to(Agent::Metric), "metric {sent:?}");
+    assert_eq!(planner, sent.to(Agent::Planner), "planner {sent:?}");
     report(json!({
         "test": "fuzz: random and mutated messages on every input topic during a run",
-        "sent": total,
-        "sent_per_stream": {
-            "results": sent.results, "objects": sent.objects, "clouds": sent.clouds,
-            "commands": sent.commands, "planner_queries": sent.queries,
-        },
+        "sent": sent.total(),
+        "sent_per_topic": per_topic,
         "counted": {"coordinator": coordinator, "hand": hand, "metric": metric, "planner": planner},
         "trials": TRIALS,
         "trials_differing_from_clean_run": differing.len(),

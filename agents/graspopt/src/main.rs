@@ -93,10 +93,11 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
     let matches = Cli::command().get_matches();
-    let cli = match Cli::from_arg_matches(&matches) {
-        Ok(cli) => cli,
-        Err(e) => e.exit(),
-    };
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // Parsed and nothing more: the test of the docs' commands (tests/cli/doc_commands.rs).
+    if std::env::var_os("GRASPOPT_PARSE_ONLY").is_some_and(|v| v == "1") {
+        return ExitCode::SUCCESS;
+    }
     let run_matches = matches.subcommand_matches("run");
     let coordinator_matches = matches
         .subcommand_matches("agent")
@@ -118,9 +119,7 @@ fn main() -> ExitCode {
         Command::Scan(args) => commands::scan::run(args),
         Command::Record(args) => commands::record::run(args),
         Command::Experiment(args) => commands::experiment::run(args),
-        Command::OptimizeFunction(args) => {
-            commands::optimize_function::run(args).map(|()| ExitCode::SUCCESS)
-        }
+        Command::OptimizeFunction(args) => commands::optimize_function::run(args),
         Command::Run(args) => commands::run::run(args, &|name| given(run_matches, name)),
         Command::Agent(args) => {
             commands::agent::run(args, &|name| given(coordinator_matches, name))

@@ -68,7 +68,7 @@ fn fmt_med(v: Option<f64>) -> String {
 }
 
 /// Run the command.
-pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
+pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<std::process::ExitCode> {
     let function = TestFunction::from_name(&args.function)?;
     let budget = args
         .budget
@@ -201,5 +201,5 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<()> {
             )?;
         }
     }
-    Ok(())
+    Ok(std::process::ExitCode::SUCCESS)
 }

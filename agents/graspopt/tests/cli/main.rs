@@ -3,6 +3,8 @@
 //! A new file here needs a `mod` line below.
 
 mod cli_bad_input;
+mod doc_commands;
+mod doc_facts;
 mod forces_cli;
 mod pipe_cli;
 mod quality_cli;
