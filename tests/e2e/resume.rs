@@ -420,4 +420,27 @@ fn a_run_of_a_hand_from_a_file_resumes_from_another_folder() {
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(err.contains("--sensing ft (the run has clouds)"), "{err}");
+    // The hand's file moved: said, and given again where it is now, the run goes on.
+    let moved = dir.join("moved");
+    std::fs::rename(dir.join("hands"), &moved).unwrap();
+    let gone = run(&elsewhere, &["--resume", "--trials", "6"]);
+    let err = String::from_utf8_lossy(&gone.stderr);
+    assert!(!gone.status.success());
+    assert!(
+        err.contains("claw.urdf is gone: give --hand FILE where it is now"),
+        "{err}"
+    );
+    let file = moved.join("claw/claw.urdf");
+    let again = run(
+        &elsewhere,
+        &[
+            "--resume",
+            "--trials",
+            "6",
+            "--hand",
+            file.to_str().unwrap(),
+        ],
+    );
+    assert!(again.status.success(), "{again:?}");
+    check_journal(&out.join("journal.sqlite"), "run", 6);
 }

@@ -199,6 +199,11 @@ impl RecordedSettings {
         s.trial.mesh = self.mesh.clone();
         s.trial.mesh_scale = self.mesh_scale;
         if let Some(file) = self.hand_file.as_ref().filter(|_| !explicit("hand")) {
+            anyhow::ensure!(
+                file.exists(),
+                "run {run:?}: its hand's file {} is gone: give --hand FILE where it is now",
+                file.display()
+            );
             s.trial.hand = file.display().to_string();
         }
         s.sensing = match &self.sensing {
