@@ -24,7 +24,37 @@ pub fn load<T: DeserializeOwned + Serialize + Default>(path: Option<&Path>) -> R
     unknown_key(&table, &known, "")
         .map_or(Ok(()), |e| Err(anyhow::anyhow!(e)))
         .with_context(context)?;
-    toml::from_str(&text).with_context(context)
+    let settings: T = toml::from_str(&text).with_context(context)?;
+    match p.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(folder) => relative_to(settings, &table, folder).with_context(context),
+        None => Ok(settings),
+    }
+}
+
+/// The settings that name a file: with a relative path in a settings file, the file is
+/// looked up beside it (as a launch file's paths are), not in the folder the agent runs in.
+/// `hand` only when it names a URDF file (a built-in hand is a name).
+const FILE_KEYS: [&str; 4] = ["hand", "mesh", "replay", "journal"];
+
+/// `settings` with the relative paths that `table` (the file) gave to [`FILE_KEYS`] made
+/// relative to `folder`.
+fn relative_to<T: DeserializeOwned + Serialize>(
+    settings: T,
+    table: &toml::Table,
+    folder: &Path,
+) -> Result<T> {
+    let mut value = serde_json::to_value(settings)?;
+    for key in FILE_KEYS {
+        let Some(toml::Value::String(given)) = table.get(key) else {
+            continue;
+        };
+        let path = Path::new(given);
+        let is_file = key != "hand" || given.to_ascii_lowercase().ends_with(".urdf");
+        if is_file && !given.is_empty() && path.is_relative() {
+            value[key] = serde_json::Value::String(folder.join(path).display().to_string());
+        }
+    }
+    Ok(serde_json::from_value(value)?)
 }
 
 /// The first key of `table` (at `path`, a dotted table name, empty at the top) that
@@ -132,5 +162,30 @@ mod tests {
         // Keys left out keep their defaults; flags of other kinds are not keys.
         let c: graspopt_hand::HandConfig = load_text("h.toml", "trial_cost_ms = 5\n").unwrap();
         assert_eq!((c.trial_cost_ms, c.hand.as_str()), (5, "barrett"));
+    }
+
+    /// Files named in a settings file are found beside it; absolute paths, built-in hand
+    /// names and empty paths are kept.
+    #[test]
+    fn paths_in_a_settings_file_are_relative_to_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("h.toml");
+        let text =
+            "hand = \"../hands/claw.urdf\"\nmesh = \"part.stl\"\nreplay = \"/abs/rec.jsonl\"\n";
+        std::fs::write(&path, text).unwrap();
+        let c: graspopt_hand::HandConfig = load(Some(&path)).unwrap();
+        assert_eq!(Path::new(&c.hand), dir.path().join("../hands/claw.urdf"));
+        assert_eq!(
+            c.mesh.as_deref(),
+            Some(dir.path().join("part.stl").as_path())
+        );
+        assert_eq!(c.replay.as_deref(), Some(Path::new("/abs/rec.jsonl")));
+        std::fs::write(&path, "hand = \"franka_hand\"\n").unwrap();
+        let c: graspopt_hand::HandConfig = load(Some(&path)).unwrap();
+        assert_eq!(c.hand, "franka_hand");
+        let path = dir.path().join("c.toml");
+        std::fs::write(&path, "journal = \"\"\n").unwrap();
+        let c: graspopt_coordinator::CoordinatorConfig = load(Some(&path)).unwrap();
+        assert_eq!(c.journal, Path::new(""));
     }
 }
