@@ -6,6 +6,7 @@ mod cli_bad_input;
 mod forces_cli;
 mod pipe_cli;
 mod quality_cli;
+mod ranges_cli;
 mod render_cli;
 mod run_pictures_cli;
 mod scene_cli;

@@ -291,22 +291,27 @@ pub fn hand_names() -> Vec<&'static str> {
 /// A built-in hand by name (see [`builtin_hands`]; `-` and `_` alike, any case), or a hand read
 /// from a URDF file (a name ending in `.urdf`, see [`urdf`]).
 pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
-    let trimmed = name.trim();
-    if trimmed.to_ascii_lowercase().ends_with(".urdf") {
-        return Ok(Box::new(UrdfHand::from_file(std::path::Path::new(
-            trimmed,
-        ))?));
-    }
-    let key = trimmed.to_ascii_lowercase().replace('-', "_");
-    match BUILTIN_HANDS
-        .iter()
-        .find(|h| h.name == key || h.aliases.contains(&key.as_str()))
-    {
-        Some(h) => Ok(Box::new(h.build()?)),
-        None => Err(SimError::UnknownHand {
-            name: name.to_string(),
-            valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
-        }),
+    Ok(Box::new(UrdfHand::by_name(name)?))
+}
+
+impl UrdfHand {
+    /// The hand [`hand_by_name`] gives, as the [`UrdfHand`] it is.
+    pub fn by_name(name: &str) -> Result<UrdfHand> {
+        let trimmed = name.trim();
+        if trimmed.to_ascii_lowercase().ends_with(".urdf") {
+            return UrdfHand::from_file(std::path::Path::new(trimmed));
+        }
+        let key = trimmed.to_ascii_lowercase().replace('-', "_");
+        match BUILTIN_HANDS
+            .iter()
+            .find(|h| h.name == key || h.aliases.contains(&key.as_str()))
+        {
+            Some(h) => h.build(),
+            None => Err(SimError::UnknownHand {
+                name: name.to_string(),
+                valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
+            }),
+        }
     }
 }
 
