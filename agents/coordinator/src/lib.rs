@@ -26,8 +26,9 @@ use serde::{Deserialize, Serialize};
 pub use crate::core::{Action, Coordinator, Write};
 pub use crate::run::{record, run, run_until, split_writes};
 pub use crate::spec::{
-    Conflicts, MAX_TRIALS, RunSpec, check_trials, open_run, param_names, quoted_runs, reconcile,
-    recorded_runs, recorded_spec, resume_conflicts, sole_run, standalone_run, trial_space,
+    Conflicts, MAX_TRIALS, RunSpec, bounds_of, check_trials, open_run, param_names, quoted_runs,
+    range_conflicts, reconcile, recorded_runs, recorded_spec, resume_conflicts, sole_run,
+    standalone_run, trial_space,
 };
 
 /// Coordinator settings.

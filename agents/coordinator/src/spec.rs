@@ -8,7 +8,7 @@ use anyhow::{Context, bail};
 use graspopt_bus::now_ms;
 use graspopt_journal::{Journal, RunLifecycle, RunRecord, TrialState, event_kind};
 use graspopt_protocol::{ObjectEstimate, PlannerMethod, RunId};
-use graspopt_sim::{ParamKind, TrialSpace};
+use graspopt_sim::{Object, ParamKind, ParamSpec, TrialSpace};
 use serde::{Deserialize, Serialize};
 
 use crate::state::{RunState, Trial, TrialPhase};
@@ -34,6 +34,64 @@ pub struct RunSpec {
     /// the coordinator.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settings: Option<serde_json::Value>,
+}
+
+impl RunSpec {
+    /// The recorded bounds as ranges of the parameters (none when the run recorded no
+    /// bounds: the simulator's defaults).
+    pub fn ranges(&self) -> Vec<ParamSpec> {
+        let Some(bounds) = &self.bounds else {
+            return Vec::new();
+        };
+        self.params
+            .iter()
+            .zip(bounds)
+            .map(|(&kind, b)| ParamSpec {
+                kind,
+                lower: b[0],
+                upper: b[1],
+            })
+            .collect()
+    }
+}
+
+/// The bounds of a space's parameters, as a run spec records them.
+pub fn bounds_of(space: &TrialSpace) -> Vec<[f64; 2]> {
+    space.bounds().iter().map(|b| [b.0, b.1]).collect()
+}
+
+/// The ranges given for a run being resumed (`--range`) that contradict its record, each
+/// described as the other flags' are: a range must be the recorded bounds of one of the
+/// run's parameters.
+pub fn range_conflicts(recorded: &RunSpec, ranges: &[ParamSpec]) -> Vec<String> {
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9;
+    let names: Vec<&str> = recorded.params.iter().map(|k| k.name()).collect();
+    let mut out = Vec::new();
+    for r in ranges {
+        let Some(i) = recorded.params.iter().position(|k| *k == r.kind) else {
+            out.push(format!(
+                "--range {r} (the run's parameters are {})",
+                names.join(", ")
+            ));
+            continue;
+        };
+        match recorded.bounds.as_ref().and_then(|b| b.get(i)) {
+            None => out.push(format!(
+                "--range {r} (the run has the simulator's default range of {})",
+                r.kind
+            )),
+            Some(b) if !(same(b[0], r.lower) && same(b[1], r.upper)) => {
+                let had = ParamSpec {
+                    lower: b[0],
+                    upper: b[1],
+                    ..*r
+                };
+                out.push(format!("--range {r} (the run has {had})"));
+            }
+            Some(_) => {}
+        }
+    }
+    out
 }
 
 /// The run's recorded spec in the journal at `path`, if the file and the run exist.
@@ -188,7 +246,7 @@ pub fn trial_space(
         }
         space = TrialSpace::new(space.reference, space.params).context("run spec")?;
     }
-    let bounds = space.bounds().iter().map(|b| [b.0, b.1]).collect();
+    let bounds = bounds_of(&space);
     Ok((space, bounds))
 }
 
@@ -355,15 +413,18 @@ fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<
 /// The run a coordinator started on its own serves (`graspopt agent coordinator`): `run`,
 /// or with `resume` and no run id given explicitly (`explicit("run")`), the only run of the
 /// journal; its spec is `given`, or with `resume` the recorded one reconciled with `given`
-/// (contrary explicit settings refused). A run not recorded yet is started, so that a
-/// supervised coordinator can be restarted with one command line. The journal's folder is
-/// created.
+/// (contrary explicit settings refused, `ranges` among them when `explicit("range")`). A run
+/// not recorded yet is started, so that a supervised coordinator can be restarted with one
+/// command line; it records the bounds of `object`'s space with `ranges` in place unless
+/// `given` has bounds. The journal's folder is created.
 ///
 /// The budget `trials` must be 1 to [`MAX_TRIALS`].
 pub fn standalone_run(
     run: &str,
     config: &crate::CoordinatorConfig,
     given: RunSpec,
+    object: &Object,
+    ranges: &[ParamSpec],
     resume: bool,
     explicit: &dyn Fn(&str) -> bool,
 ) -> anyhow::Result<(RunId, RunSpec)> {
@@ -382,8 +443,27 @@ pub fn standalone_run(
         None
     };
     let spec = match recorded {
-        Some(recorded) => reconcile(&run_id, &recorded, &given, explicit)?,
-        None => given,
+        Some(recorded) => {
+            let mut c = resume_conflicts(&recorded, &given, explicit);
+            if explicit("range") {
+                c.0.extend(range_conflicts(&recorded, ranges));
+            }
+            if let Some(e) = c.into_error(&run_id) {
+                return Err(e);
+            }
+            reconcile(&run_id, &recorded, &given, explicit)?
+        }
+        None => RunSpec {
+            bounds: match given.bounds {
+                Some(b) => Some(b),
+                None => Some(bounds_of(&TrialSpace::with_ranges(
+                    object,
+                    &given.params,
+                    ranges,
+                )?)),
+            },
+            ..given
+        },
     };
     if let Some(dir) = journal.parent()
         && !dir.as_os_str().is_empty()
@@ -516,6 +596,68 @@ mod tests {
         let order: Vec<(f64, f64)> = state.observations().iter().map(|o| (o.x[0], o.y)).collect();
         let recorded = [3, 1, 4, 2].map(|id: u64| (0.01 * id as f64, 0.1 * id as f64));
         assert_eq!(order, recorded);
+    }
+
+    /// A standalone coordinator's new run records its bounds (a range in place of its
+    /// parameter's default); resumed, it keeps them, and a range that contradicts them is
+    /// refused with the recorded one.
+    #[test]
+    fn a_run_records_its_ranges_and_a_contrary_range_is_refused_on_resume() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = crate::CoordinatorConfig {
+            journal: dir.path().join("journal.sqlite"),
+            ..Default::default()
+        };
+        let sphere = Object::by_name("sphere").unwrap();
+        let rz = ParamSpec::parse_range("rz=-3:3").unwrap();
+        let given = RunSpec {
+            params: vec![ParamKind::Approach, ParamKind::RotZ],
+            ..spec(4)
+        };
+        let none = |_: &str| false;
+        let (run, started) =
+            standalone_run("r", &config, given.clone(), &sphere, &[rz], false, &none).unwrap();
+        let approach = TrialSpace::full_6d(&sphere).params[0];
+        assert_eq!(
+            started.bounds,
+            Some(vec![[approach.lower, approach.upper], [-3.0, 3.0]])
+        );
+        assert_eq!(started.ranges()[1], rz);
+        let mut journal = Journal::open(&config.journal).unwrap();
+        open_run(&mut journal, &run, &started, false).unwrap();
+        drop(journal);
+        // Resumed without ranges, or with the recorded one: the record's bounds.
+        let range = |f: &str| f == "range";
+        for ranges in [&[][..], &[rz][..]] {
+            let (_, resumed) =
+                standalone_run("r", &config, given.clone(), &sphere, ranges, true, &range).unwrap();
+            assert_eq!(resumed.bounds, started.bounds);
+        }
+        let other = ParamSpec::parse_range("rz=-2:2").unwrap();
+        let lateral = ParamSpec::parse_range("lateral=-0.1:0.1").unwrap();
+        let e = standalone_run(
+            "r",
+            &config,
+            given,
+            &sphere,
+            &[other, lateral],
+            true,
+            &range,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("--range rz=-2:2 (the run has rz=-3:3)"), "{e}");
+        assert!(
+            e.contains("--range lateral=-0.1:0.1 (the run's parameters are approach, rz)"),
+            "{e}"
+        );
+        // A run recorded before runs recorded their bounds has the simulator's defaults.
+        let old = spec(4);
+        assert_eq!(
+            range_conflicts(&old, &[ParamSpec::parse_range("x=-0.1:0").unwrap()]),
+            ["--range approach=-0.1:0 (the run has the simulator's default range of approach)"]
+        );
+        assert!(old.ranges().is_empty());
     }
 
     /// A trial issued for run `r`, attempt 1.

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::embedded::{Embedded, own_bus};
 
 /// An embedded run's settings. `explicit(name)` in [`RunSettings::resolve`] names them by
-/// these field names (and the [`TrialSettings`] field names).
+/// these field names (and the [`TrialSettings`] field names; `range` for its `ranges`).
 #[derive(Debug, Clone)]
 pub struct RunSettings {
     /// Run id (one key chunk).
@@ -328,7 +328,11 @@ impl RunSettings {
             .validate()
             .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
         Ok(Embedded {
-            spec: self.spec(object, None)?,
+            // The run's ranges are recorded with it (a resumed run keeps them).
+            spec: self.spec(
+                object,
+                Some(graspopt_coordinator::bounds_of(&evaluator.space)),
+            )?,
             workers: self.workers,
             resume: self.resume,
             perception,
@@ -390,6 +394,10 @@ impl RunSettings {
         if let Some(r) = &recorded_settings {
             r.conflicts(&RecordedSettings::of(self), &mut conflicts, explicit);
         }
+        if explicit("range") {
+            let contrary = graspopt_coordinator::range_conflicts(&recorded, &self.trial.ranges);
+            conflicts.0.extend(contrary);
+        }
         if let Some(e) = conflicts.into_error(run) {
             return Err(e);
         }
@@ -402,6 +410,7 @@ impl RunSettings {
             s.trial.hand = spec.hand.clone();
         }
         s.params = spec.params.clone();
+        s.trial.ranges = spec.ranges();
         s.trials = spec.trials;
         s.seed = spec.seed;
         s.method = spec.method;

@@ -194,3 +194,74 @@ fn a_lease_out_of_range_is_refused_by_name() {
         "{msg}"
     );
 }
+
+/// A run's ranges reach its planner and its journal; resumed, the run keeps them (its
+/// evaluator too, which draws the pictures), and a contrary range is refused by name.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_run_records_its_ranges_and_a_resumed_run_keeps_them() {
+    use graspopt_runner::RunSettings;
+    use graspopt_sim::ParamSpec;
+    use graspopt_trial::TrialSettings;
+
+    let dir = tempfile::tempdir().unwrap();
+    let rz = ParamSpec::parse_range("rz=-3:3").unwrap();
+    let first = RunSettings {
+        run: "turns".into(),
+        trial: TrialSettings {
+            object: "cylinder".into(),
+            ranges: vec![rz],
+            ..TrialSettings::default()
+        },
+        params: vec![ParamKind::Approach, ParamKind::RotZ],
+        workers: 1,
+        trials: 4,
+        method: PlannerMethod::Random,
+        seed: 5,
+        out: Some(dir.path().to_path_buf()),
+        ..RunSettings::default()
+    };
+    let e = first.embedded().unwrap();
+    let status = run_embedded(&e, None).await.unwrap();
+    assert_eq!((status.phase, status.completed), (RunPhase::Finished, 4));
+    let journal = graspopt_journal::Journal::open(&e.coordinator.journal).unwrap();
+    let record = journal.run("turns").unwrap().unwrap();
+    let spec: RunSpec = serde_json::from_str(&record.config_json).unwrap();
+    assert_eq!(spec.bounds, Some(vec![[-0.16, 0.02], [-3.0, 3.0]]));
+    // The planner drew rz from the range, beyond the default 45 degrees.
+    let trials = journal.export("turns").unwrap().trials;
+    let turns: Vec<f64> = trials.iter().map(|t| t.params[1]).collect();
+    assert!(turns.iter().all(|r| r.abs() <= 3.0), "{turns:?}");
+    assert!(
+        turns.iter().any(|r| r.abs() > std::f64::consts::FRAC_PI_4),
+        "{turns:?}"
+    );
+    drop(journal);
+
+    let again = RunSettings {
+        trials: 5,
+        resume: true,
+        out: Some(dir.path().to_path_buf()),
+        ..RunSettings::default()
+    };
+    let e = again.resolve(&|name| name == "trials").unwrap();
+    assert_eq!(e.evaluator.space.params[1], rz);
+    assert_eq!(e.spec.bounds, spec.bounds);
+    let contrary = RunSettings {
+        trial: TrialSettings {
+            ranges: vec![ParamSpec::parse_range("rz=-2:2").unwrap()],
+            ..TrialSettings::default()
+        },
+        ..again.clone()
+    };
+    let msg = format!(
+        "{:#}",
+        contrary
+            .resolve(&|name| name == "range")
+            .err()
+            .expect("a contrary range must be refused")
+    );
+    assert!(
+        msg.contains("--range rz=-2:2 (the run has rz=-3:3)"),
+        "{msg}"
+    );
+}

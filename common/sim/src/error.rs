@@ -107,6 +107,14 @@ pub enum SimError {
         "unknown trial parameter {name:?}: expected x (approach), y (vertical), lateral, rx, ry or rz"
     )]
     UnknownParam { name: String },
+    /// A parameter range (`NAME=LOWER:UPPER`) that cannot be used, and why.
+    #[error("range {text:?}: {reason}")]
+    Range {
+        /// The range as written.
+        text: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A collision query that parry does not support for the shapes involved.
     #[error("unsupported collision query between {0}")]
     UnsupportedQuery(String),

@@ -385,3 +385,172 @@ fn a_hand_is_known_by_its_name_whether_given_by_name_alias_or_file() {
     assert!(graspopt_sim::same_hand("claw", "claw"));
     assert!(!graspopt_sim::same_hand("claw", "barrett"));
 }
+
+/// Two jaws written by the test that slide along the palm's `x` (unlike the built-in
+/// gripper's, along `y`): open 0.16 m apart, each 0.08 deep along the approach axis.
+const X_JAWS_URDF: &str = r#"<robot name="x_jaws">
+  <link name="palm"><collision><origin xyz="0 0 -0.01"/><geometry><box size="0.2 0.04 0.02"/></geometry></collision></link>
+  <link name="a"><collision><origin xyz="0 0 0.04"/><geometry><box size="0.01 0.02 0.08"/></geometry></collision></link>
+  <link name="b"><collision><origin xyz="0 0 0.04"/><geometry><box size="0.01 0.02 0.08"/></geometry></collision></link>
+  <joint name="a" type="prismatic"><parent link="palm"/><child link="a"/><origin xyz="-0.085 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.08" effort="1" velocity="1"/></joint>
+  <joint name="b" type="prismatic"><parent link="palm"/><child link="b"/><origin xyz="0.085 0 0"/><axis xyz="-1 0 0"/><limit lower="0" upper="0.08" effort="1" velocity="1"/></joint>
+</robot>"#;
+
+/// Each jaw's mean contact normal (world) on the cylinder, the palm 2 cm into its default
+/// approach range.
+fn jaw_normals(hand: &UrdfHand) -> Vec<nalgebra::Vector3<f64>> {
+    let cylinder = Object::by_name("cylinder").unwrap();
+    let space = TrialSpace::approach_1d(&cylinder);
+    let out = trial(&cylinder, hand, &space.palm_pose(&[0.02]).unwrap());
+    assert_eq!(out.fingers_in_contact(), 2, "{:?}", out.grasp.joints);
+    assert!(!out.palm.touches());
+    out.fingers
+        .iter()
+        .map(|f| f.mean_point.unwrap().normal)
+        .collect()
+}
+
+#[test]
+fn rz_degrees_turns_a_hand_about_its_approach_axis() {
+    // As written, the jaws close along the palm's x, which the reference pose puts vertical:
+    // they pinch the cylinder's end faces.
+    let plain = UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, None, None).unwrap();
+    assert_eq!(plain.rz(), 0.0);
+    for n in jaw_normals(&plain) {
+        assert!(n.z.abs() > 0.9, "{n}");
+    }
+    // Turned by 90 degrees, they close horizontally: on the cylinder's side.
+    let turned =
+        UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, Some("rz_degrees = 90"), None).unwrap();
+    assert!((turned.rz() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    let normals = jaw_normals(&turned);
+    for n in &normals {
+        assert!(n.z.abs() < 1e-6 && n.y.abs() > 0.99, "{n}");
+    }
+    assert!(
+        normals[0].y * normals[1].y < 0.0,
+        "opposite sides: {normals:?}"
+    );
+    // The turn is about the approach axis: the open hand's links keep their distance along it.
+    let (p, t) = (
+        plain.link_poses(&plain.open_configuration()).unwrap(),
+        turned.link_poses(&turned.open_configuration()).unwrap(),
+    );
+    for (a, b) in p.iter().zip(&t) {
+        let (a, b) = (a.translation.vector, b.translation.vector);
+        assert!((a.z - b.z).abs() < 1e-15 && (a.xy().norm() - b.xy().norm()).abs() < 1e-15);
+        assert!(
+            (b.x + a.y).abs() < 1e-15 && (b.y - a.x).abs() < 1e-15,
+            "{a} {b}"
+        );
+    }
+    // Finite and within a turn, or refused by name.
+    for bad in [
+        "rz_degrees = 361",
+        "rz_degrees = -400.5",
+        "rz_degrees = nan",
+        "rz_degrees = inf",
+    ] {
+        let e = UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, Some(bad), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x_jaws.urdf") && e.contains("rz_degrees") && e.contains("-360 to 360"),
+            "{bad}: {e}"
+        );
+    }
+    UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, Some("rz_degrees = -360"), None).unwrap();
+}
+
+#[test]
+fn a_hand_says_along_which_world_axis_it_closes_and_which_joints_are_mimics() {
+    let plain = UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, None, None).unwrap();
+    let axis = plain.closing_axis().unwrap();
+    // Palm x is world -z at the reference pose.
+    assert!((axis.palm.x.abs() - 1.0).abs() < 1e-12, "{axis:?}");
+    assert!((axis.world.z.abs() - 1.0).abs() < 1e-12, "{axis:?}");
+    assert!((axis.share - 1.0).abs() < 1e-12);
+    let text = plain.summary();
+    assert!(text.contains("mimic joints: none"), "{text}");
+    assert!(
+        text.contains(
+            "fingers close along world z (vertical) at the reference pose; rz_degrees = 90 in \
+             the hand's settings would make them close along world y (horizontal)"
+        ),
+        "{text}"
+    );
+    let turned =
+        UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, Some("rz_degrees = 90"), None).unwrap();
+    let text = turned.summary();
+    assert!(
+        text.contains(
+            "fingers close along world y (horizontal) at the reference pose (turned by \
+             rz_degrees = 90); rz_degrees = 0 in the hand's settings would make them close \
+             along world z (vertical)"
+        ),
+        "{text}"
+    );
+    let oblique =
+        UrdfHand::from_strs("x_jaws.urdf", X_JAWS_URDF, Some("rz_degrees = 30"), None).unwrap();
+    assert!(
+        oblique.summary().contains(
+            "a line -60 degrees above world y at the reference pose (turned by rz_degrees = 30); \
+             rz_degrees = 90 in the hand's settings would make it world y (horizontal), 0 world \
+             z (vertical)"
+        ),
+        "{}",
+        oblique.summary()
+    );
+    // Three jaws 120 degrees apart have no single closing axis.
+    let jaw = |name: &str, deg: f64| {
+        let (c, s) = (deg.to_radians().cos(), deg.to_radians().sin());
+        format!(
+            r#"<link name="{name}"><collision><origin xyz="0 0 0.04"/><geometry><box size="0.01 0.01 0.08"/></geometry></collision></link>
+<joint name="{name}" type="prismatic"><parent link="palm"/><child link="{name}"/><origin xyz="{} {} 0"/><axis xyz="{} {} 0"/><limit lower="0" upper="0.05" effort="1" velocity="1"/></joint>"#,
+            0.06 * c,
+            0.06 * s,
+            -c,
+            -s
+        )
+    };
+    let three = format!(
+        r#"<robot name="three"><link name="palm"><collision><geometry><box size="0.1 0.1 0.02"/></geometry></collision></link>{}{}{}</robot>"#,
+        jaw("j1", 90.0),
+        jaw("j2", 210.0),
+        jaw("j3", 330.0)
+    );
+    let three = UrdfHand::from_strs("three.urdf", &three, None, None).unwrap();
+    assert!((three.closing_axis().unwrap().share - 0.5).abs() < 1e-9);
+    let text = three.summary();
+    assert!(
+        text.contains("closing: fingers close from several directions across the approach axis (no single axis; 50% of"),
+        "{text}"
+    );
+    // The Barrett's F3 faces F1 and F2 across the palm's y: horizontal; its mimic joints.
+    let text = bh8().summary();
+    assert!(text.contains("along world y (horizontal)"), "{text}");
+    assert!(
+        text.contains(
+            "f1_distal        follows f1_medial as 0.3333 * f1_medial + 0.8727 rad, breaks away"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains("f2_spread        follows spread as 1 * spread + 0 rad\n"),
+        "{text}"
+    );
+    assert_eq!(bh8().mimic_joints().len(), 4);
+    let franka = UrdfHand::from_strs("f.urdf", FRANKA_URDF, Some(FRANKA_TOML), None).unwrap();
+    let m = franka.mimic_joints();
+    assert_eq!(m.len(), 1);
+    assert_eq!(
+        (
+            m[0].joint.as_str(),
+            m[0].follows.as_str(),
+            m[0].multiplier,
+            m[0].offset,
+            m[0].unit
+        ),
+        ("finger_joint2", "finger_joint1", 1.0, 0.0, "m")
+    );
+}

@@ -2,6 +2,7 @@
 //! [`ParamKind::parse`] reads them; metres, radians for rx, ry, rz), checked against a
 //! trial space with messages that keep numbers short.
 
+use graspopt_sim::pose::short as compact_bound;
 use graspopt_sim::{ParamKind, TrialSpace};
 
 use crate::error::TrialError;
@@ -49,7 +50,8 @@ impl NamedPoint {
     }
 
     /// Checks every value against `space`'s bounds (the simulator's own slack, so exact
-    /// bounds pass); `object` names the object in the message.
+    /// bounds pass); `object` names the object in the message, which also says how to set
+    /// other bounds.
     pub fn check_within(&self, space: &TrialSpace, object: &str) -> Result<(), TrialError> {
         for (((name, kind), value), (lo, hi)) in self
             .names
@@ -59,16 +61,18 @@ impl NamedPoint {
             .zip(space.bounds())
         {
             if *value < lo - 1e-9 || *value > hi + 1e-9 {
-                let unit = match kind {
-                    ParamKind::RotX | ParamKind::RotY | ParamKind::RotZ => "rad",
-                    _ => "m",
-                };
+                let (min, max) = kind.limits();
                 return Err(bad(format!(
-                    "{} = {} is outside [{}, {}] {unit} for the {object}",
+                    "{} = {} is outside [{}, {}] {} for the {object} (--range {}=LO:HI sets \
+                     other bounds, within {}:{})",
                     described(name, *kind),
                     compact(*value),
                     compact_bound(lo),
                     compact_bound(hi),
+                    kind.unit(),
+                    kind.name(),
+                    compact_bound(min),
+                    compact_bound(max),
                 )));
             }
         }
@@ -81,17 +85,6 @@ fn compact(v: f64) -> String {
     let plain = format!("{v}");
     if plain.len() <= 12 {
         plain
-    } else {
-        format!("{v:.4e}")
-    }
-}
-
-/// A bound for a message: at most 4 decimals (`-0.7854`), or `1.0000e-6` when tiny or huge.
-fn compact_bound(v: f64) -> String {
-    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" { "0".into() } else { s.into() }
     } else {
         format!("{v:.4e}")
     }
@@ -155,7 +148,8 @@ mod tests {
             .unwrap_err()
             .to_string();
         let expected = format!(
-            "roll (rx) = {} is outside [{}, {}] rad for the sphere",
+            "roll (rx) = {} is outside [{}, {}] rad for the sphere (--range rx=LO:HI sets other \
+             bounds, within -1.5708:1.5708)",
             compact(lo - 1.0),
             compact_bound(lo),
             compact_bound(hi)

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use graspopt_sim::hand::hand_by_name;
-use graspopt_sim::{ContactModel, Object, ParamKind, TrialSpace};
+use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec, TrialSpace};
 use serde::{Deserialize, Serialize};
 
 use crate::error::TrialError;
@@ -28,6 +28,10 @@ pub struct TrialSettings {
     pub frame: ReferenceFrame,
     /// Torque scale in metres (None: the object's bounding radius).
     pub torque_scale: Option<f64>,
+    /// Bounds that replace the object's defaults for these parameters (each one of the
+    /// trial's parameters; see [`TrialSpace::with_ranges`]).
+    #[serde(default)]
+    pub ranges: Vec<ParamSpec>,
 }
 
 impl Default for TrialSettings {
@@ -43,6 +47,7 @@ impl Default for TrialSettings {
             metric: score.metric,
             frame: score.frame,
             torque_scale: None,
+            ranges: Vec::new(),
         }
     }
 }
@@ -63,14 +68,14 @@ impl TrialSettings {
 }
 
 impl Evaluator {
-    /// The evaluator of `settings` over the parameters `kinds` (each with its full default
-    /// bounds, in that order).
+    /// The evaluator of `settings` over the parameters `kinds` (in that order, each with its
+    /// default bounds or its range in `settings.ranges`).
     pub fn from_settings(
         settings: &TrialSettings,
         kinds: &[ParamKind],
     ) -> Result<Self, TrialError> {
         let object = settings.object()?;
-        let space = TrialSpace::with_params(&object, kinds)?;
+        let space = TrialSpace::with_ranges(&object, kinds, &settings.ranges)?;
         let hand = hand_by_name(&settings.hand)?;
         let mut ev = Evaluator::new(object, hand, space);
         ev.score.contacts = settings.contacts;

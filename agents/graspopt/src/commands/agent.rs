@@ -246,8 +246,9 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 c.journal = v.clone();
             }
             c.lease_ms = lease_ms.unwrap_or(c.lease_ms);
+            let object = sim.object()?;
             let given = RunSpec {
-                object: sim.object()?.name().to_string(),
+                object: object.name().to_string(),
                 hand: graspopt_sim::hand_name(&sim.hand).with_context(|| {
                     format!(
                         "--hand {}: the coordinator knows a hand by its name; where its file \
@@ -263,8 +264,15 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 initial: *initial,
                 settings: None,
             };
-            let (run_id, spec) =
-                graspopt_coordinator::standalone_run(&common.run, &c, given, *resume, explicit)?;
+            let (run_id, spec) = graspopt_coordinator::standalone_run(
+                &common.run,
+                &c,
+                given,
+                &object,
+                &sim.range,
+                *resume,
+                explicit,
+            )?;
             let bus = Bus::open(&common.bus).await?;
             let status = graspopt_coordinator::run_until(
                 &bus,

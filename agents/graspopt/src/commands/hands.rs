@@ -1,9 +1,9 @@
 //! `graspopt hands`: the built-in hands (name, fingers, joints, source file), or one hand's
-//! joints and links (`graspopt hands NAME|FILE.urdf`).
+//! joints, links, mimic joints and closing axis (`graspopt hands NAME|FILE.urdf`).
 
 use anyhow::Result;
 use clap::Args;
-use graspopt_sim::{Hand, builtin_hands, hand_by_name};
+use graspopt_sim::{Hand, UrdfHand, builtin_hands};
 
 #[derive(Args, Debug)]
 pub struct HandsArgs {
@@ -16,8 +16,8 @@ pub fn run(args: &HandsArgs) -> Result<std::process::ExitCode> {
         None => crate::out::print(format_args!("{}", table()?))?,
         Some(name) => {
             // Its errors name the hand (the file, or the unknown name).
-            let hand = hand_by_name(name)?;
-            crate::out::print(format_args!("{}", describe(hand.as_ref())))?;
+            let hand = UrdfHand::by_name(name)?;
+            crate::out::print(format_args!("{}{}", describe(&hand), hand.summary()))?;
         }
     }
     Ok(std::process::ExitCode::SUCCESS)

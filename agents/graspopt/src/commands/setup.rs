@@ -1,6 +1,7 @@
-//! The flags every simulated-trial command shares (`trial`, `scan`, `run`): which
-//! object, hand, contact model, metric and reference frame, and the value parsers of the flags
-//! that name a library type (`--contacts`, `--metric`, `--frame`, `--params`, `--method`).
+//! The flags every simulated-trial command shares (`trial`, `scan`, `record`, `run`, `agent
+//! coordinator`): which object, hand, contact model, metric, reference frame and parameter
+//! ranges, and the value parsers of the flags that name a library type (`--contacts`,
+//! `--metric`, `--frame`, `--params`, `--range`, `--method`).
 
 use std::path::PathBuf;
 
@@ -8,7 +9,7 @@ use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use graspopt_protocol::PlannerMethod;
-use graspopt_sim::{ContactModel, Object, ParamKind};
+use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
@@ -38,6 +39,14 @@ pub struct SimArgs {
     /// Torque scale in metres (default: the object's bounding radius).
     #[arg(long)]
     pub torque_scale: Option<f64>,
+    #[arg(long, value_name = "NAME=LO:HI", value_delimiter = ',', value_parser = param_range())]
+    #[arg(help = graspopt_sim::pose::ranges_help())]
+    pub range: Vec<ParamSpec>,
+}
+
+/// `--range`: `NAME=LO:HI` ([`ParamSpec::parse_range`]).
+fn param_range() -> impl TypedValueParser<Value = ParamSpec> {
+    clap::builder::NonEmptyStringValueParser::new().try_map(|s| ParamSpec::parse_range(&s))
 }
 
 /// `--contacts`: the simulator's contact models by name.
@@ -91,6 +100,7 @@ impl SimArgs {
             metric: self.metric,
             frame: self.frame,
             torque_scale: self.torque_scale,
+            ranges: self.range.clone(),
         }
     }
 
@@ -99,7 +109,8 @@ impl SimArgs {
         Ok(self.settings().object()?)
     }
 
-    /// An evaluator over the trial space with the given parameters (full default bounds).
+    /// An evaluator over the trial space with the given parameters (default bounds, or
+    /// `--range`).
     pub fn evaluator(&self, kinds: &[ParamKind]) -> Result<Evaluator> {
         Ok(Evaluator::from_settings(&self.settings(), kinds)?)
     }

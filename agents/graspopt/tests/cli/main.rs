@@ -8,6 +8,7 @@ mod doc_facts;
 mod forces_cli;
 mod pipe_cli;
 mod quality_cli;
+mod ranges_cli;
 mod render_cli;
 mod run_pictures_cli;
 mod scene_cli;

@@ -304,18 +304,23 @@ pub fn builtin_hand(name: &str) -> Option<&'static BuiltinHand> {
 /// A built-in hand by name (see [`builtin_hand`]), or a hand read from a URDF file (a name
 /// ending in `.urdf`, see [`urdf`]).
 pub fn hand_by_name(name: &str) -> Result<Box<dyn Hand>> {
-    let trimmed = name.trim();
-    if is_urdf_file(trimmed) {
-        return Ok(Box::new(UrdfHand::from_file(std::path::Path::new(
-            trimmed,
-        ))?));
-    }
-    match builtin_hand(trimmed) {
-        Some(h) => Ok(Box::new(h.build()?)),
-        None => Err(SimError::UnknownHand {
-            name: name.to_string(),
-            valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
-        }),
+    Ok(Box::new(UrdfHand::by_name(name)?))
+}
+
+impl UrdfHand {
+    /// The hand [`hand_by_name`] gives, as the [`UrdfHand`] it is.
+    pub fn by_name(name: &str) -> Result<UrdfHand> {
+        let trimmed = name.trim();
+        if is_urdf_file(trimmed) {
+            return UrdfHand::from_file(std::path::Path::new(trimmed));
+        }
+        match builtin_hand(trimmed) {
+            Some(h) => h.build(),
+            None => Err(SimError::UnknownHand {
+                name: name.to_string(),
+                valid: format!("{}, or a FILE.urdf", hand_names().join(", ")),
+            }),
+        }
     }
 }
 

@@ -7,12 +7,17 @@ use super::*;
 pub struct UrdfHand {
     name: String,
     file: String,
-    links: Vec<LinkSpec>,
+    pub(super) links: Vec<LinkSpec>,
     bodies: Vec<Body>,
-    joints: Vec<JointModel>,
-    dofs: Vec<Dof>,
+    pub(super) joints: Vec<JointModel>,
+    pub(super) dofs: Vec<Dof>,
     link_count: usize,
-    finger_count: usize,
+    pub(super) finger_count: usize,
+    /// The root link's frame in the palm frame: turned by `rz_degrees` about the approach axis
+    /// (`None` when not turned, so that the hand's poses are exactly the URDF's).
+    mount: Option<Isometry3<f64>>,
+    /// The turn of `mount` (radians).
+    pub(super) rz: f64,
     geometry: LinkGeometry,
     /// `levers[d][b]`: bound on how far a point of body `b` moves per unit of dof `d` (when the
     /// dof moves the body).
@@ -63,6 +68,13 @@ impl UrdfHand {
             dofs: desc.dofs,
             link_count: desc.link_names.len(),
             finger_count: desc.finger_count,
+            mount: (desc.rz != 0.0).then(|| {
+                Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), desc.rz),
+                )
+            }),
+            rz: desc.rz,
             geometry,
             levers: Vec::new(),
         };
@@ -150,13 +162,21 @@ impl UrdfHand {
         frames
     }
 
-    /// Body frames in the palm frame for the joint values `q`.
-    fn body_poses(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+    /// Body frames in the palm frame for the joint values `q` (turned by `rz_degrees`).
+    pub(super) fn body_poses(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
         let frames = self.link_frames(q);
         self.bodies
             .iter()
-            .map(|b| frames[b.link] * b.origin)
+            .map(|b| match &self.mount {
+                Some(m) => m * frames[b.link] * b.origin,
+                None => frames[b.link] * b.origin,
+            })
             .collect()
+    }
+
+    /// The palm's turn about its approach axis (radians; the settings' `rz_degrees`).
+    pub fn rz(&self) -> f64 {
+        self.rz
     }
 
     /// For each dof and body: a bound on how far any point of the body moves per unit of the

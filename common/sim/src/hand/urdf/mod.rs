@@ -35,6 +35,7 @@
 //! [`UrdfHand::from_file`] when it exists; the URDF alone must and does work):
 //! ```toml
 //! name = "barrett"              # the hand's name (default: the URDF robot's name)
+//! rz_degrees = 90               # the palm turned about its approach axis (default 0)
 //! fingers = [["f1_medial", "f1_distal"], ["f2_medial", "f2_distal"]]  # links per finger
 //!
 //! [joints.spread]
@@ -51,6 +52,12 @@
 //! ```
 //! With `fingers`, links listed nowhere belong to the palm. Unknown keys, joints or links are
 //! errors.
+//!
+//! `rz_degrees` turns the hand about its approach axis (the root link's `z`): the root link's
+//! frame is the palm frame turned by this angle (degrees, finite, within a turn: -360 to 360),
+//! so the hand sits as if the trial parameter `rz` were always that much larger. At the
+//! reference pose ([`crate::pose::reference_pose`]) the root link's `-x` is world up with 0,
+//! and its `+y` with 90: fingers that close along the root link's `x` then close horizontally.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -66,7 +73,9 @@ use crate::mesh::{self, TriangleMesh};
 use crate::object::Object;
 
 mod hand;
+mod summary;
 pub use hand::UrdfHand;
+pub use summary::{ClosingAxis, MimicJoint};
 
 /// Per-hand settings that URDF cannot say (the TOML file beside the URDF).
 #[derive(Clone, Debug, Default, PartialEq, serde::Deserialize)]
@@ -74,6 +83,8 @@ pub use hand::UrdfHand;
 pub struct HandSettings {
     /// The hand's name (default: the URDF robot's name).
     pub name: Option<String>,
+    /// The palm turned about its approach axis, degrees (default 0; see the module doc).
+    pub rz_degrees: Option<f64>,
     /// Links of each finger, in finger order (default: see the module doc).
     pub fingers: Option<Vec<Vec<String>>>,
     /// Settings per joint name.
@@ -107,10 +118,28 @@ pub enum CloseTowards {
     Lower,
 }
 
+/// The largest `rz_degrees` either way: a full turn.
+pub const MAX_RZ_DEGREES: f64 = 360.0;
+
 impl HandSettings {
     /// Parses the TOML text of a settings file; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self> {
         toml::from_str(text).map_err(|e| bad(file, format!("settings: {e}")))
+    }
+
+    /// The palm's turn about its approach axis in radians (`rz_degrees`, checked: finite and
+    /// within a turn either way).
+    fn rz(&self, file: &str) -> Result<f64> {
+        let degrees = self.rz_degrees.unwrap_or(0.0);
+        if !(degrees.is_finite() && degrees.abs() <= MAX_RZ_DEGREES) {
+            return Err(bad(
+                file,
+                format!(
+                    "settings: rz_degrees = {degrees} must be a finite angle within a turn (-{MAX_RZ_DEGREES} to {MAX_RZ_DEGREES} degrees)"
+                ),
+            ));
+        }
+        Ok(degrees.to_radians())
     }
 }
 
@@ -189,6 +218,8 @@ pub struct HandDescription {
     dofs: Vec<Dof>,
     bodies: Vec<(Body, String, Option<usize>, RawShape)>,
     finger_count: usize,
+    /// The palm's turn about its approach axis (radians; `rz_degrees`).
+    rz: f64,
 }
 
 fn pose_of(p: &urdf_rs::Pose) -> Isometry3<f64> {
@@ -217,6 +248,7 @@ impl HandDescription {
         let robot = urdf_rs::read_from_string(urdf).map_err(|e| bad(file, urdf_error(&e)))?;
         let default_settings = HandSettings::default();
         let settings = settings.unwrap_or(&default_settings);
+        let rz = settings.rz(file)?;
         let link_names: Vec<String> = robot.links.iter().map(|l| l.name.clone()).collect();
         let link_index = |name: &str, joint: &str| -> Result<usize> {
             link_names.iter().position(|l| l == name).ok_or_else(|| {
@@ -631,6 +663,7 @@ impl HandDescription {
             dofs,
             bodies,
             finger_count,
+            rz,
         })
     }
 
