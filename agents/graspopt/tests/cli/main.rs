@@ -3,6 +3,8 @@
 //! A new file here needs a `mod` line below.
 
 mod cli_bad_input;
+mod docs_figures_cli;
+mod experiment_report_cli;
 mod forces_cli;
 mod pipe_cli;
 mod quality_cli;
