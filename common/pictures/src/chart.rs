@@ -1,7 +1,8 @@
 //! SVG charts of scans, runs and experiments, drawn with `plotters` and its SVG backend: a
-//! line plot, several lines with bands, the model of a 1D run, heatmaps with samples, a
-//! run's progress and its trials on the parameter space, and the colour map they share with
-//! the PNG pictures of [`crate::preview`].
+//! line plot, several lines with bands, scans along one axis (misses as grey ticks off the
+//! scale), the model of a 1D run, heatmaps with samples and a labelled colour bar, a run's
+//! progress and its trials on the parameter space, and the colour map they share with the
+//! PNG pictures of [`crate::preview`]. An axis of trial counts reads in whole numbers.
 //!
 //! plotters is built without default features, with `svg_backend` only: plotters,
 //! plotters-backend and plotters-svg, pure Rust, no font library. Text is laid out with
@@ -36,8 +37,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 const W: u32 = 640;
 const H: u32 = 420;
 const MODEL_H: u32 = 560;
-/// Width of the colour bar beside a map, its scale labels included.
-const BAR_W: u32 = 90;
+/// Width of the colour bar beside a map, its values and its label included.
+const BAR_W: u32 = 110;
 const FONT: &str = "sans-serif";
 /// The note written in a chart with nothing to draw.
 pub const NO_DATA: &str = "no finite values to draw";
@@ -77,7 +78,7 @@ const LIMIT: f64 = 1e100;
 /// `(lo, hi)` of the finite values (held within [`LIMIT`]), widened by half a unit, or a
 /// hundredth of their magnitude if more, on each side when they are all equal (or too close
 /// for the axis to be divided); `(0, 1)` when there are none.
-fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+pub(crate) fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
         .map(|v| v.clamp(-LIMIT, LIMIT))
@@ -98,7 +99,7 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// An axis tick label: three decimals, or three significant digits for very small or large
 /// numbers.
-fn tick(v: &f64) -> String {
+pub(crate) fn tick(v: &f64) -> String {
     let a = v.abs();
     if a != 0.0 && !(1e-2..1e5).contains(&a) {
         format!("{v:.2e}")
@@ -109,13 +110,33 @@ fn tick(v: &f64) -> String {
 
 /// `v` on an axis spanning `r`, with the rounding error of a tick at zero (say -2.8e-17,
 /// from `-0.15 + 3 * 0.05`) set to zero.
-fn snap(v: f64, r: (f64, f64)) -> f64 {
+pub(crate) fn snap(v: f64, r: (f64, f64)) -> f64 {
     if v.abs() < 1e-9 * (r.1 - r.0) { 0.0 } else { v }
 }
 
-/// An axis tick label for counts (trials).
-fn whole(v: &f64) -> String {
-    format!("{v:.0}")
+/// An axis tick label for counts (trials): a whole number as one (`5`, not `5.000`); a tick
+/// between two (on a short axis) with the decimals it needs, up to two; a huge one as [`tick`].
+fn count(v: &f64) -> String {
+    let r = v.round();
+    if r.abs() >= 1e15 || !v.is_finite() {
+        tick(v)
+    } else if (v - r).abs() <= 1e-9 * r.abs().max(1.0) {
+        // `+ 0.0` turns -0 into 0.
+        format!("{:.0}", r + 0.0)
+    } else {
+        let decimals = format!("{v:.2}");
+        decimals
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    }
+}
+
+/// Whether `xs` are counts: at least two finite values, every one a whole number of at most
+/// a million (trial numbers), so the axis is labelled by [`count`].
+fn is_count_axis(xs: &[f64]) -> bool {
+    let finite: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
+    finite.len() >= 2 && finite.iter().all(|x| x.fract() == 0.0 && x.abs() <= 1e6)
 }
 
 /// The axes' ranges of a chart, to hold what is drawn near them: a point far outside would
@@ -313,6 +334,39 @@ pub fn lines_plot(
     bands_plot(title, xlabel, ylabel, xs, series, &[], None)
 }
 
+/// The legend's words for the grey ticks of grasps that touched nothing.
+pub const MISS_TICK_LABEL: &str = "grey tick: no contact (below the scale)";
+
+/// Scans along one axis: named series of scores against the same `xs`, `None` where the hand
+/// touched nothing. A miss's score is far below every grasp's, so misses are grey ticks on the
+/// bottom edge (one per point where a series missed) and never set the scale, which spans the
+/// grasps' scores; the line of a series is broken at its misses.
+pub fn scan_plot(
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    xs: &[f64],
+    series: &[(&str, Vec<Option<f64>>)],
+) -> String {
+    let lines: Vec<(&str, Vec<f64>)> = series
+        .iter()
+        .map(|(name, ys)| (*name, ys.iter().map(|y| y.unwrap_or(f64::NAN)).collect()))
+        .collect();
+    let misses: Vec<f64> = xs
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| series.iter().any(|(_, ys)| ys.get(k) == Some(&None)))
+        .map(|(_, &x)| x)
+        .collect();
+    let chart = Lines {
+        series: &lines,
+        bands: &[],
+        reference: None,
+        misses: &misses,
+    };
+    lines_chart(title, (xlabel, ylabel), xs, &chart)
+}
+
 /// The polygons of a band between `low` and `high` over `xs`: one per run of points where
 /// all three are finite, held near the axes by `fit`.
 fn band_polygons(xs: &[f64], low: &[f64], high: &[f64], fit: Fit) -> Vec<Vec<(f64, f64)>> {
@@ -343,6 +397,7 @@ fn dashed(
 
 /// [`lines_plot`] with a shaded band `(low, high)` behind series `k` for each `bands[k]`
 /// (empty bands are skipped) and an optional dashed horizontal reference line with a label.
+/// When every `x` is a whole number (trial counts) the x axis is labelled in whole numbers.
 pub fn bands_plot(
     title: &str,
     xlabel: &str,
@@ -352,6 +407,35 @@ pub fn bands_plot(
     bands: &[(Vec<f64>, Vec<f64>)],
     reference: Option<(f64, &str)>,
 ) -> String {
+    let chart = Lines {
+        series,
+        bands,
+        reference,
+        misses: &[],
+    };
+    lines_chart(title, (xlabel, ylabel), xs, &chart)
+}
+
+/// What a chart of lines against the same `xs` draws.
+struct Lines<'a> {
+    /// Named series (a NaN breaks the line).
+    series: &'a [(&'a str, Vec<f64>)],
+    /// A band behind series `k` for each `bands[k]`.
+    bands: &'a [(Vec<f64>, Vec<f64>)],
+    /// A dashed horizontal line and its label.
+    reference: Option<(f64, &'a str)>,
+    /// Where a grasp touched nothing: grey ticks on the bottom edge.
+    misses: &'a [f64],
+}
+
+/// Draws [`Lines`] against `xs`.
+fn lines_chart(title: &str, (xlabel, ylabel): (&str, &str), xs: &[f64], c: &Lines) -> String {
+    let Lines {
+        series,
+        bands,
+        reference,
+        misses,
+    } = *c;
     render((W, H), title, |area| {
         let reference = reference.filter(|r| r.0.is_finite());
         let mut entries: Vec<(Mark, &str)> = reference
@@ -363,6 +447,9 @@ pub fn bands_plot(
                 entries.push((Mark::Line(PALETTE[k % PALETTE.len()], 2), name));
             }
         }
+        if !misses.is_empty() {
+            entries.push((Mark::Square(GREY), MISS_TICK_LABEL));
+        }
         let area = legend(area, &entries)?;
         let xr = range(xs.iter().copied());
         let yr = range(
@@ -372,7 +459,8 @@ pub fn bands_plot(
                 .chain(bands.iter().flat_map(|(l, h)| l.iter().chain(h).copied()))
                 .chain(reference.map(|r| r.0)),
         );
-        let mut chart = axes(&area, xr, yr, (xlabel, ylabel), tick)?;
+        let fmt = if is_count_axis(xs) { count } else { tick };
+        let mut chart = axes(&area, xr, yr, (xlabel, ylabel), fmt)?;
         let fit = Fit { x: xr, y: yr };
         for (k, (low, high)) in bands.iter().enumerate() {
             let colour = PALETTE[k % PALETTE.len()];
@@ -401,6 +489,8 @@ pub fn bands_plot(
                     .map(|r| PathElement::new(r, colour.stroke_width(2))),
             )?;
         }
+        let ticks: Vec<_> = misses.iter().map(|&x| miss_tick(&chart, x)).collect();
+        chart.draw_series(ticks)?;
         if drawn == 0 {
             no_data(&chart)?;
         }
@@ -569,164 +659,12 @@ fn hit_range(scores: impl Iterator<Item = Option<f64>>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// A run's progress: each trial's score (dots) and the best score so far (a line), against
-/// the trials in the order they completed. `scores[k]` is `None` for a trial that touched
-/// nothing: its score is far below every grasp's, so it is drawn as a grey tick on the
-/// bottom edge and never sets the scale, which spans the scores of the grasps.
-pub fn progress_plot(title: &str, scores: &[Option<f64>]) -> String {
-    render((W, H), title, |area| {
-        let area = legend(
-            area,
-            &[
-                (Mark::Line(BEST_COLOUR, 2), "best so far"),
-                (Mark::Faint(BEST_COLOUR), "a trial's score"),
-                (
-                    Mark::Square(GREY),
-                    "grey tick: no contact (below the scale)",
-                ),
-            ],
-        )?;
-        let scores: Vec<Option<f64>> = scores.iter().map(|s| s.filter(|v| v.is_finite())).collect();
-        let n = scores.len().max(1) as f64;
-        let xr = (1.0, n.max(2.0));
-        let yr = hit_range(scores.iter().copied());
-        let names = ("trial (in the order completed)", "score");
-        let mut chart = axes(&area, xr, yr, names, whole)?;
-        let fit = Fit { x: xr, y: yr };
-        let trial = |k: usize| k as f64 + 1.0;
-        let mut best: Option<f64> = None;
-        let best_line: Vec<(f64, f64)> = scores
-            .iter()
-            .enumerate()
-            .filter_map(|(k, s)| {
-                if let Some(v) = *s {
-                    best = Some(best.map_or(v, |b| b.max(v)));
-                }
-                best.map(|b| fit.at((trial(k), b)))
-            })
-            .collect();
-        let ticks: Vec<_> = (0..scores.len())
-            .filter(|&k| scores[k].is_none())
-            .map(|k| miss_tick(&chart, trial(k)))
-            .collect();
-        chart.draw_series(ticks)?;
-        chart.draw_series(
-            (0..scores.len())
-                .filter_map(|k| Some((trial(k), scores[k]?)))
-                .map(|at| Circle::new(fit.at(at), 3, BEST_COLOUR.mix(0.45).filled())),
-        )?;
-        if best_line.is_empty() {
-            no_data(&chart)?;
-        } else {
-            chart.draw_series([PathElement::new(best_line, BEST_COLOUR.stroke_width(2))])?;
-        }
-        Ok(())
-    })
-}
-
-/// The trials of a run on its parameter space: one dot per trial at its first two
-/// parameters (`bounds` the axes' ranges), coloured by score on the scale of the grasps
-/// that touched something, grey where it touched nothing (`None`), the best ringed in red;
-/// with one parameter, the score against it instead (misses as grey ticks on the bottom edge).
-pub fn trials_map(
-    title: &str,
-    labels: &[&str],
-    bounds: &[(f64, f64)],
-    trials: &[(Vec<f64>, Option<f64>)],
-) -> String {
-    let finite = |v: Option<&f64>| v.copied().filter(|v| v.is_finite());
-    // (parameter 1, parameter 2 if any, score if a grasp) of the trials that can be drawn.
-    let points: Vec<(f64, Option<f64>, Option<f64>)> = trials
-        .iter()
-        .filter_map(|(p, s)| Some((finite(p.first())?, finite(p.get(1)), finite(s.as_ref()))))
-        .collect();
-    let zr = hit_range(points.iter().map(|t| t.2));
-    let best = points
-        .iter()
-        .filter_map(|&(x, y, s)| Some((x, y, s?)))
-        .max_by(|a, b| a.2.total_cmp(&b.2));
-    let bound = |k: usize| range(bounds.get(k).map_or([0.0, 1.0], |b| [b.0, b.1]).into_iter());
-    let label = |k: usize, default: &'static str| labels.get(k).copied().unwrap_or(default);
-    if bounds.len() < 2 {
-        return render((W, H), title, |area| {
-            let area = legend(
-                area,
-                &[
-                    (Mark::Dot(BEST_COLOUR), "a trial"),
-                    (Mark::Ring(RED), "the best"),
-                    (
-                        Mark::Square(GREY),
-                        "grey tick: no contact (below the scale)",
-                    ),
-                ],
-            )?;
-            let names = (label(0, "parameter"), "score");
-            let mut chart = axes(&area, bound(0), zr, names, tick)?;
-            let fit = Fit { x: bound(0), y: zr };
-            let ticks: Vec<_> = points
-                .iter()
-                .filter(|t| t.2.is_none())
-                .map(|t| miss_tick(&chart, t.0))
-                .collect();
-            chart.draw_series(ticks)?;
-            chart.draw_series(
-                points
-                    .iter()
-                    .filter_map(|&(x, _, s)| Some(dot(fit.at((x, s?)), BEST_COLOUR))),
-            )?;
-            if let Some((x, _, s)) = best {
-                chart.draw_series([best_ring(fit.at((x, s)))])?;
-            }
-            if points.is_empty() {
-                no_data(&chart)?;
-            }
-            Ok(())
-        });
-    }
-    render((W, H), title, |area| {
-        let area = legend(
-            area,
-            &[
-                (Mark::Dot(RGBColor(170, 220, 60)), "a trial, by score"),
-                (Mark::Ring(RED), "the best"),
-                (Mark::Square(GREY), MISSING_LABEL),
-            ],
-        )?;
-        let main = with_colour_bar(&area, zr)?;
-        let names = (label(0, "parameter 1"), label(1, "parameter 2"));
-        let mut chart = axes(&main, bound(0), bound(1), names, tick)?;
-        let fit = Fit {
-            x: bound(0),
-            y: bound(1),
-        };
-        // Misses first, then the grasps from the lowest score up, so the best show on top.
-        let mut order: Vec<(f64, f64, Option<f64>)> = points
-            .iter()
-            .filter_map(|&(x, y, s)| Some((x, y?, s)))
-            .collect();
-        order.sort_by(|a, b| {
-            let key = |s: Option<f64>| s.unwrap_or(f64::NEG_INFINITY);
-            key(a.2).total_cmp(&key(b.2))
-        });
-        chart.draw_series(
-            order
-                .iter()
-                .map(|&(x, y, s)| dot(fit.at((x, y)), colour_of(s.unwrap_or(f64::NAN), zr))),
-        )?;
-        if let Some((x, Some(y), _)) = best {
-            chart.draw_series([best_ring(fit.at((x, y)))])?;
-        }
-        if order.is_empty() {
-            no_data(&chart)?;
-        }
-        Ok(())
-    })
-}
-
 mod map;
+mod run;
 
 pub use map::{colour, heatmap, samples_map};
 use map::{colour_of, with_colour_bar};
+pub use run::{progress_plot, trials_map};
 
 #[cfg(test)]
 mod tests;

@@ -1,6 +1,7 @@
-//! Raster pictures (PNG) of grasp scenes and scan maps: a small software rasteriser (filled
-//! triangles, z-buffer, Lambert shading from a fixed light, orthographic views), written with
-//! the pure-Rust `png` crate. Titles and labels use the 8 x 8 bitmap font of `font8x8` (ASCII),
+//! Raster pictures (PNG) of grasp scenes and scans: a small software rasteriser (filled
+//! triangles, z-buffer, Lambert shading from a fixed light, orthographic views), and figures
+//! of 1D and 2D scans with axes ([`heatmap_figure`], [`line_figure`]), written with the
+//! pure-Rust `png` crate. Titles and labels use the 8 x 8 bitmap font of `font8x8` (ASCII),
 //! so no font files are needed.
 
 use std::fs::File;
@@ -12,6 +13,10 @@ use graspopt_sim::{ContactPoint, TriangleMesh};
 use nalgebra::{Point3, Vector3};
 
 use crate::chart::colour;
+
+mod figure;
+
+pub use figure::{Axis, HeatmapFigure, LINE_COLOUR, LineFigure, heatmap_figure, line_figure};
 
 /// Background of scene pictures.
 pub const BACKGROUND: [u8; 3] = [255, 255, 255];
@@ -477,63 +482,6 @@ pub fn heatmap_png(z: &[Vec<f64>], cell: u32) -> Image {
         for x in bx..w {
             img.set(i64::from(x), i64::from(y), c);
         }
-    }
-    img
-}
-
-/// [`heatmap_png`] as a figure: `title` above the map and a legend below it, the colour
-/// bar's range and, when some cell is not finite, a grey square with `missing` (what grey
-/// means). The figure is at least as wide as its text.
-pub fn heatmap_figure(z: &[Vec<f64>], cell: u32, title: &str, missing: &str) -> Image {
-    const MARGIN: u32 = 8;
-    const LINE: u32 = 14;
-    let map = heatmap_png(z, cell);
-    let finite = z.iter().flatten().copied().filter(|v| v.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-        (lo.min(v), hi.max(v))
-    });
-    let bar = if lo <= hi {
-        format!("colour bar: {lo:.3} (bottom) to {hi:.3} (top)")
-    } else {
-        "no finite value".to_string()
-    };
-    let any_missing = z.iter().flatten().any(|v| !v.is_finite());
-    // The grey legend's text starts after a square and a space.
-    let swatch = 12;
-    let text_w = text_width(&bar, 1).max(if any_missing {
-        swatch + text_width(missing, 1)
-    } else {
-        0
-    });
-    let title_scale = if text_width(title, 2) <= map.width.max(text_w) {
-        2
-    } else {
-        1
-    };
-    let inner = map.width.max(text_w).max(text_width(title, title_scale));
-    let title_h = 8 * title_scale;
-    let map_y = MARGIN + title_h + MARGIN;
-    let legend_y = map_y + map.height + MARGIN;
-    let lines = if any_missing { 2 } else { 1 };
-    let mut img = Image::new(
-        inner + 2 * MARGIN,
-        legend_y + lines * LINE + MARGIN,
-        BACKGROUND,
-    );
-    let centre = i64::from(img.width / 2);
-    draw_text_centred(&mut img, centre, i64::from(MARGIN), title, title_scale);
-    img.blit(&map, (i64::from(MARGIN), i64::from(map_y)));
-    let left = i64::from(MARGIN);
-    draw_text(&mut img, (left, i64::from(legend_y)), &bar, 1, TEXT_COLOUR);
-    if any_missing {
-        let y = i64::from(legend_y + LINE);
-        for dy in 0..8 {
-            for dx in 0..8 {
-                img.set(left + dx, y + dy, MISSING_COLOUR);
-            }
-        }
-        let x = left + i64::from(swatch);
-        draw_text(&mut img, (x, y), missing, 1, TEXT_COLOUR);
     }
     img
 }

@@ -29,7 +29,32 @@ pub(crate) fn write(dir: &Path, name: &str, text: &str) -> Result<String> {
     Ok(name.to_string())
 }
 
+/// `word` as one word of a POSIX shell command line: as it is when it holds only characters
+/// no shell treats specially, else in single quotes (a quote inside written `'\''`).
+pub(crate) fn shell_word(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_./,:=+@%".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', r"'\''"))
+    }
+}
+
 /// Creates `dir` and its parents.
 pub(crate) fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shell_word;
+
+    #[test]
+    fn shell_words_are_quoted_only_when_a_shell_would_split_or_expand_them() {
+        assert_eq!(shell_word("hands/my_gripper.urdf"), "hands/my_gripper.urdf");
+        assert_eq!(shell_word("my hands/g.urdf"), "'my hands/g.urdf'");
+        assert_eq!(shell_word("it's.urdf"), r"'it'\''s.urdf'");
+        assert_eq!(shell_word("$HOME/g.urdf"), "'$HOME/g.urdf'");
+        assert_eq!(shell_word(""), "''");
+    }
 }

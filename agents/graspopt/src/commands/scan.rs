@@ -1,9 +1,9 @@
 //! `graspopt scan --object sphere --axes x,y --steps 41,41`: a grid scan of a metric over
 //! one or two trial parameters (any number for the CSV), in parallel over cores, with a
 //! progress bar. Writes `<out>/<object>-<metric>-<axes>.csv`, and images for one axis (an
-//! SVG line plot) or two (an SVG and a PNG heatmap); three or more axes write the CSV only,
-//! with a note. Grids hold at most `graspopt_trial::scan::MAX_GRID_POINTS` points; the files
-//! are written by `graspopt_report::scan`.
+//! SVG and a PNG line plot) or two (an SVG and a PNG heatmap); three or more axes write the
+//! CSV only, with a note. Grids hold at most `graspopt_trial::scan::MAX_GRID_POINTS` points;
+//! the files are written by `graspopt_report::scan`.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -20,8 +20,8 @@ use crate::out::outln;
 #[derive(Args, Debug)]
 #[command(
     after_help = "Writes <out>/<object>-<metric>-<axes>.csv for any number of axes, and images for \
-                  1 axis (an SVG line plot) or 2 axes (an SVG and a PNG heatmap); 3 or more axes \
-                  write the CSV only. A grid holds at most 10,000,000 points."
+                  1 axis (an SVG and a PNG line plot) or 2 axes (an SVG and a PNG heatmap); 3 or \
+                  more axes write the CSV only. A grid holds at most 10,000,000 points."
 )]
 pub struct ScanArgs {
     #[command(flatten)]
@@ -71,12 +71,11 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
     bar.finish_and_clear();
     let elapsed = started.elapsed();
 
-    let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
     let written = graspopt_report::scan::write_scan(
         &args.out,
         &ev,
         args.sim.metric.name(),
-        &names,
+        &kinds,
         &axes,
         &points,
     )?;

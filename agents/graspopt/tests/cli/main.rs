@@ -5,6 +5,8 @@
 mod cli_bad_input;
 mod doc_commands;
 mod doc_facts;
+mod docs_figures_cli;
+mod experiment_report_cli;
 mod forces_cli;
 mod pipe_cli;
 mod quality_cli;

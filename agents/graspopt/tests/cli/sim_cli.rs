@@ -143,6 +143,41 @@ fn scan_2d_writes_a_png_heatmap_too() {
 }
 
 #[test]
+fn a_one_axis_scan_writes_a_png_line_plot_with_its_misses_grey() {
+    let dir = tempdir("scan-1d");
+    let out = graspopt_ok(&[
+        "scan",
+        "--object",
+        "sphere",
+        "--axes",
+        "x",
+        "--steps",
+        "9",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let png = dir.join("sphere-bw-approach.png");
+    assert!(stdout.contains(png.to_str().unwrap()), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("sphere-bw-approach.csv")).unwrap();
+    let misses = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(5) == Some("0"))
+        .count();
+    assert!(misses > 0 && misses < 9, "{csv}");
+    let (w, h, px) = decode_png(&png);
+    assert!(w >= 560 && h >= 280, "{w} x {h}");
+    // A grey tick of 2 x 8 pixels per miss (9 points are far apart) and the legend's square;
+    // the line in the first colour of the charts, and text.
+    let grey = px.iter().filter(|c| **c == [128, 128, 128]).count();
+    assert_eq!(grey, 16 * misses + 64);
+    assert!(px.contains(&[31, 119, 180]));
+    assert!(px.iter().filter(|c| **c == [20, 20, 20]).count() > 500);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
     let dir = tempdir("misses");
     graspopt_ok(&[
@@ -452,7 +487,7 @@ fn hands_lists_the_built_in_hands_and_describes_one() {
 
 /// A two-jaw gripper in URDF, written by the test: two prismatic jaws, the second mimicking
 /// the first, so they close together.
-const JAWS_URDF: &str = r#"<robot name="two_jaws">
+pub(crate) const JAWS_URDF: &str = r#"<robot name="two_jaws">
   <link name="base"><collision><origin xyz="0 0 -0.01"/><geometry><box size="0.04 0.16 0.02"/></geometry></collision></link>
   <link name="left"><collision><origin xyz="0 -0.005 0.03"/><geometry><box size="0.02 0.01 0.06"/></geometry></collision></link>
   <link name="right"><collision><origin xyz="0 0.005 0.03"/><geometry><box size="0.02 0.01 0.06"/></geometry></collision></link>

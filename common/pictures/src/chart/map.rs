@@ -39,11 +39,13 @@ pub(super) fn colour_of(v: f64, zr: (f64, f64)) -> RGBColor {
 }
 
 /// Splits `area` into a plotting part and, on the right, a colour bar for the scale `zr`
-/// (`zr.0` at the bottom, `zr.1` at the top) with its labels; returns the plotting part.
+/// (`zr.0` at the bottom, `zr.1` at the top) with its values and, beside them, `label` (what
+/// the colours stand for); returns the plotting part.
 /// The bar's top and bottom line up with a plotting area built by [`axes`] with an x label.
 pub(super) fn with_colour_bar<'b>(
     area: &Area<'b>,
     zr: (f64, f64),
+    label: &str,
 ) -> Result<Area<'b>, Box<dyn Error>> {
     let (w, _) = area.dim_in_pixel();
     let (main, bar) = area.split_horizontally(w.saturating_sub(BAR_W));
@@ -51,7 +53,7 @@ pub(super) fn with_colour_bar<'b>(
         .margin(10)
         .margin_left(0)
         .x_label_area_size(42)
-        .right_y_label_area_size(60)
+        .right_y_label_area_size(BAR_W as i32 - 30)
         .build_cartesian_2d(0.0..1.0, zr.0..zr.1)?;
     chart
         .configure_mesh()
@@ -61,6 +63,8 @@ pub(super) fn with_colour_bar<'b>(
         .set_tick_mark_size(LabelAreaPosition::Right, 5)
         .y_labels(6)
         .y_label_formatter(&|v: &f64| tick(&snap(*v, zr)))
+        .y_desc(label)
+        .axis_desc_style((FONT, 15))
         .label_style((FONT, 13))
         .draw()?;
     const STEPS: usize = 50;
@@ -89,7 +93,7 @@ fn cells(n: usize, r: (f64, f64)) -> ((f64, f64), f64) {
 /// on it when given.
 fn map(
     title: &str,
-    (xlabel, ylabel): (&str, &str),
+    (xlabel, ylabel, zlabel): (&str, &str, &str),
     (xs, ys, z): (&[f64], &[f64], &[Vec<f64>]),
     samples: &[(f64, f64, f64)],
 ) -> String {
@@ -110,7 +114,7 @@ fn map(
             entries.push((Mark::Square(GREY), MISSING_LABEL));
         }
         let area = legend(area, &entries)?;
-        let main = with_colour_bar(&area, zr)?;
+        let main = with_colour_bar(&area, zr, zlabel)?;
         let nx = xs.len().max(z.len());
         let ny = ys.len().max(z.iter().map(Vec::len).max().unwrap_or(0));
         let ((xa, sx), (ya, sy)) = (
@@ -152,26 +156,26 @@ fn map(
 }
 
 /// A heatmap ([`heatmap`]) with samples drawn on it as dots coloured by their own value on
-/// the map's scale, the best one as a larger ring.
+/// the map's scale, the best one as a larger ring; `zlabel` names the values (beside the
+/// colour bar).
 pub fn samples_map(
     title: &str,
-    xlabel: &str,
-    ylabel: &str,
+    (xlabel, ylabel, zlabel): (&str, &str, &str),
     grid: (&[f64], &[f64], &[Vec<f64>]),
     samples: &[(f64, f64, f64)],
 ) -> String {
-    map(title, (xlabel, ylabel), grid, samples)
+    map(title, (xlabel, ylabel, zlabel), grid, samples)
 }
 
 /// A heatmap of `z[i][j]` over `xs[i]` (horizontal) and `ys[j]` (vertical), the values
 /// evenly spaced (as a grid scan's); cells that are not finite are grey ([`MISSING`]).
+/// `labels` name the axes and the values (`zlabel`, beside the colour bar).
 pub fn heatmap(
     title: &str,
-    xlabel: &str,
-    ylabel: &str,
+    labels: (&str, &str, &str),
     xs: &[f64],
     ys: &[f64],
     z: &[Vec<f64>],
 ) -> String {
-    map(title, (xlabel, ylabel), (xs, ys, z), &[])
+    map(title, labels, (xs, ys, z), &[])
 }

@@ -273,14 +273,17 @@ fn empty_or_non_finite_input_gives_an_empty_state_chart() {
                 None,
             ),
         ),
-        ("heatmap, empty", heatmap("e", "x", "y", &[], &[], &[])),
+        (
+            "heatmap, empty",
+            heatmap("e", ("x", "y", "bw"), &[], &[], &[]),
+        ),
         (
             "heatmap, NaN",
-            heatmap("e", "x", "y", &nan, &nan[..2], &nan_grid),
+            heatmap("e", ("x", "y", "bw"), &nan, &nan[..2], &nan_grid),
         ),
         (
             "samples, empty",
-            samples_map("e", "x", "y", (&[], &[], &[]), &[]),
+            samples_map("e", ("x", "y", "bw"), (&[], &[], &[]), &[]),
         ),
         ("progress, empty", progress_plot("e", &[])),
         (
@@ -322,7 +325,7 @@ fn cells_of<'a>(els: &'a [El], fill: &str) -> Vec<&'a El> {
 fn a_heatmap_draws_one_cell_per_value_on_the_colour_scale() {
     let (xs, ys) = ([0.0, 1.0], [0.0, 10.0, 20.0]);
     let z = vec![vec![0.0, 1.0, 2.0], vec![3.0, 4.0, 5.0]];
-    let els = parse(&heatmap("m", "x", "y", &xs, &ys, &z));
+    let els = parse(&heatmap("m", ("x", "y", "bw"), &xs, &ys, &z));
     let mut corners = Vec::new();
     for (i, column) in z.iter().enumerate() {
         for (j, v) in column.iter().enumerate() {
@@ -346,11 +349,21 @@ fn a_heatmap_draws_one_cell_per_value_on_the_colour_scale() {
         .collect();
     assert_eq!(bar.len(), 50);
     assert!(!texts(&els).contains(&MISSING_LABEL.to_string()));
+    // The bar is labelled with what its colours stand for, right of its values.
+    let label = els
+        .iter()
+        .find(|e| e.name == "text" && e.text.trim() == "bw")
+        .expect("the colour bar's label");
+    let bar_right = bar
+        .iter()
+        .map(|e| e.num("x") + e.num("width"))
+        .fold(0.0, f64::max);
+    assert!(label.num("x") > bar_right, "{label:?} left of {bar_right}");
 
     // A missing value: a grey cell and a legend that says what grey means.
     let mut z = z;
     z[1][2] = f64::NAN;
-    let els = parse(&heatmap("m", "x", "y", &xs, &ys, &z));
+    let els = parse(&heatmap("m", ("x", "y", "bw"), &xs, &ys, &z));
     assert_eq!(cells_of(&els, MISSING).len(), 1);
     assert!(texts(&els).contains(&MISSING_LABEL.to_string()));
     assert!(
@@ -376,7 +389,12 @@ fn samples_sit_on_the_centres_of_their_grid_cells_and_the_best_is_ringed() {
         .collect();
     // One sample on the first grid point, one on the last (the best).
     let samples = [(0.0, 10.0, 0.0), (3.0, 20.0, 7.0)];
-    let els = parse(&samples_map("m", "x", "y", (&xs, &ys, &z), &samples));
+    let els = parse(&samples_map(
+        "m",
+        ("x", "y", "bw"),
+        (&xs, &ys, &z),
+        &samples,
+    ));
     let placed = dots(&els, DOT_R);
     // The two samples and the legend's sign.
     assert_eq!(placed.len(), 3, "{placed:?}");
@@ -588,7 +606,7 @@ fn extreme_values_never_panic() {
         let els = parse(&line_plot("x", "x", "y", &xs, ys));
         assert!(els.len() > 3, "{ys:?}");
         let grid = vec![ys.to_vec(), ys.to_vec()];
-        parse(&heatmap("x", "x", "y", ys, ys, &grid));
+        parse(&heatmap("x", ("x", "y", "bw"), ys, ys, &grid));
         parse(&progress_plot(
             "x",
             &ys.iter().map(|&v| Some(v)).collect::<Vec<_>>(),
@@ -615,4 +633,103 @@ fn a_tick_at_zero_reads_zero() {
         .collect();
     assert!(labels.iter().any(|t| t == "0.000"), "{labels:?}");
     assert!(labels.iter().all(|t| !t.contains('e')), "{labels:?}");
+}
+
+#[test]
+fn a_scan_plot_keeps_misses_off_the_scale_as_grey_ticks() {
+    let xs = [-0.2, -0.1, 0.0, 0.1, 0.2];
+    let hits = vec![None, Some(0.1), Some(0.3), Some(0.2), None];
+    let els = parse(&scan_plot(
+        "s",
+        "approach offset (m)",
+        "BW",
+        &xs,
+        &[("", hits)],
+    ));
+    let grey = lines(&els, MISSING, "2");
+    // A tick per miss and the legend's... square (a rect, not a line).
+    assert_eq!(grey.len(), 2, "{grey:?}");
+    let bottom = grey[0].points()[0].1;
+    assert!(grey.iter().all(|e| e.points()[0].1 == bottom));
+    assert!(texts(&els).contains(&MISS_TICK_LABEL.to_string()));
+    // The score axis spans the hits: 0.1 to 0.3, never the misses' scores.
+    let y = ticks(&els, "end");
+    assert!(
+        y.len() >= 3 && y.iter().all(|v| (0.09..=0.31).contains(v)),
+        "{y:?}"
+    );
+    let line = lines(&els, &hex(PALETTE[0]), "2");
+    assert_eq!(line.len(), 1);
+    assert_eq!(line[0].points().len(), 3);
+    // Series that miss at different points: a tick wherever one missed, a legend per name.
+    let series = [
+        (
+            "mean point",
+            vec![None, Some(0.1), Some(0.2), Some(0.1), Some(0.1)],
+        ),
+        (
+            "surface",
+            vec![Some(0.2), None, Some(0.3), Some(0.2), Some(0.2)],
+        ),
+    ];
+    let els = parse(&scan_plot("s", "x", "BW", &xs, &series));
+    assert_eq!(lines(&els, MISSING, "2").len(), 2);
+    assert!(texts(&els).contains(&"surface".to_string()));
+}
+
+/// The texts of the x-axis tick labels (anchored in their middle) that are numbers.
+fn x_tick_labels(els: &[El]) -> Vec<String> {
+    els.iter()
+        .filter(|e| e.is("text", "text-anchor", "middle"))
+        .map(|e| e.text.trim().to_string())
+        .filter(|s| s.parse::<f64>().is_ok())
+        .collect()
+}
+
+#[test]
+fn trial_counts_are_labelled_as_whole_numbers() {
+    let xs: Vec<f64> = (1..=40).map(f64::from).collect();
+    let mean: Vec<f64> = xs.iter().map(|x| x.sqrt()).collect();
+    let band = (mean.clone(), mean.clone());
+    let els = parse(&bands_plot(
+        "b",
+        "trial",
+        "best so far",
+        &xs,
+        &[("bo", mean)],
+        &[band],
+        None,
+    ));
+    let labels = x_tick_labels(&els);
+    assert!(labels.len() >= 3, "{labels:?}");
+    assert!(labels.iter().all(|s| !s.contains('.')), "{labels:?}");
+    // A short count axis may have ticks between whole numbers: as many decimals as needed.
+    let els = parse(&line_plot("s", "trial", "y", &[1.0, 2.0], &[1.0, 2.0]));
+    let labels = x_tick_labels(&els);
+    assert!(
+        labels
+            .iter()
+            .all(|s| !s.ends_with(".000") && !s.ends_with('0') || s == "0")
+    );
+    assert!(labels.iter().any(|s| s == "1" || s == "2"), "{labels:?}");
+    // Offsets in metres keep three decimals.
+    let xs = [-0.1, 0.0, 0.1];
+    let labels = x_tick_labels(&parse(&line_plot("s", "x", "y", &xs, &xs)));
+    assert!(
+        labels
+            .iter()
+            .all(|s| s.split('.').nth(1).is_some_and(|d| d.len() == 3)),
+        "{labels:?}"
+    );
+}
+
+#[test]
+fn count_labels_whole_numbers_without_decimals() {
+    assert_eq!(count(&5.0), "5");
+    assert_eq!(count(&10.000000000001), "10");
+    assert_eq!(count(&-0.0), "0");
+    assert_eq!(count(&1.5), "1.5");
+    assert_eq!(count(&2.25), "2.25");
+    assert_eq!(count(&1.999), "2");
+    assert_eq!(count(&1e300), tick(&1e300));
 }
