@@ -1,6 +1,7 @@
 //! Every `graspopt` command the docs show in a code block, checked against the binary of this
 //! build: each one parses (in `cargo test --workspace`), and the cheap, self-contained ones
-//! run and succeed (ignored tests, half a minute and two: `.ci/run` runs them).
+//! run and succeed (ignored tests: `.ci/run` runs the cheap ones, half a minute; the slow
+//! one, two minutes, is run by hand).
 //!
 //! **What is read.** README.md, deploy/README.md, docs/*.md and the examples' docs (any
 //! README.md under examples/, and the module docstring of each examples/**/*.py, whose
@@ -608,7 +609,7 @@ fn the_cheap_commands_in_the_docs_run() {
 }
 
 #[test]
-#[ignore = "slow: two minutes (the README's optimize-function); .ci/run runs it"]
+#[ignore = "slow: two minutes (the README's optimize-function); run it by hand, .ci/run parses it only"]
 fn the_slow_commands_in_the_docs_run() {
     let failures = check(|list| list == Some("SLOW"), false);
     assert!(
