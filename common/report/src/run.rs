@@ -78,11 +78,7 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
     );
     std::fs::write(folder.out.join("trials.svg"), map)?;
 
-    let Some(best) = done.iter().max_by(|a, b| {
-        a.score
-            .unwrap_or(f64::NAN)
-            .total_cmp(&b.score.unwrap_or(f64::NAN))
-    }) else {
+    let Some(best) = best_trial(&done) else {
         return Ok(());
     };
     let grasp = folder
@@ -103,4 +99,58 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
     );
     crate::trial::preview_image(folder.evaluator, &grasp, &title)?
         .save_png(&folder.out.join("best.png"))
+}
+
+/// The best of `done`, as the journal and the run's summary name it: the highest score, the
+/// first trial among equal scores.
+fn best_trial<'a>(done: &[&'a TrialRow]) -> Option<&'a TrialRow> {
+    done.iter().copied().max_by(|a, b| {
+        a.score
+            .unwrap_or(f64::NAN)
+            .total_cmp(&b.score.unwrap_or(f64::NAN))
+            .then(b.trial_id.cmp(&a.trial_id))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use graspopt_journal::TrialState;
+
+    fn trial(trial_id: u64, score: f64) -> TrialRow {
+        TrialRow {
+            run_id: "r".into(),
+            trial_id,
+            state: TrialState::Completed,
+            attempts: 1,
+            params: vec![0.0, 0.0],
+            worker: "hand-1".into(),
+            issued_ms: 0,
+            lease_until_ms: 0,
+            completed_ms: Some(1),
+            result_attempt: Some(1),
+            score: Some(score),
+            metrics: None,
+            contacts: 0,
+            fingers_in_contact: 0,
+            cloud_points: 0,
+            details_json: None,
+            error: None,
+            forces: None,
+        }
+    }
+
+    /// A replaying hand answers several trials with one recorded grasp: equal scores. The
+    /// picture names the trial the summary and the journal name, the first of them.
+    #[test]
+    fn the_best_trial_of_equal_scores_is_the_first_as_in_the_journal() {
+        let rows = [
+            trial(1, 0.1),
+            trial(2, 0.18),
+            trial(11, 0.18),
+            trial(12, 0.18),
+        ];
+        let done: Vec<&TrialRow> = rows.iter().collect();
+        assert_eq!(best_trial(&done).map(|t| t.trial_id), Some(2));
+    }
 }
