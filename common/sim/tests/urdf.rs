@@ -554,3 +554,23 @@ fn a_hand_says_along_which_world_axis_it_closes_and_which_joints_are_mimics() {
         ("finger_joint2", "finger_joint1", 1.0, 0.0, "m")
     );
 }
+
+/// An error in a hand's settings file names that file, not the URDF beside it.
+#[test]
+fn an_error_in_a_hands_settings_names_the_settings_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let claw = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/hands/claw");
+    std::fs::create_dir(dir.path().join("meshes")).unwrap();
+    std::fs::copy(
+        claw.join("meshes/finger.obj"),
+        dir.path().join("meshes/finger.obj"),
+    )
+    .unwrap();
+    std::fs::copy(claw.join("claw.urdf"), dir.path().join("grip.urdf")).unwrap();
+    std::fs::write(dir.path().join("grip.toml"), "finger = []\n").unwrap();
+    let e = UrdfHand::from_file(&dir.path().join("grip.urdf"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("grip.toml"), "{e}");
+    assert!(e.contains("finger"), "{e}");
+}

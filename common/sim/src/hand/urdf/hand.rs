@@ -90,8 +90,10 @@ impl UrdfHand {
         settings: Option<&str>,
         mesh_dir: Option<&Path>,
     ) -> Result<Self> {
+        // Errors in the settings name their file: the one beside the URDF, same stem.
+        let settings_file = Path::new(file).with_extension("toml").display().to_string();
         let settings = settings
-            .map(|s| HandSettings::parse(s, &format!("{file} (settings)")))
+            .map(|s| HandSettings::parse(s, &settings_file))
             .transpose()?;
         Self::new(
             HandDescription::parse(file, urdf, settings.as_ref())?,
