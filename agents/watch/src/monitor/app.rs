@@ -79,6 +79,7 @@ pub(crate) fn phase_name(p: RunPhase) -> &'static str {
         RunPhase::Waiting => "waiting",
         RunPhase::Running => "running",
         RunPhase::Finished => "finished",
+        RunPhase::Stopped => "stopped",
     }
 }
 
