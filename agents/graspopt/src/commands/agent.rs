@@ -12,6 +12,7 @@ use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::RunId;
 use graspopt_runner::config::load;
+use graspopt_runner::ending::RunEnd;
 use graspopt_runner::signal::{shutdown_signal, until_signal};
 use graspopt_sim::ParamKind;
 
@@ -270,13 +271,12 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 shutdown_signal(),
             )
             .await?;
-            outln!("{}", serde_json::to_string(&status)?)?;
-            // 130: the shell's code for a command stopped by Ctrl-C.
-            Ok(if status.phase == graspopt_protocol::RunPhase::Finished {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(130)
-            })
+            let end = RunEnd::read(status, &c.journal_path(&run_id))?;
+            outln!("{}", end.json()?)?;
+            for line in end.lines(" (stopped)") {
+                eprintln!("coordinator: {line}");
+            }
+            Ok(ExitCode::from(end.exit_code()))
         }
     }
 }

@@ -10,14 +10,15 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::Args;
 use graspopt_bus::BusArgs;
-use graspopt_protocol::{PlannerMethod, RunPhase};
+use graspopt_protocol::PlannerMethod;
+use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
 use super::setup::{SimArgs, planner_method, trial_param};
 use crate::out::outln;
-use graspopt_protocol::named_params;
+use graspopt_runner::ending::RunEnd;
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
 
 #[derive(Args, Debug, Clone)]
@@ -139,8 +140,8 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
                     bar.set_position(s.completed + s.failed);
                     if let Some(b) = &s.best {
                         bar.set_message(format!(
-                            "best {:.4} (trial {}){}",
-                            b.score,
+                            "best {} (trial {}){}",
+                            rounded(b.score),
                             b.trial_id,
                             if b.force_closure == Some(true) {
                                 ", force closure"
@@ -165,34 +166,14 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
         evaluator: &e.evaluator,
     };
     graspopt_report::run::write_results(&folder, &status.object)?;
-    let stopped = status.phase != RunPhase::Finished;
-    outln!(
-        "run {:?}: {} trials completed, {} failed{}",
-        status.run_id,
-        status.completed,
-        status.failed,
-        if stopped {
-            format!(
-                " (stopped; continue with --resume --out {})",
-                e.out.display()
-            )
-        } else {
-            String::new()
-        }
-    )?;
-    if let Some(b) = &status.best {
-        outln!(
-            "best: trial {} score {} at {}",
-            b.trial_id,
-            b.score,
-            named_params(&status.param_names, &b.params, ",")
-        )?;
+    let end = RunEnd::read(status, &e.coordinator.journal)?;
+    let then = format!(
+        " (stopped; continue with --resume --out {})",
+        e.out.display()
+    );
+    for line in end.lines(&then) {
+        outln!("{line}")?;
     }
     outln!("results: {}", e.out.display())?;
-    // 130: the shell's code for a command stopped by Ctrl-C.
-    Ok(if stopped {
-        ExitCode::from(130)
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(ExitCode::from(end.exit_code()))
 }

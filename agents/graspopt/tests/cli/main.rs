@@ -4,6 +4,7 @@
 
 mod cli_bad_input;
 mod forces_cli;
+mod messages_cli;
 mod pipe_cli;
 mod quality_cli;
 mod render_cli;
