@@ -59,6 +59,22 @@ enum Command {
     Bench(commands::bench::BenchArgs),
 }
 
+/// The command line: [`Cli`], where every flag that takes a value takes a negative number as
+/// one (and a comma-separated list any text), so that `--trials -5` reaches the flag's own
+/// check, which names the range it accepts, instead of being an unknown flag `-5`.
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_subcommands(negatives).mut_args(|a| {
+            match (a.get_action().takes_values(), a.get_value_delimiter()) {
+                (true, Some(_)) => a.allow_hyphen_values(true),
+                (true, None) => a.allow_negative_numbers(true),
+                (false, _) => a,
+            }
+        })
+    }
+    negatives(Cli::command())
+}
+
 /// Whether the flag with id `name` (a field name: `trials`, `torque_scale`) was given on
 /// the command line rather than left at its default.
 fn given(matches: Option<&ArgMatches>, name: &str) -> bool {
@@ -92,7 +108,7 @@ const DEFAULT_LOG: &str = "warn,zenoh::net::runtime::orchestrator=error,\
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
-    let matches = Cli::command().get_matches();
+    let matches = command().get_matches();
     let cli = match Cli::from_arg_matches(&matches) {
         Ok(cli) => cli,
         Err(e) => e.exit(),

@@ -1,4 +1,4 @@
-//! How the tools show a message's numbers to people. JSON and CSV keep every digit; a line
+//! How the tools show numbers to people. JSON and CSV keep every digit; a line
 //! a person reads rounds.
 
 /// Significant digits of a number a person reads (a score, say).
@@ -23,9 +23,31 @@ pub fn rounded(v: f64) -> String {
     format!("{v:.decimals$}")
 }
 
+/// `n` with its digits in groups of three (`1,000,000,000`).
+pub fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, d) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(d);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
-    use super::rounded;
+    use super::{grouped, rounded};
+
+    #[test]
+    fn thousands_are_grouped() {
+        assert_eq!(grouped(0), "0");
+        assert_eq!(grouped(999), "999");
+        assert_eq!(grouped(1000), "1,000");
+        assert_eq!(grouped(1_000_000_000), "1,000,000,000");
+        assert_eq!(grouped(u64::MAX), "18,446,744,073,709,551,615");
+    }
 
     #[test]
     fn five_significant_digits() {

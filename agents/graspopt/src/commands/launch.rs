@@ -77,7 +77,7 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     // before it have started.
     for p in &plan {
         let argv = std::iter::once("graspopt").chain(p.args.iter().map(String::as_str));
-        if let Err(e) = <crate::Cli as clap::Parser>::try_parse_from(argv) {
+        if let Err(e) = crate::command().try_get_matches_from(argv) {
             let rendered = e.render().to_string();
             let why = rendered
                 .lines()

@@ -16,8 +16,9 @@ use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
-use super::setup::{SimArgs, planner_method, trial_param};
+use super::setup::{SimArgs, count, planner_method, trial_param};
 use crate::out::outln;
+use graspopt_coordinator::{MAX_TRIALS, MAX_WAIT_MS};
 use graspopt_runner::ending::RunEnd;
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
 
@@ -29,10 +30,10 @@ pub struct RunArgs {
     #[arg(long, default_value = "run")]
     pub run: String,
     /// Number of simulated hand workers.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = count::<usize>(1, u64::MAX))]
     pub workers: usize,
     /// Number of trials.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
     pub trials: u64,
     /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
     #[arg(
@@ -48,11 +49,11 @@ pub struct RunArgs {
     #[arg(long, default_value = "bo", value_parser = planner_method())]
     pub method: PlannerMethod,
     /// Size of the initial design (space-filling, not model-based) (default: the engine's).
-    #[arg(long)]
+    #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
     pub initial: Option<u32>,
     /// Seed of the planner's random choices and of perception's noise (the same seed
     /// proposes the same trials).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub seed: u64,
     /// Results folder (default: results/<run>).
     #[arg(long)]
@@ -63,10 +64,10 @@ pub struct RunArgs {
     #[arg(long)]
     pub resume: bool,
     /// Minimum duration of a simulated trial, to model a robot (milliseconds).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub trial_cost_ms: u64,
     /// Lease of a trial: re-issued if no result comes within this time (milliseconds).
-    #[arg(long, default_value_t = 30_000)]
+    #[arg(long, default_value_t = 30_000, value_parser = count::<u64>(1, MAX_WAIT_MS))]
     pub lease_ms: u64,
     /// Perception's position error, standard deviation per axis (metres).
     #[arg(long, default_value_t = 0.0)]

@@ -129,3 +129,99 @@ fn a_run_s_summary_rounds_its_best_score() {
         "{stdout}"
     );
 }
+
+/// A negative count (which clap would take for an unknown flag) is refused naming the range
+/// the flag accepts, in every command that takes a count.
+#[test]
+fn a_negative_count_is_refused_naming_the_accepted_range() {
+    let dir = tempdir("negative-counts");
+    let out = dir.join("never");
+    let o = out.to_str().unwrap();
+    for (args, expected) in [
+        (
+            vec!["run", "--trials", "-5", "--out", o],
+            "--trials <TRIALS>': must be a whole number from 1 to 1,000,000,000",
+        ),
+        (
+            vec!["run", "--workers", "-1", "--out", o],
+            "--workers <WORKERS>': must be a whole number of 1 or more",
+        ),
+        (
+            vec!["run", "--initial", "-1", "--out", o],
+            "--initial <INITIAL>': must be a whole number",
+        ),
+        (
+            vec!["agent", "coordinator", "--trials", "-5", "--journal", o],
+            "--trials <TRIALS>': must be a whole number from 1 to 1,000,000,000",
+        ),
+        (
+            vec!["bench", "coordinator", "--trials", "-5"],
+            "must be a whole number from 1 to 100,000",
+        ),
+        (
+            vec!["bench", "pipeline", "--workers", "-2,4"],
+            "must be a whole number from 1 to 256",
+        ),
+        (
+            vec!["bench", "pipeline", "--trials-per-worker", "-1"],
+            "must be a whole number",
+        ),
+        (
+            vec!["bench", "clouds", "--messages", "-1"],
+            "must be a whole number from 1 to 100,000",
+        ),
+        (
+            vec!["bench", "planner", "--rounds", "-1"],
+            "must be a whole number from 1 to 1,000",
+        ),
+        (
+            vec!["experiment", "bo", "--seeds", "-1", "--out", o],
+            "must be a whole number from 1 to 1,000",
+        ),
+        (
+            vec!["experiment", "bo", "--budget", "-1", "--out", o],
+            "must be a whole number",
+        ),
+        (
+            vec!["experiment", "metrics", "--steps", "-1", "--out", o],
+            "must be a whole number",
+        ),
+        (
+            vec!["experiment", "sensing", "--trials", "-1"],
+            "-1 is not in 1..=100000",
+        ),
+        (
+            vec!["optimize-function", "branin", "--seeds", "-1"],
+            "must be a whole number from 1 to 1,000",
+        ),
+        (
+            vec!["optimize-function", "branin", "--budget", "-1"],
+            "must be a whole number from 1 to 100,000",
+        ),
+        (
+            vec!["scan", "--steps", "-5", "--out", o],
+            "--steps: expected whole numbers >= 1, got \"-5\"",
+        ),
+        (
+            vec!["scan", "--threads", "-1", "--out", o],
+            "must be a whole number",
+        ),
+        (
+            vec!["topic", "echo", "status", "--count", "-1"],
+            "must be a whole number",
+        ),
+    ] {
+        let run = graspopt(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} ran");
+        assert!(
+            !stderr.contains("unexpected argument"),
+            "{args:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains(expected),
+            "{args:?}: {expected:?} not in {stderr}"
+        );
+    }
+    assert!(!out.exists(), "a refused command wrote {o}");
+}
