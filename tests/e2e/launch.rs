@@ -122,6 +122,10 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journ
     let out = first.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
+    // The final status the coordinator printed says what the journal records: stopped.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let status: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(status["phase"], "stopped", "{stdout}");
     assert!(
         stderr.contains(&format!(
             "continue the run with graspopt launch --resume {}",

@@ -290,3 +290,41 @@ fn hands_started_together_with_one_id_leave_one_running() {
         );
     }
 }
+
+/// A run whose every trial fails (here a replay hand whose recording has two parameters per
+/// grasp, for a run of three) ends by saying why, with how many trials each reason ended: in
+/// the final status the coordinator prints (`failures`) and on its stderr; and the
+/// coordinator exits with status 3, not 0.
+#[test]
+fn a_coordinator_whose_every_trial_failed_says_why_and_exits_3() {
+    let c = Cluster::start("all-failed", "allfail");
+    let (rec, _) = record(&c.dir);
+    let _hand = c.agent(
+        "replay-hand",
+        &["hand", "--id", "hand-1", "--replay", rec.to_str().unwrap()],
+    );
+    let _support = c.support("cuboid");
+    let coordinator = c.coordinator("cuboid", "6", "0", &["--params", "x,y,rz"]);
+    let (status, stdout) = coordinator.wait_output(Duration::from_secs(120));
+    let log = c.log("coordinator");
+    assert_eq!(status.code(), Some(3), "{stdout}\n{log}");
+    let reason = format!(
+        "the recording {} has 2 parameters per grasp, the trial has 3",
+        rec.display()
+    );
+    let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(
+        (&json["completed"], &json["failed"]),
+        (&0.into(), &6.into())
+    );
+    assert_eq!(
+        json["failures"],
+        serde_json::json!([{"reason": reason, "trials": 6}]),
+        "{stdout}"
+    );
+    assert!(
+        log.contains("run \"allfail\": 0 of 6 trials completed, 6 failed")
+            && log.contains(&format!("failed: 6 × {reason}")),
+        "{log}"
+    );
+}

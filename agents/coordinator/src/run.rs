@@ -75,7 +75,7 @@ pub async fn run_until(
     };
     let period = Duration::from_millis(config.status_period_ms.max(20));
     if drive(&mut core, &inputs, &mut io, period, stop, place.lost()).await? {
-        io.stopped(&core, &journal_path)
+        io.stopped(&core, &journal_path).await
     } else {
         io.finished(&core).await
     }
@@ -269,22 +269,33 @@ impl<'a> Io<'a> {
         self.journal
             .set_run_status(run, RunLifecycle::Finished, now_ms())?;
         let s = core.status_at(RunPhase::Finished, now_ms());
+        self.last_status(&s).await;
+        Ok(s)
+    }
+
+    /// Publishes the run's last status, and gives it to the progress watcher.
+    async fn last_status(&self, s: &RunStatus) {
         let _ = self
             .bus
-            .put(&STATUS.key(self.run.into()), &s, Encoding::Bincode)
+            .put(&STATUS.key(self.run.into()), s, Encoding::Bincode)
             .await;
         if let Some(p) = &self.progress {
             let _ = p.send(s.clone());
         }
-        Ok(s)
     }
 
-    /// The run was stopped: recorded, and said how to go on.
-    fn stopped(self, core: &Coordinator, path: &std::path::Path) -> anyhow::Result<RunStatus> {
+    /// The run was stopped: recorded (its status, published, says so), and said how to go
+    /// on.
+    async fn stopped(
+        self,
+        core: &Coordinator,
+        path: &std::path::Path,
+    ) -> anyhow::Result<RunStatus> {
         let run = self.run;
         self.journal
             .set_run_status(run.as_str(), RunLifecycle::Stopped, now_ms())?;
-        let s = core.status(now_ms());
+        let s = core.status_at(RunPhase::Stopped, now_ms());
+        self.last_status(&s).await;
         let waiting = if s.waiting.is_empty() {
             String::new()
         } else {

@@ -59,6 +59,22 @@ enum Command {
     Bench(commands::bench::BenchArgs),
 }
 
+/// The command line: [`Cli`], where every flag that takes a value takes a negative number as
+/// one (and a comma-separated list any text), so that `--trials -5` reaches the flag's own
+/// check, which names the range it accepts, instead of being an unknown flag `-5`.
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_subcommands(negatives).mut_args(|a| {
+            match (a.get_action().takes_values(), a.get_value_delimiter()) {
+                (true, Some(_)) => a.allow_hyphen_values(true),
+                (true, None) => a.allow_negative_numbers(true),
+                (false, _) => a,
+            }
+        })
+    }
+    negatives(Cli::command())
+}
+
 /// Whether the flag with id `name` (a field name: `trials`, `torque_scale`) was given on
 /// the command line rather than left at its default.
 fn given(matches: Option<&ArgMatches>, name: &str) -> bool {
@@ -92,8 +108,11 @@ const DEFAULT_LOG: &str = "warn,zenoh::net::runtime::orchestrator=error,\
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
-    let matches = Cli::command().get_matches();
-    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    let matches = command().get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     // Parsed and nothing more: the test of the docs' commands (tests/cli/doc_commands.rs).
     if std::env::var_os("GRASPOPT_PARSE_ONLY").is_some_and(|v| v == "1") {
         return ExitCode::SUCCESS;

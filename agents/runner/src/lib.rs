@@ -10,6 +10,7 @@
 pub mod bench;
 pub mod config;
 pub mod embedded;
+pub mod ending;
 pub mod launch;
 pub mod open_files;
 pub mod record;

@@ -133,7 +133,7 @@ impl Journal {
 
     /// A read transaction, so that multi-statement reads see one snapshot even
     /// while another process writes.
-    fn read_tx(&self) -> Result<Transaction<'_>> {
+    pub(crate) fn read_tx(&self) -> Result<Transaction<'_>> {
         Ok(self.conn.unchecked_transaction()?)
     }
 
@@ -782,7 +782,7 @@ fn parse_state(s: &str) -> Result<TrialState> {
         .ok_or_else(|| JournalError::Schema(format!("unknown trial state {s:?} in the database")))
 }
 
-fn require_run(conn: &Connection, run_id: &str) -> Result<()> {
+pub(crate) fn require_run(conn: &Connection, run_id: &str) -> Result<()> {
     let mut stmt = conn.prepare_cached("SELECT 1 FROM runs WHERE run_id = ?1")?;
     if stmt.exists([run_id])? {
         Ok(())

@@ -17,6 +17,7 @@
 pub mod batch;
 mod error;
 pub mod export;
+mod failures;
 mod journal;
 pub mod output;
 mod rows;
@@ -25,6 +26,7 @@ mod types;
 
 pub use batch::{Write, Written};
 pub use error::{JournalError, Result};
+pub use failures::{FailureReason, NO_REASON};
 pub use journal::Journal;
 pub use schema::SCHEMA_VERSION;
 pub use types::{

@@ -8,6 +8,7 @@
 //!   payload prefixed by the [`WIRE_VERSION`].
 //! - [`layout`]: the fixed little-endian layout of contact clouds written straight into a
 //!   shared-memory sample (hand to metric agent on one host).
+//! - [`text`]: how the tools round the numbers a person reads.
 //!
 //! This crate knows the shape of the conversation, not the network: it has no Zenoh, no
 //! sockets, no files. `docs/protocol.md` describes the same scheme for agent writers.
@@ -17,6 +18,7 @@ pub mod codec;
 pub mod keys;
 pub mod layout;
 pub mod messages;
+pub mod text;
 
 pub use codec::{DecodeError, Encoding, Request, decode, decode_topic, encode};
 pub use keys::{AgentKind, Key, QueryKey, RunId, Runs, Topic};

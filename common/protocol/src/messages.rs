@@ -730,6 +730,9 @@ pub enum RunPhase {
     Waiting,
     Running,
     Finished,
+    /// Stopped before its end (Ctrl-C, SIGTERM): the journal records it stopped, and
+    /// `--resume` continues it. Added last, within wire version 3.
+    Stopped,
 }
 
 /// `name=value` for each parameter of a trial (5 decimals), joined by `sep`: how the

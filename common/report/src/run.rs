@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use graspopt_journal::{Journal, TrialRow};
 use graspopt_pictures::chart;
 use graspopt_protocol::named_params;
+use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
 use graspopt_trial::Evaluator;
 
@@ -85,18 +86,7 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
         .evaluator
         .evaluate(&best.params)
         .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
-    let words = match (&best.metrics, best.score) {
-        (Some(m), Some(s)) if m.force_closure => format!("score {s:.4}, force closure"),
-        (Some(_), Some(s)) => format!("score {s:.4}"),
-        _ => "no contact".to_string(),
-    };
-    let short: Vec<String> = folder.params.iter().map(|k| k.name().to_string()).collect();
-    let title = format!(
-        "run {}, best trial {} at {}: {words}",
-        folder.run,
-        best.trial_id,
-        named_params(&short, &best.params, ",")
-    );
+    let title = best_title(folder.run, best, folder.params);
     crate::trial::preview_image(folder.evaluator, &grasp, &title)?
         .save_png(&folder.out.join("best.png"))
 }
@@ -112,18 +102,34 @@ fn best_trial<'a>(done: &[&'a TrialRow]) -> Option<&'a TrialRow> {
     })
 }
 
+/// The title of `best.png`: `run "R": best trial N at x=..,y=..: score S, force closure`
+/// (the score rounded as a person reads it).
+fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
+    let words = match (&best.metrics, best.score) {
+        (Some(m), Some(s)) if m.force_closure => format!("score {}, force closure", rounded(s)),
+        (Some(_), Some(s)) => format!("score {}", rounded(s)),
+        _ => "no contact".to_string(),
+    };
+    let short: Vec<String> = params.iter().map(|k| k.name().to_string()).collect();
+    format!(
+        "run {run:?}: best trial {} at {}: {words}",
+        best.trial_id,
+        named_params(&short, &best.params, ",")
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use graspopt_journal::TrialState;
+    use graspopt_journal::{MetricValues, TrialState};
 
     fn trial(trial_id: u64, score: f64) -> TrialRow {
         TrialRow {
-            run_id: "r".into(),
+            run_id: "run".into(),
             trial_id,
             state: TrialState::Completed,
             attempts: 1,
-            params: vec![0.0, 0.0],
+            params: vec![0.01, -0.02],
             worker: "hand-1".into(),
             issued_ms: 0,
             lease_until_ms: 0,
@@ -152,5 +158,27 @@ mod tests {
         ];
         let done: Vec<&TrialRow> = rows.iter().collect();
         assert_eq!(best_trial(&done).map(|t| t.trial_id), Some(2));
+    }
+
+    #[test]
+    fn the_best_picture_s_title_names_the_run_and_rounds_the_score() {
+        let best = TrialRow {
+            metrics: Some(MetricValues {
+                rank: 6,
+                force_closure: true,
+                epsilon: 0.1,
+                volume: None,
+                distance: 0.2,
+                bw: 0.20025899065118113,
+            }),
+            contacts: 3,
+            fingers_in_contact: 3,
+            cloud_points: 30,
+            ..trial(12, 0.20025899065118113)
+        };
+        assert_eq!(
+            best_title("run", &best, &[ParamKind::Approach, ParamKind::Vertical]),
+            "run \"run\": best trial 12 at approach=0.01000,vertical=-0.02000: score 0.20026, force closure"
+        );
     }
 }

@@ -574,3 +574,26 @@ fn an_error_in_a_hands_settings_names_the_settings_file() {
     assert!(e.contains("grip.toml"), "{e}");
     assert!(e.contains("finger"), "{e}");
 }
+
+/// A mesh that is not there is named as the URDF writes it, where it was looked for
+/// (absolute, whatever the folder the URDF was loaded from) and why it cannot be read.
+#[test]
+fn a_missing_mesh_names_its_written_and_resolved_paths_and_the_system_s_reason() {
+    let scratch = tempfile::tempdir().unwrap();
+    let urdf = r#"<robot name="r"><link name="palm"><collision><geometry><mesh filename="meshes/palm.stl"/></geometry></collision></link></robot>"#;
+    std::fs::write(scratch.path().join("gripper.urdf"), urdf).unwrap();
+    let e = UrdfHand::from_file(&scratch.path().join("gripper.urdf"))
+        .unwrap_err()
+        .to_string();
+    let resolved = scratch.path().join("meshes/palm.stl");
+    assert!(resolved.is_absolute());
+    assert_eq!(
+        e,
+        format!(
+            "hand `{}`: link `palm`: cannot read the mesh `meshes/palm.stl` (looked for at `{}`): \
+             No such file or directory (os error 2)",
+            scratch.path().join("gripper.urdf").display(),
+            resolved.display()
+        )
+    );
+}

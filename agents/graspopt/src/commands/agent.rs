@@ -8,14 +8,15 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
-use graspopt_coordinator::{CoordinatorConfig, RunSpec};
+use graspopt_coordinator::{CoordinatorConfig, MAX_TRIALS, MAX_WAIT_MS, RunSpec};
 use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::RunId;
 use graspopt_runner::config::load;
+use graspopt_runner::ending::RunEnd;
 use graspopt_runner::signal::{shutdown_signal, until_signal};
 use graspopt_sim::ParamKind;
 
-use super::setup::{SimArgs, planner_method, sensing, trial_param};
+use super::setup::{SimArgs, count, planner_method, sensing, trial_param};
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -64,7 +65,7 @@ pub enum Kind {
         #[arg(long)]
         rotation_noise: Option<f64>,
         /// Seed of the estimate's noise (default 0).
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u64>(0, u64::MAX))]
         seed: Option<u64>,
     },
     /// Executes trials on the simulated hand.
@@ -75,7 +76,7 @@ pub enum Kind {
         #[arg(long)]
         hand: Option<String>,
         /// Minimum trial duration (milliseconds).
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u64>(0, u64::MAX))]
         trial_cost_ms: Option<u64>,
         /// Answer trials from recorded contact data (JSON lines, `graspopt record` writes
         /// them) instead of simulating.
@@ -117,7 +118,7 @@ pub enum Kind {
         #[arg(long)]
         journal: Option<PathBuf>,
         /// Number of trials (with --resume: raises the recorded budget).
-        #[arg(long, default_value_t = 60)]
+        #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
         trials: u64,
         /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
         #[arg(
@@ -133,14 +134,14 @@ pub enum Kind {
         method: PlannerMethod,
         /// Size of the initial design (space-filling, not model-based) (default: the
         /// engine's).
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
         initial: Option<u32>,
         /// Seed of the planner's random choices (the same seed proposes the same trials).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
         seed: u64,
         /// Lease of a trial: re-issued if no result comes within this time (milliseconds;
         /// default 30000).
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u64>(1, MAX_WAIT_MS))]
         lease_ms: Option<u64>,
         /// Continue the run recorded in the journal (its only run, unless --run names one),
         /// with its recorded settings. Without --resume, a run recorded with no trial (a
@@ -284,13 +285,12 @@ async fn run_async(args: &AgentArgs, explicit: &dyn Fn(&str) -> bool) -> Result<
                 shutdown_signal(),
             )
             .await?;
-            outln!("{}", serde_json::to_string(&status)?)?;
-            // 130: the shell's code for a command stopped by Ctrl-C.
-            Ok(if status.phase == graspopt_protocol::RunPhase::Finished {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(130)
-            })
+            let end = RunEnd::read(status, &c.journal_path(&run_id))?;
+            outln!("{}", end.json()?)?;
+            for line in end.lines(" (stopped)") {
+                eprintln!("coordinator: {line}");
+            }
+            Ok(ExitCode::from(end.exit_code()))
         }
     }
 }

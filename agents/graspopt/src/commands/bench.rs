@@ -10,7 +10,7 @@ use graspopt_protocol::PlannerMethod;
 use graspopt_runner::bench::coordinator::{BenchPath, CoordinatorSettings};
 use graspopt_runner::bench::{self, PipelineSettings};
 
-use super::setup::planner_method;
+use super::setup::{count, planner_method};
 use crate::out::outln;
 
 /// The most hand workers of one throughput run.
@@ -31,16 +31,16 @@ pub enum What {
     /// Throughput versus workers, and overhead per trial.
     Pipeline {
         /// Simulated trial cost for the throughput runs (milliseconds, at most 60000).
-        #[arg(long, default_value_t = 200)]
+        #[arg(long, default_value_t = 200, value_parser = count::<u64>(0, 60_000))]
         trial_cost_ms: u64,
         /// Trials per worker in the throughput runs (at least 1).
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = count::<u64>(1, MAX_MESSAGES as u64))]
         trials_per_worker: u64,
         /// Worker counts, each 1 to 256.
-        #[arg(long, default_value = "1,2,4", value_delimiter = ',')]
+        #[arg(long, default_value = "1,2,4", value_delimiter = ',', value_parser = count::<usize>(1, MAX_WORKERS as u64))]
         workers: Vec<usize>,
         /// Trials of the overhead run (at least 2: a cycle is the time between two).
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, value_parser = count::<u64>(2, MAX_MESSAGES as u64))]
         overhead_trials: u64,
         /// How the throughput runs propose trials: bo or random.
         #[arg(long, default_value = "random", value_parser = planner_method())]
@@ -53,11 +53,12 @@ pub enum What {
         #[arg(
             long,
             default_value = "1,2,4,8,16,32,64,128,256",
-            value_delimiter = ','
+            value_delimiter = ',',
+            value_parser = count::<usize>(1, MAX_WORKERS as u64)
         )]
         workers: Vec<usize>,
         /// Trials of each run (at least 1, at most 100000).
-        #[arg(long, default_value_t = 10_000)]
+        #[arg(long, default_value_t = 10_000, value_parser = count::<u64>(1, MAX_MESSAGES as u64))]
         trials: u64,
         /// Which coordinator: core (the I/O-free core and the journal), bus (the loop over
         /// an in-process Zenoh bus), or both.
@@ -68,13 +69,13 @@ pub enum What {
     /// engine path (engine grasp) in this thread: pin it to one core with `taskset -c 0`.
     Planner {
         /// Observations at the first timed round (1 to 100000).
-        #[arg(long, default_value_t = 2000)]
+        #[arg(long, default_value_t = 2000, value_parser = count::<usize>(1, MAX_BENCH_POINTS as u64))]
         observations: usize,
         /// Points pending in each round, and proposals per round (1 to 100000).
-        #[arg(long, default_value_t = 32)]
+        #[arg(long, default_value_t = 32, value_parser = count::<usize>(1, MAX_BENCH_POINTS as u64))]
         pending: usize,
         /// Timed rounds per dimension (1 to 1000).
-        #[arg(long, default_value_t = 9)]
+        #[arg(long, default_value_t = 9, value_parser = count::<usize>(1, 1000))]
         rounds: usize,
         /// Dimensions: 2 (Branin), 6 (Hartmann6) or both.
         #[arg(long, default_value = "2,6", value_delimiter = ',')]
@@ -83,10 +84,10 @@ pub enum What {
     /// Contact-cloud latency, shared memory versus Zenoh.
     Clouds {
         /// Points per message (at most 1000000).
-        #[arg(long, default_value_t = 10_000)]
+        #[arg(long, default_value_t = 10_000, value_parser = count::<usize>(0, MAX_POINTS as u64))]
         points: usize,
         /// Messages per path (1 to 100000).
-        #[arg(long, default_value_t = 300)]
+        #[arg(long, default_value_t = 300, value_parser = count::<usize>(1, MAX_MESSAGES as u64))]
         messages: usize,
     },
 }
@@ -99,33 +100,20 @@ fn bench_path() -> impl clap::builder::TypedValueParser<Value = BenchPath> {
     })
 }
 
-/// Checks every argument before anything runs.
+/// Checks what the flags' parsers cannot (each count's range is its parser's), before
+/// anything runs.
 fn validate(what: &What) -> Result<()> {
     match what {
-        What::Coordinator {
-            workers,
-            trials,
-            paths,
-        } => {
-            check_workers(workers)?;
-            if !(1..=MAX_MESSAGES as u64).contains(trials) {
-                bail!("--trials must be between 1 and {MAX_MESSAGES}, got {trials}");
-            }
+        What::Coordinator { paths, .. } => {
             if paths.is_empty() {
                 bail!("--paths: give core, bus or both");
             }
         }
         What::Pipeline {
-            trial_cost_ms,
             trials_per_worker,
             workers,
-            overhead_trials,
             ..
         } => {
-            check_workers(workers)?;
-            if *trials_per_worker < 1 {
-                bail!("--trials-per-worker must be at least 1, got {trials_per_worker}");
-            }
             let max_workers = workers.iter().copied().max().unwrap_or(1) as u64;
             if trials_per_worker.saturating_mul(max_workers) > MAX_MESSAGES as u64 {
                 bail!(
@@ -133,51 +121,13 @@ fn validate(what: &What) -> Result<()> {
                      {MAX_MESSAGES} trials in one run"
                 );
             }
-            if !(2..=MAX_MESSAGES as u64).contains(overhead_trials) {
-                bail!(
-                    "--overhead-trials must be between 2 and {MAX_MESSAGES}, got {overhead_trials}"
-                );
-            }
-            if *trial_cost_ms > 60_000 {
-                bail!("--trial-cost-ms must be at most 60000 (one minute), got {trial_cost_ms}");
-            }
         }
-        What::Planner {
-            observations,
-            pending,
-            rounds,
-            dims,
-        } => {
+        What::Planner { dims, .. } => {
             if dims.is_empty() || dims.iter().any(|d| *d != 2 && *d != 6) {
                 bail!("--dims: give 2, 6 or 2,6");
             }
-            for (flag, v) in [("--observations", observations), ("--pending", pending)] {
-                if !(1..=MAX_BENCH_POINTS).contains(v) {
-                    bail!("{flag} must be between 1 and {MAX_BENCH_POINTS}, got {v}");
-                }
-            }
-            if !(1..=1000).contains(rounds) {
-                bail!("--rounds must be between 1 and 1000, got {rounds}");
-            }
         }
-        What::Clouds { points, messages } => {
-            if *points > MAX_POINTS {
-                bail!("--points must be at most {MAX_POINTS}, got {points}");
-            }
-            if !(1..=MAX_MESSAGES).contains(messages) {
-                bail!("--messages must be between 1 and {MAX_MESSAGES}, got {messages}");
-            }
-        }
-    }
-    Ok(())
-}
-
-fn check_workers(workers: &[usize]) -> Result<()> {
-    if workers.is_empty() {
-        bail!("--workers: give at least one worker count");
-    }
-    if let Some(w) = workers.iter().find(|w| !(1..=MAX_WORKERS).contains(*w)) {
-        bail!("--workers: each count must be between 1 and {MAX_WORKERS}, got {w}");
+        What::Clouds { .. } => {}
     }
     Ok(())
 }

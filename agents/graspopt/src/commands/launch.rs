@@ -18,6 +18,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use graspopt_runner::ending::NO_TRIAL_COMPLETED;
 use graspopt_runner::launch::{Children, LaunchFile, Outcome, resume_coordinator, tail};
 
 use crate::out::outln;
@@ -76,7 +77,7 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
     // before it have started.
     for p in &plan {
         let argv = std::iter::once("graspopt").chain(p.args.iter().map(String::as_str));
-        if let Err(e) = <crate::Cli as clap::Parser>::try_parse_from(argv) {
+        if let Err(e) = crate::command().try_get_matches_from(argv) {
             let rendered = e.render().to_string();
             let why = rendered
                 .lines()
@@ -110,8 +111,13 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
         Outcome::Coordinator(Some(0), _) => Ok(ExitCode::SUCCESS),
         Outcome::Coordinator(code, log) => {
             let log = log.unwrap_or_default();
+            let what = if code == Some(i32::from(NO_TRIAL_COMPLETED)) {
+                "no trial of the run completed"
+            } else {
+                "the coordinator failed"
+            };
             eprintln!(
-                "graspopt launch: the coordinator failed; its log ({}):\n{}",
+                "graspopt launch: {what}; the coordinator's log ({}):\n{}",
                 log.display(),
                 tail(&log, 20)
             );

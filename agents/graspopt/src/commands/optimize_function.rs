@@ -8,6 +8,7 @@ use graspopt_bayesopt::benchmark::{Benchmark, REGRET_LEVELS};
 use graspopt_bayesopt::{Method, TestFunction};
 use serde_json::json;
 
+use super::setup::count;
 use crate::out::outln;
 
 /// The most seeds one command runs.
@@ -39,17 +40,17 @@ pub struct OptimizeFunctionArgs {
     /// (log form), michalewicz, ackley, levy or styblinskitang.
     pub function: String,
     /// Number of seeds, 1 to 1000 (seeds 0..N).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = count::<u64>(1, MAX_SEEDS))]
     pub seeds: u64,
     /// Evaluations per seed, 1 to 100000 (default: 50 in 2D, 100 otherwise).
-    #[arg(long)]
+    #[arg(long, value_parser = count::<usize>(1, MAX_BUDGET as u64))]
     pub budget: Option<usize>,
     /// Random initial points, at most the budget (default: 5 in 2D, 10 in 6D, otherwise 2 d;
     /// capped at the budget).
-    #[arg(long = "initial", alias = "init", value_name = "N")]
+    #[arg(long = "initial", alias = "init", value_name = "N", value_parser = count::<usize>(0, u64::MAX))]
     pub init: Option<usize>,
     /// Points proposed per round (parallel workers).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = count::<usize>(1, u64::MAX))]
     pub batch: usize,
     /// Method.
     #[arg(long, default_value = "bo", value_parser = method_parser())]
@@ -73,16 +74,6 @@ pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<std::process::ExitCode
     let budget = args
         .budget
         .unwrap_or_else(|| Benchmark::default_budget(function));
-    anyhow::ensure!(
-        (1..=MAX_SEEDS).contains(&args.seeds),
-        "--seeds must be between 1 and {MAX_SEEDS}, got {}",
-        args.seeds
-    );
-    anyhow::ensure!(
-        (1..=MAX_BUDGET).contains(&budget),
-        "--budget must be between 1 and {MAX_BUDGET}, got {budget}"
-    );
-    anyhow::ensure!(args.batch >= 1, "--batch must be at least 1");
     let n_init = match args.init {
         Some(n) => {
             anyhow::ensure!(

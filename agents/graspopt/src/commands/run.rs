@@ -10,14 +10,16 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::Args;
 use graspopt_bus::BusArgs;
-use graspopt_protocol::{PlannerMethod, RunPhase};
+use graspopt_protocol::PlannerMethod;
+use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
-use super::setup::{SimArgs, planner_method, sensing, trial_param};
+use super::setup::{SimArgs, count, planner_method, sensing, trial_param};
 use crate::out::outln;
-use graspopt_protocol::named_params;
+use graspopt_coordinator::{MAX_TRIALS, MAX_WAIT_MS};
+use graspopt_runner::ending::RunEnd;
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
 
 #[derive(Args, Debug, Clone)]
@@ -29,14 +31,14 @@ pub struct RunArgs {
     pub run: String,
     /// Number of simulated hand workers (0: none, the run waits for hands that attach to
     /// its endpoint, `--listen`, such as a real hand's agent).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = count::<usize>(0, u64::MAX))]
     pub workers: usize,
     /// What the simulated hands measure: clouds (contact clouds) or ft (fingertip
     /// force/torque readings; a hand with sensing fingertips, barrett_ft).
     #[arg(long, default_value = "clouds", value_parser = sensing())]
     pub sensing: graspopt_hand::Sensing,
     /// Number of trials.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
     pub trials: u64,
     /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
     #[arg(
@@ -52,11 +54,11 @@ pub struct RunArgs {
     #[arg(long, default_value = "bo", value_parser = planner_method())]
     pub method: PlannerMethod,
     /// Size of the initial design (space-filling, not model-based) (default: the engine's).
-    #[arg(long)]
+    #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
     pub initial: Option<u32>,
     /// Seed of the planner's random choices and of perception's noise (the same seed
     /// proposes the same trials).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub seed: u64,
     /// Results folder (default: results/<run>).
     #[arg(long)]
@@ -67,10 +69,10 @@ pub struct RunArgs {
     #[arg(long)]
     pub resume: bool,
     /// Minimum duration of a simulated trial, to model a robot (milliseconds).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub trial_cost_ms: u64,
     /// Lease of a trial: re-issued if no result comes within this time (milliseconds).
-    #[arg(long, default_value_t = 30_000)]
+    #[arg(long, default_value_t = 30_000, value_parser = count::<u64>(1, MAX_WAIT_MS))]
     pub lease_ms: u64,
     /// Perception's position error, standard deviation per axis (metres).
     #[arg(long, default_value_t = 0.0)]
@@ -145,8 +147,8 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
                     bar.set_position(s.completed + s.failed);
                     if let Some(b) = &s.best {
                         bar.set_message(format!(
-                            "best {:.4} (trial {}){}",
-                            b.score,
+                            "best {} (trial {}){}",
+                            rounded(b.score),
                             b.trial_id,
                             if b.force_closure == Some(true) {
                                 ", force closure"
@@ -171,34 +173,14 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
         evaluator: &e.evaluator,
     };
     graspopt_report::run::write_results(&folder, &status.object)?;
-    let stopped = status.phase != RunPhase::Finished;
-    outln!(
-        "run {:?}: {} trials completed, {} failed{}",
-        status.run_id,
-        status.completed,
-        status.failed,
-        if stopped {
-            format!(
-                " (stopped; continue with --resume --out {})",
-                e.out.display()
-            )
-        } else {
-            String::new()
-        }
-    )?;
-    if let Some(b) = &status.best {
-        outln!(
-            "best: trial {} score {} at {}",
-            b.trial_id,
-            b.score,
-            named_params(&status.param_names, &b.params, ",")
-        )?;
+    let end = RunEnd::read(status, &e.coordinator.journal)?;
+    let then = format!(
+        " (stopped; continue with --resume --out {})",
+        e.out.display()
+    );
+    for line in end.lines(&then) {
+        outln!("{line}")?;
     }
     outln!("results: {}", e.out.display())?;
-    // 130: the shell's code for a command stopped by Ctrl-C.
-    Ok(if stopped {
-        ExitCode::from(130)
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(ExitCode::from(end.exit_code()))
 }

@@ -14,7 +14,7 @@ use graspopt_sim::ParamKind;
 use graspopt_trial::scan::{Grid, grid_steps, scan_grid, worker_count};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::setup::SimArgs;
+use super::setup::{SimArgs, count};
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -38,7 +38,7 @@ pub struct ScanArgs {
     #[arg(long, default_value = "results/scan")]
     pub out: PathBuf,
     /// Worker threads (0: all cores).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<usize>(0, u64::MAX))]
     pub threads: usize,
 }
 

@@ -9,6 +9,7 @@ use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use graspopt_protocol::PlannerMethod;
+use graspopt_protocol::text::grouped;
 use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
@@ -74,6 +75,24 @@ fn frame() -> impl TypedValueParser<Value = ReferenceFrame> {
 /// `--params`: a trial parameter by any of its names ([`ParamKind::parse`]).
 pub fn trial_param() -> impl TypedValueParser<Value = ParamKind> {
     clap::builder::NonEmptyStringValueParser::new().try_map(|s| ParamKind::parse(&s))
+}
+
+/// A count flag (`--trials`, `--workers`, `--seeds`): a whole number from `min` to `max`
+/// (`u64::MAX`: no bound), anything else refused naming that range. Every flag takes a
+/// negative number as a value (see `main`), so `-5` is refused here too, not taken for a flag.
+pub fn count<T: TryFrom<u64> + Clone + Send + Sync + 'static>(
+    min: u64,
+    max: u64,
+) -> impl TypedValueParser<Value = T> {
+    clap::builder::NonEmptyStringValueParser::new().try_map(move |s| {
+        let range = match max {
+            u64::MAX => format!("of {} or more", grouped(min)),
+            _ => format!("from {} to {}", grouped(min), grouped(max)),
+        };
+        let whole = s.parse::<u64>().ok().filter(|v| (min..=max).contains(v));
+        let whole = whole.and_then(|v| T::try_from(v).ok());
+        whole.ok_or_else(|| format!("must be a whole number {range}"))
+    })
 }
 
 /// `--sensing`: what a hand measures, by name.

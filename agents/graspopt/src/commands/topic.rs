@@ -9,7 +9,9 @@ use clap::{Args, Subcommand};
 use graspopt_bus::{Bus, BusArgs};
 use graspopt_protocol::RunId;
 use graspopt_runner::signal::shutdown_signal;
-use graspopt_watch::topic::{self, EchoSettings, Format, Measure, RateSettings};
+use graspopt_watch::topic::{self, EchoSettings, Format, MIN_WINDOW, Measure, RateSettings};
+
+use super::setup::count;
 
 use crate::out::outln;
 
@@ -68,7 +70,7 @@ pub enum TopicCommand {
         #[arg(long, default_value = "text", value_parser = format_parser())]
         format: Format,
         /// Stop after this many messages.
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u64>(0, u64::MAX))]
         count: Option<u64>,
     },
     /// Message rate of a topic.
@@ -76,7 +78,7 @@ pub enum TopicCommand {
         #[command(flatten)]
         watch: Watch,
         /// Messages in the sliding window (at least 3: a rate needs two intervals).
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, value_parser = count::<usize>(MIN_WINDOW as u64, u64::MAX))]
         window: usize,
     },
     /// Bandwidth of a topic.
@@ -84,7 +86,7 @@ pub enum TopicCommand {
         #[command(flatten)]
         watch: Watch,
         /// Messages in the sliding window (at least 3: a rate needs two intervals).
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, value_parser = count::<usize>(MIN_WINDOW as u64, u64::MAX))]
         window: usize,
     },
 }

@@ -1,5 +1,6 @@
-//! Bad input to `graspopt` gets a clear error naming the flag and its value (exit 1), never a
-//! panic (101) or an abort (134), and loses nothing already recorded.
+//! Bad input to `graspopt` gets a clear error naming the flag and its value (exit 1; 2 for a
+//! value its flag's parser refuses, naming the range it accepts), never a panic (101) or an
+//! abort (134), and loses nothing already recorded.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -32,8 +33,13 @@ fn graspopt_within(args: &[&str], limit: Duration) -> Option<Output> {
 
 /// Asserts `out` is a refusal (exit 1, no panic) whose message holds every one of `expected`.
 fn assert_refused(out: &Output, args: &[&str], expected: &[&str]) {
+    assert_exit(out, args, 1, expected);
+}
+
+/// Asserts `out` exited with `code` (no panic) and its message holds every one of `expected`.
+fn assert_exit(out: &Output, args: &[&str], code: i32, expected: &[&str]) {
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     for e in expected {
         assert!(stderr.contains(e), "{args:?}: expected {e:?} in: {stderr}");
@@ -43,6 +49,14 @@ fn assert_refused(out: &Output, args: &[&str], expected: &[&str]) {
 fn refused(args: &[&str], expected: &[&str]) -> Output {
     let out = graspopt(args);
     assert_refused(&out, args, expected);
+    out
+}
+
+/// As [`refused`], for a value its flag's parser refuses, naming the range it accepts: a
+/// usage error (exit 2).
+fn usage_refused(args: &[&str], expected: &[&str]) -> Output {
+    let out = graspopt(args);
+    assert_exit(&out, args, 2, expected);
     out
 }
 
@@ -226,18 +240,20 @@ fn optimize_function_validates_initial_budget_and_seeds() {
         ],
         &["--initial 1000000000", "--budget 3"],
     );
-    refused(
+    usage_refused(
         &[
             "optimize-function",
             "branin",
             "--budget",
             "18446744073709551615",
         ],
-        &["--budget", "18446744073709551615"],
+        &[
+            "'18446744073709551615' for '--budget <BUDGET>': must be a whole number from 1 to 100,000",
+        ],
     );
-    refused(
+    usage_refused(
         &["optimize-function", "branin", "--seeds", "0"],
-        &["--seeds", "0"],
+        &["'0' for '--seeds <SEEDS>': must be a whole number from 1 to 1,000"],
     );
     // `--initial` is the flag (as in `graspopt run`), `--init` its alias.
     for flag in ["--initial", "--init"] {
@@ -267,14 +283,14 @@ fn optimize_function_validates_initial_budget_and_seeds() {
 
 #[test]
 fn bench_validates_every_argument_before_running() {
-    let out = refused(
+    let out = usage_refused(
         &["bench", "clouds", "--points", "100", "--messages", "0"],
-        &["--messages", "0"],
+        &["'0' for '--messages <MESSAGES>': must be a whole number from 1 to 100,000"],
     );
     assert!(out.stdout.is_empty());
-    refused(
+    usage_refused(
         &["bench", "clouds", "--points", "18446744073709551615"],
-        &["--points", "18446744073709551615"],
+        &["--points <POINTS>': must be a whole number from 0 to 1,000,000"],
     );
     // The 1-worker case must not run before the 0 is refused.
     for workers in ["1,0", "0", "1,100000"] {
@@ -289,29 +305,36 @@ fn bench_validates_every_argument_before_running() {
             "1",
         ];
         let out = graspopt_within(&args, Duration::from_secs(60)).expect("bench pipeline hung");
-        assert_refused(&out, &args, &["--workers"]);
+        assert_exit(
+            &out,
+            &args,
+            2,
+            &["--workers <WORKERS>': must be a whole number from 1 to 256"],
+        );
         assert!(
             out.stdout.is_empty(),
             "{args:?} ran before refusing: {}",
             String::from_utf8_lossy(&out.stdout)
         );
     }
-    refused(
+    usage_refused(
         &["bench", "pipeline", "--overhead-trials", "1"],
-        &["--overhead-trials", "1"],
+        &[
+            "'1' for '--overhead-trials <OVERHEAD_TRIALS>': must be a whole number from 2 to 100,000",
+        ],
     );
 }
 
 #[test]
 fn bench_planner_validates_its_arguments_and_prints_one_row_per_dimension() {
     refused(&["bench", "planner", "--dims", "3"], &["--dims"]);
-    refused(
+    usage_refused(
         &["bench", "planner", "--pending", "0"],
-        &["--pending", "got 0"],
+        &["'0' for '--pending <PENDING>': must be a whole number from 1 to 100,000"],
     );
-    refused(
+    usage_refused(
         &["bench", "planner", "--rounds", "0"],
-        &["--rounds", "got 0"],
+        &["'0' for '--rounds <ROUNDS>': must be a whole number from 1 to 1,000"],
     );
     // Past the engine's model cap (150), small enough to be quick.
     let out = graspopt(&[
@@ -339,11 +362,11 @@ fn bench_planner_validates_its_arguments_and_prints_one_row_per_dimension() {
 
 #[test]
 fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
-    refused(
+    usage_refused(
         &["bench", "coordinator", "--trials", "0"],
-        &["--trials", "got 0"],
+        &["'0' for '--trials <TRIALS>': must be a whole number from 1 to 100,000"],
     );
-    refused(
+    usage_refused(
         &[
             "bench",
             "coordinator",
@@ -352,7 +375,7 @@ fn bench_coordinator_validates_its_arguments_and_prints_one_row_per_run() {
             "--trials",
             "5",
         ],
-        &["--workers", "got 300"],
+        &["'300' for '--workers <WORKERS>': must be a whole number from 1 to 256"],
     );
     // Clap refuses an unknown path itself (exit code 2).
     let out = graspopt(&["bench", "coordinator", "--paths", "disk"]);
@@ -395,7 +418,9 @@ fn experiment_metrics_refuses_fewer_than_two_steps() {
     let dir = tempdir("metrics-steps");
     let out_dir = dir.join("out");
     let o = out_dir.to_str().unwrap();
-    refused(
+    let steps = "'--steps <STEPS>': must be a whole number from 2 to 100,000";
+    let steps_2d = "'--steps-2d <STEPS_2D>': must be a whole number from 2 to 3,000";
+    usage_refused(
         &[
             "experiment",
             "metrics",
@@ -406,19 +431,19 @@ fn experiment_metrics_refuses_fewer_than_two_steps() {
             "--out",
             o,
         ],
-        &["--steps", "got 0"],
+        &[steps],
     );
-    refused(
+    usage_refused(
         &["experiment", "metrics", "--steps", "1", "--out", o],
-        &["--steps", "got 1"],
+        &[steps],
     );
-    refused(
+    usage_refused(
         &["experiment", "metrics", "--steps-2d", "1", "--out", o],
-        &["--steps-2d", "got 1"],
+        &[steps_2d],
     );
-    refused(
+    usage_refused(
         &["experiment", "metrics", "--steps-2d", "100000", "--out", o],
-        &["--steps-2d", "got 100000"],
+        &[steps_2d],
     );
     assert!(!out_dir.exists(), "a refused experiment wrote {o}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -507,7 +532,12 @@ fn topic_rate_windows_below_three_messages_are_refused() {
             "--no-multicast-scouting",
         ];
         let out = graspopt_within(&args, Duration::from_secs(30)).expect("topic hung");
-        assert_refused(&out, &args, &["--window", "got 0"]);
+        assert_exit(
+            &out,
+            &args,
+            2,
+            &["'--window <WINDOW>': must be a whole number of 3 or more"],
+        );
     }
 }
 

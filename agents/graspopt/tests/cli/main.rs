@@ -8,6 +8,7 @@ mod doc_facts;
 mod docs_figures_cli;
 mod experiment_report_cli;
 mod forces_cli;
+mod messages_cli;
 mod pipe_cli;
 mod quality_cli;
 mod ranges_cli;

@@ -386,7 +386,10 @@ fn experiment_bo_bad_input_is_named() {
             vec!["--steps", "5,100000"],
             "each count must be between 2 and 1000",
         ),
-        (vec!["--seeds", "0"], "--seeds must be between 1 and 1000"),
+        (
+            vec!["--seeds", "0"],
+            "'--seeds <SEEDS>': must be a whole number from 1 to 1,000",
+        ),
         (
             vec!["--first-seed", "18446744073709551615"],
             "--first-seed + --seeds must stay below 2^64",
@@ -405,7 +408,7 @@ fn experiment_bo_bad_input_is_named() {
         ),
         (
             vec!["--workers", "0"],
-            "--workers must be between 1 and 256, got 0",
+            "'--workers <WORKERS>': must be a whole number from 1 to 256",
         ),
     ] {
         let mut all = vec!["experiment", "bo", "--out", dir.to_str().unwrap()];

@@ -79,6 +79,7 @@ pub(crate) fn phase_name(p: RunPhase) -> &'static str {
         RunPhase::Waiting => "waiting",
         RunPhase::Running => "running",
         RunPhase::Finished => "finished",
+        RunPhase::Stopped => "stopped",
     }
 }
 
@@ -140,8 +141,10 @@ pub fn run_lines(name: &str, view: &RunView, now: Instant) -> Vec<String> {
                 None => "",
             };
             out.push(format!(
-                "best: trial {} score {:.5} at {}{fc}",
-                b.trial_id, b.score, params
+                "best: trial {} score {} at {}{fc}",
+                b.trial_id,
+                graspopt_protocol::text::rounded(b.score),
+                params
             ));
             if let Some(f) = &s.best_forces {
                 out.push(format!("best's forces: {}", f.describe()));

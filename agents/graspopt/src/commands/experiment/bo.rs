@@ -17,9 +17,10 @@ use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use graspopt_bayesopt::Preset;
-use graspopt_experiment::bo_study::{BoRequest, BoStudy, ModelCapChoice, Part};
+use graspopt_experiment::bo_study::{BoRequest, BoStudy, MAX_BUDGET, MAX_SEEDS, MAX_WORKERS};
+use graspopt_experiment::bo_study::{ModelCapChoice, Part};
 
-use crate::commands::setup::contact_model;
+use crate::commands::setup::{contact_model, count};
 use crate::out::outln;
 use graspopt_sim::ContactModel;
 
@@ -32,16 +33,16 @@ pub struct BoArgs {
     #[arg(long, default_value = "barrett")]
     pub hand: String,
     /// Seeds per method and object.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = count::<u64>(1, MAX_SEEDS))]
     pub seeds: u64,
     /// The first seed (seeds run from it upwards).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub first_seed: u64,
     /// Trials per 2D run (the thesis compared over 100).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = count::<usize>(1, MAX_BUDGET as u64))]
     pub budget: usize,
     /// Trials per 6D run.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = count::<usize>(1, MAX_BUDGET as u64))]
     pub budget_6d: usize,
     /// Grid of the 2D reference scan, approach x vertical (the thesis's 2,211 points); one
     /// count is used for both axes, as in `graspopt scan`.
@@ -65,13 +66,13 @@ pub struct BoArgs {
     pub model_cap: ModelCapChoice,
     /// Trials in flight in the 2D and 6D runs (1: one at a time, as the thesis; W: the engine
     /// proposes each trial with the other W - 1 pending).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = count::<usize>(1, MAX_WORKERS as u64))]
     pub workers: usize,
     /// Contact model scored: surface, patch or mean.
     #[arg(long, default_value = "surface", value_parser = contact_model())]
     pub contacts: ContactModel,
     /// Worker threads (0: all cores).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<usize>(0, u64::MAX))]
     pub threads: usize,
 }
 

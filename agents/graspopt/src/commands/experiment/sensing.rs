@@ -7,6 +7,7 @@ use clap::Args;
 use graspopt_experiment::sensing_study::{SensingStudySettings, markdown_table, round_trip};
 use graspopt_sensing::SensorNoise;
 
+use crate::commands::setup::count;
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -15,7 +16,7 @@ pub struct SensingArgs {
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     trials: u32,
     /// Seed of the trials and the noise.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     seed: u64,
     /// Force resolution of the noisy run (N; default 1/320, an ATI Nano17's).
     #[arg(long)]

@@ -43,6 +43,7 @@ impl UrdfHand {
                     })?;
                     LinkShape::Mesh {
                         mesh: load_link_mesh(
+                            &filename,
                             &resolve_mesh(&filename, dir),
                             scale,
                             link,

@@ -700,10 +700,30 @@ fn resolve_mesh(filename: &str, dir: &Path) -> PathBuf {
     dir.join(filename)
 }
 
-/// Loads a link mesh (OBJ or STL, scaled) as the triangle mesh of its convex hull.
-fn load_link_mesh(path: &Path, scale: [f64; 3], link: &str, file: &str) -> Result<TriangleMesh> {
+/// Loads a link mesh (OBJ or STL, scaled) as the triangle mesh of its convex hull. `written`
+/// is its file name as the URDF gives it, `path` where it was looked for: a file that cannot
+/// be read is named both ways (absolute), with the system's reason.
+fn load_link_mesh(
+    written: &str,
+    path: &Path,
+    scale: [f64; 3],
+    link: &str,
+    file: &str,
+) -> Result<TriangleMesh> {
     let shown = path.display().to_string();
-    let m = mesh::read(path).map_err(|e| bad(file, format!("link `{link}`: {e}")))?;
+    let m = mesh::read(path).map_err(|e| match e {
+        SimError::Io { source, .. } => {
+            let resolved = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+            bad(
+                file,
+                format!(
+                    "link `{link}`: cannot read the mesh `{written}` (looked for at `{}`): {source}",
+                    resolved.display()
+                ),
+            )
+        }
+        e => bad(file, format!("link `{link}`: {e}")),
+    })?;
     let points: Vec<Point3<f64>> = m
         .vertices
         .iter()
