@@ -179,7 +179,7 @@ fn a_stopped_run_resumes_with_the_command_it_prints() {
     // The id reads as a name in messages.
     assert!(stdout.contains("run \"stopme\": "), "{stdout}");
     assert!(
-        text.contains("run \"stopme\": 12 trials completed"),
+        text.contains("run \"stopme\": 12 of 12 trials completed"),
         "{text}"
     );
 
@@ -443,4 +443,41 @@ fn a_run_of_a_hand_from_a_file_resumes_from_another_folder() {
     );
     assert!(again.status.success(), "{again:?}");
     check_journal(&out.join("journal.sqlite"), "run", 6);
+}
+
+/// `graspopt run --workers 0` waits for a hand to attach; stopped by Ctrl-C before any came,
+/// it says that the same command starts it afresh (not to resume it: there is nothing to
+/// resume), and exits as stopped.
+#[test]
+fn a_run_stopped_before_its_first_trial_says_the_same_command_starts_it_afresh() {
+    let dir = tempdir("workers0");
+    let out = dir.join("results");
+    let shm = format!("gpe2e_w0_{}_", std::process::id());
+    let run = Proc::start(
+        "run",
+        &[
+            "run",
+            "--workers",
+            "0",
+            "--trials",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+            "--shm-prefix",
+            &shm,
+        ],
+        &dir,
+    );
+    wait_until(
+        "the run announces its endpoint",
+        Duration::from_secs(60),
+        || crate::support::log(&dir, "run").contains("(attach with --connect)"),
+    );
+    signal(&run, "INT");
+    let (status, stdout) = run.wait_output(Duration::from_secs(60));
+    assert_eq!(status.code(), Some(130), "{stdout}");
+    assert!(
+        stdout.contains("(stopped before its first trial: the same command starts it afresh)"),
+        "{stdout}"
+    );
 }

@@ -174,10 +174,15 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     };
     graspopt_report::run::write_results(&folder, &status.object)?;
     let end = RunEnd::read(status, &e.coordinator.journal)?;
-    let then = format!(
-        " (stopped; continue with --resume --out {})",
-        e.out.display()
-    );
+    let s = &end.status;
+    let then = if s.completed + s.failed + s.running == 0 {
+        " (stopped before its first trial: the same command starts it afresh)".to_string()
+    } else {
+        format!(
+            " (stopped; continue with --resume --out {})",
+            e.out.display()
+        )
+    };
     for line in end.lines(&then) {
         outln!("{line}")?;
     }
