@@ -191,51 +191,64 @@ fn frame(f: &Frame) -> (Image, Plot) {
         y: f.y.1,
     };
     draw_text_centred(&mut img, width / 2, MARGIN, f.title, title_scale);
-    // The box, one pixel outside the plot.
-    for x in left - 1..=left + pw {
+    draw_axes(&mut img, &plot, &x_ticks, &y_ticks);
+    draw_text_centred(&mut img, left + pw / 2, x_label_y, f.x.0, 1);
+    let y_label_bottom = top + ph / 2 + width_of(f.y.0) / 2;
+    draw_text_up(&mut img, (MARGIN, y_label_bottom), f.y.0);
+    draw_legend(&mut img, legend_y, f.notes, f.missing);
+    (img, plot)
+}
+
+/// The box one pixel outside `plot`, and its ticks with their values.
+fn draw_axes(img: &mut Image, plot: &Plot, x_ticks: &[(f64, String)], y_ticks: &[(f64, String)]) {
+    let Plot {
+        left,
+        top,
+        width,
+        height,
+        ..
+    } = *plot;
+    for x in left - 1..=left + width {
         img.set(x, top - 1, TEXT_COLOUR);
-        img.set(x, top + ph, TEXT_COLOUR);
+        img.set(x, top + height, TEXT_COLOUR);
     }
-    for y in top - 1..=top + ph {
+    for y in top - 1..=top + height {
         img.set(left - 1, y, TEXT_COLOUR);
-        img.set(left + pw, y, TEXT_COLOUR);
+        img.set(left + width, y, TEXT_COLOUR);
     }
-    for (v, text) in &x_ticks {
+    let width_of = |t: &str| i64::from(text_width(t, 1));
+    for (v, text) in x_ticks {
         let x = plot.px(*v).round() as i64;
-        for y in top + ph..top + ph + TICK {
+        for y in top + height..top + height + TICK {
             img.set(x, y, TEXT_COLOUR);
         }
-        let at = (x - width_of(text) / 2, top + ph + TICK + 2);
-        draw_text(&mut img, at, text, 1, TEXT_COLOUR);
+        let at = (x - width_of(text) / 2, top + height + TICK + 2);
+        draw_text(img, at, text, 1, TEXT_COLOUR);
     }
-    for (v, text) in &y_ticks {
+    for (v, text) in y_ticks {
         let y = plot.py(*v).round() as i64;
         for x in left - 1 - TICK..left - 1 {
             img.set(x, y, TEXT_COLOUR);
         }
         let at = (left - 1 - TICK - 2 - width_of(text), y - GLYPH / 2);
-        draw_text(&mut img, at, text, 1, TEXT_COLOUR);
+        draw_text(img, at, text, 1, TEXT_COLOUR);
     }
-    draw_text_centred(&mut img, left + pw / 2, x_label_y, f.x.0, 1);
-    draw_text_up(
-        &mut img,
-        (MARGIN, top + ph / 2 + width_of(f.y.0) / 2),
-        f.y.0,
-    );
-    for (k, note) in f.notes.iter().enumerate() {
-        let y = legend_y + k as i64 * LINE;
-        draw_text(&mut img, (MARGIN, y), note, 1, TEXT_COLOUR);
+}
+
+/// The notes, one a line from row `y`, then the grey square and what it means.
+fn draw_legend(img: &mut Image, y: i64, notes: &[&str], missing: Option<&str>) {
+    for (k, note) in notes.iter().enumerate() {
+        draw_text(img, (MARGIN, y + k as i64 * LINE), note, 1, TEXT_COLOUR);
     }
-    if let Some(missing) = f.missing {
-        let y = legend_y + f.notes.len() as i64 * LINE;
+    if let Some(missing) = missing {
+        let y = y + notes.len() as i64 * LINE;
         for dy in 0..8 {
             for dx in 0..8 {
                 img.set(MARGIN + dx, y + dy, MISSING_COLOUR);
             }
         }
-        draw_text(&mut img, (MARGIN + 12, y), missing, 1, TEXT_COLOUR);
+        draw_text(img, (MARGIN + 12, y), missing, 1, TEXT_COLOUR);
     }
-    (img, plot)
 }
 
 /// The cell edges of `n` cells centred on values spanning `values`' range (evenly spaced).

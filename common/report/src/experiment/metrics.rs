@@ -41,40 +41,7 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         hand_description(&study.hand)?,
     );
 
-    // 4.3-4.5: LS, GWV, BW along the approach axis.
-    report.push_str(
-        "## Figures 4.3-4.5: LS, GWV and BW along the approach axis (mean-point contacts)\n\n",
-    );
-    report.push_str("| object | force-closure range (LS > 0) | range where BW is defined (hand touches) | BW max at | files |\n|---|---|---|---|---|\n");
-    for (fig, object) in APPROACH_FIGURES {
-        let m = study.approach_metrics(object)?;
-        let xs = &m.scan.axes[0];
-        let mut csv = String::from("approach,ls,gwv,bw,force_closure,contacts\n");
-        for (p, ((l, g), b)) in m.scan.points.iter().zip(m.ls.iter().zip(&m.gwv).zip(&m.bw)) {
-            let fc = p.score.metrics.is_some_and(|m| m.force_closure);
-            let _ = writeln!(csv, "{},{l},{g},{b},{fc},{}", p.params[0], p.score.contacts);
-        }
-        let mut files = vec![write(dir, &format!("fig{fig}-{object}.csv"), &csv)?];
-        for (name, ys) in [("ls", &m.ls), ("gwv", &m.gwv), ("bw", &m.bw)] {
-            let title = format!("Fig. {fig}: {} on the {object}", name.to_uppercase());
-            let plot = if name == "bw" {
-                // BW is not defined where the hand touches nothing: grey ticks there.
-                let bw: Vec<Option<f64>> = m.scan.points.iter().map(touched).collect();
-                chart::scan_plot(&title, APPROACH, "BW", xs, &[("", bw)])
-            } else {
-                chart::line_plot(&title, APPROACH, &name.to_uppercase(), xs, ys)
-            };
-            files.push(write(dir, &format!("fig{fig}-{object}-{name}.svg"), &plot)?);
-        }
-        let _ = writeln!(
-            report,
-            "| {object} | {:.0} mm | {:.0} mm | {:.3} | {} |",
-            m.force_closure_range * 1e3,
-            m.touched_range * 1e3,
-            m.bw_max_at,
-            files.join(", ")
-        );
-    }
+    approach_section(dir, study, &mut report)?;
 
     // 4.6: contact models.
     report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n");
@@ -148,6 +115,46 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
     let path = dir.join("report.md");
     std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
     Ok(path)
+}
+
+/// Figures 4.3-4.5: LS, GWV and BW along the approach axis of three objects, a CSV and three
+/// plots each, and their table in `report`.
+fn approach_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
+    // 4.3-4.5: LS, GWV, BW along the approach axis.
+    report.push_str(
+        "## Figures 4.3-4.5: LS, GWV and BW along the approach axis (mean-point contacts)\n\n",
+    );
+    report.push_str("| object | force-closure range (LS > 0) | range where BW is defined (hand touches) | BW max at | files |\n|---|---|---|---|---|\n");
+    for (fig, object) in APPROACH_FIGURES {
+        let m = study.approach_metrics(object)?;
+        let xs = &m.scan.axes[0];
+        let mut csv = String::from("approach,ls,gwv,bw,force_closure,contacts\n");
+        for (p, ((l, g), b)) in m.scan.points.iter().zip(m.ls.iter().zip(&m.gwv).zip(&m.bw)) {
+            let fc = p.score.metrics.is_some_and(|m| m.force_closure);
+            let _ = writeln!(csv, "{},{l},{g},{b},{fc},{}", p.params[0], p.score.contacts);
+        }
+        let mut files = vec![write(dir, &format!("fig{fig}-{object}.csv"), &csv)?];
+        for (name, ys) in [("ls", &m.ls), ("gwv", &m.gwv), ("bw", &m.bw)] {
+            let title = format!("Fig. {fig}: {} on the {object}", name.to_uppercase());
+            let plot = if name == "bw" {
+                // BW is not defined where the hand touches nothing: grey ticks there.
+                let bw: Vec<Option<f64>> = m.scan.points.iter().map(touched).collect();
+                chart::scan_plot(&title, APPROACH, "BW", xs, &[("", bw)])
+            } else {
+                chart::line_plot(&title, APPROACH, &name.to_uppercase(), xs, ys)
+            };
+            files.push(write(dir, &format!("fig{fig}-{object}-{name}.svg"), &plot)?);
+        }
+        let _ = writeln!(
+            report,
+            "| {object} | {:.0} mm | {:.0} mm | {:.3} | {} |",
+            m.force_closure_range * 1e3,
+            m.touched_range * 1e3,
+            m.bw_max_at,
+            files.join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// The best point of a variant's scan.
