@@ -278,3 +278,70 @@ fn the_routers_access_list_lets_each_role_publish_what_the_key_table_says() {
     assert!(missing.is_empty(), "router.json5 lacks rules: {missing:#?}");
     assert!(extra.is_empty(), "router.json5 allows too much: {extra:#?}");
 }
+
+/// A failed login to the secure router is said as one: no credentials (a peer or a client
+/// without `transport.auth.usrpwd`) or a wrong password, for an agent and for a watcher,
+/// naming the endpoint and what to check, without Zenoh's source-file paths. An address
+/// where nothing listens is still "nothing answers".
+#[test]
+fn a_failed_login_says_that_authentication_failed() {
+    let c = Cluster::start_with("secure-login", "sec-login", router_config);
+    let wrong = c.dir.join("wrong-hand.json5");
+    let text = std::fs::read_to_string(secure("hand.json5")).unwrap();
+    std::fs::write(&wrong, text.replace("change-me-hand", "guess")).unwrap();
+    let wrong = wrong.to_str().unwrap().to_string();
+    let ep = c.endpoint.as_str();
+    for (args, user) in [
+        // A wrong password, in client mode: an agent and a watcher.
+        (
+            vec![
+                "agent",
+                "hand",
+                "--run",
+                "r",
+                "--zenoh-config",
+                &wrong,
+                "--connect",
+                ep,
+            ],
+            "user \"hand\"",
+        ),
+        (
+            vec!["topic", "list", "--zenoh-config", &wrong, "--connect", ep],
+            "user \"hand\"",
+        ),
+        // No credentials at all: a watcher as a peer, and an agent as a client.
+        (
+            vec!["topic", "list", "--connect", ep],
+            "gives no user name and password",
+        ),
+        (
+            vec![
+                "agent",
+                "planner",
+                "--run",
+                "r",
+                "--mode",
+                "client",
+                "--connect",
+                ep,
+            ],
+            "gives no user name and password",
+        ),
+    ] {
+        let out = crate::support::graspopt(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        for part in [
+            &format!("authentication failed at {ep}"),
+            user,
+            "transport.auth.usrpwd",
+            "credentials dictionary",
+        ] {
+            assert!(stderr.contains(part), "{args:?}: {part:?} not in {stderr}");
+        }
+        for not in [".rs:", "Unable to connect", "nothing answers"] {
+            assert!(!stderr.contains(not), "{args:?}: {not:?} in {stderr}");
+        }
+    }
+}

@@ -90,9 +90,11 @@ fn given(matches: Option<&ArgMatches>, name: &str) -> bool {
 /// `RUST_LOG=zenoh=debug` shows them. Two more Zenoh messages are silenced: "sending on a
 /// closed channel" from a subscriber whose receiver a stopping agent already dropped (most
 /// Ctrl-Cs printed it), and "Unable to find transport for link event" from its admin space
-/// when a link closes; neither says anything a user can act on.
+/// when a link closes; neither says anything a user can act on. Nor do its errors of a
+/// session refused by a router (a failed login): graspopt says `authentication failed`.
 const DEFAULT_LOG: &str = "warn,zenoh::net::runtime::orchestrator=error,\
-                           zenoh::api::handlers::fifo=off,zenoh::api::admin=error";
+                           zenoh::api::handlers::fifo=off,zenoh::api::admin=error,\
+                           zenoh_transport::unicast::establishment::open=off";
 
 /// mimalloc, not glibc's malloc. Every agent allocates each contact cloud it builds or reads
 /// (10,000 points: three vectors of 187 KB) on one thread and frees it on another. glibc gave

@@ -27,6 +27,10 @@ pub enum BusError {
     NoResponder { key: String },
     #[error("{key} replied with an error: {detail}")]
     ReplyError { key: String, detail: String },
+    /// None of the endpoints the session connects to was reached: why (nothing answers, a
+    /// host name that does not resolve, a router that refused the login).
+    #[error("{0}")]
+    Unreached(String),
 }
 
 impl From<graspopt_shm::ShmError> for BusError {

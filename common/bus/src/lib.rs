@@ -8,6 +8,8 @@
 //!   they are never dropped under congestion. Payloads that do not decode are handed to the
 //!   caller as errors (to count and log), never acted on.
 //! - [`alive`]: liveliness tokens and watching who is alive.
+//! - `reach`: whether a session reached the endpoints it connects to, and if not, why (a
+//!   router that refused the login among them).
 //! - [`inbox`]: accepting the messages of one run, counting and logging the bad ones.
 //! - [`clouds`]: the contact-cloud channel: iceoryx2 shared memory when a metric agent listens
 //!   on the same host, Zenoh otherwise, chosen per message.
@@ -18,6 +20,7 @@ pub mod args;
 pub mod clouds;
 pub mod error;
 pub mod inbox;
+mod reach;
 pub mod session;
 mod task;
 
@@ -26,6 +29,7 @@ pub use args::{BusArgs, BusMode};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
 pub use error::BusError;
 pub use inbox::Inbox;
+pub use reach::{REACH_GRACE, REACH_REMINDER};
 pub use session::{
     Bus, Incoming, LoopbackSessions, RawSample, RawSubscription, Received, Server, Subscription,
     host_name, protocol_encoding, zenoh_encoding,

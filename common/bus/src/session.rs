@@ -13,6 +13,7 @@ use zenoh::qos::CongestionControl;
 use zenoh::query::{Query, Queryable};
 use zenoh::sample::Sample;
 
+use crate::reach::{Target, linked, watch_reach};
 use crate::{BusArgs, BusError};
 
 /// The protocol encoding as a Zenoh encoding.
@@ -38,6 +39,8 @@ pub struct Bus {
     /// (`--connect` endpoints, multicast scouting or a configuration file): a session that
     /// only listens (the embedded run) was just made and holds no other agents yet.
     reaches_out: bool,
+    /// Where it connects, and who it logs in as there.
+    target: Target,
 }
 
 impl std::fmt::Debug for Bus {
@@ -98,9 +101,27 @@ impl Bus {
         Bus::open(&args).await
     }
 
-    /// Opens a session from the flags.
+    /// Opens a session from the flags. A client refused by the router it connects to (a
+    /// failed login: Zenoh says only "Unable to connect") is [`BusError::Unreached`], saying
+    /// so.
     pub async fn open(args: &BusArgs) -> Result<Bus, BusError> {
+        Bus::open_with(args, true).await
+    }
+
+    /// A session for a tool that watches the bus (`topic`, `monitor`): no shared memory and,
+    /// when `quiet`, no warnings in the background about endpoints that do not answer: a
+    /// command that ends soon says so itself ([`Bus::check_linked`]).
+    pub async fn open_watcher(args: &BusArgs, quiet: bool) -> Result<Bus, BusError> {
+        let args = BusArgs {
+            no_shm: true,
+            ..args.clone()
+        };
+        Bus::open_with(&args, !quiet).await
+    }
+
+    async fn open_with(args: &BusArgs, warn_reach: bool) -> Result<Bus, BusError> {
         let config = args.zenoh_config()?;
+        let target = Target::of(&config, args.zenoh_config.as_deref());
         let shm = if args.no_shm {
             None
         } else {
@@ -120,14 +141,19 @@ impl Bus {
                 .map_err(|e| BusError::Config(format!("--shm-prefix: {e}")))?;
             Some(config)
         };
-        let session = zenoh::open(config)
-            .await
-            .map_err(|e| BusError::zenoh("opening the session", e))?;
+        let session = match zenoh::open(config).await {
+            Ok(session) => session,
+            // A client that reaches none of its endpoints fails at once: say why.
+            Err(e) if e.to_string().contains("Unable to connect") => {
+                return Err(BusError::Unreached(target.why_unreached().await));
+            }
+            Err(e) => return Err(BusError::zenoh("opening the session", e)),
+        };
         // A peer does not fail when its `--connect` endpoints are unreachable: Zenoh keeps
         // trying in the background, in silence. Say which cannot be reached, and when they
         // are.
-        if !args.connect.is_empty() && args.mode != Some(crate::BusMode::Client) {
-            tokio::spawn(watch_reach(session.clone(), args.connect.clone()));
+        if warn_reach && !args.connect.is_empty() && args.mode != Some(crate::BusMode::Client) {
+            tokio::spawn(watch_reach(session.clone(), target.clone()));
         }
         // Resources of processes that died under this prefix (a killed worker).
         if let Some(config) = &shm
@@ -142,7 +168,18 @@ impl Bus {
             reaches_out: !args.connect.is_empty()
                 || args.multicast_scouting()
                 || args.zenoh_config.is_some(),
+            target,
         })
+    }
+
+    /// Ok when the session holds a link, or connects nowhere (it meets others by multicast
+    /// or as they connect to it); else [`BusError::Unreached`], naming the endpoints and why
+    /// (nothing answers, a name that does not resolve, a router that refused the login).
+    pub async fn check_linked(&self) -> Result<(), BusError> {
+        if self.target.endpoints.is_empty() || self.is_linked().await {
+            return Ok(());
+        }
+        Err(BusError::Unreached(self.target.why_unreached().await))
     }
 
     pub fn session(&self) -> &Session {
@@ -338,86 +375,6 @@ impl Bus {
             .close()
             .await
             .map_err(|e| BusError::zenoh("closing the session", e))
-    }
-}
-
-/// How long a process waits for its `--connect` endpoints before saying it cannot reach them.
-pub const REACH_GRACE: Duration = Duration::from_secs(3);
-/// How often it says so again while Zenoh keeps trying (every 1 to 4 s, in the background).
-pub const REACH_REMINDER: Duration = Duration::from_secs(15);
-
-/// Whether the session holds a link to a router or peer.
-async fn linked(session: &Session) -> bool {
-    let info = session.info();
-    info.routers_zid().await.next().is_some() || info.peers_zid().await.next().is_some()
-}
-
-/// Warns, [`REACH_GRACE`] after the session opened, that none of `endpoints` answered (naming
-/// them, with the reason when a host name does not resolve), then every [`REACH_REMINDER`]
-/// while that lasts; says so when one answers at last. Ends with the session.
-async fn watch_reach(session: Session, endpoints: Vec<String>) {
-    let started = tokio::time::Instant::now();
-    let poll = Duration::from_millis(100);
-    while started.elapsed() < REACH_GRACE {
-        if session.is_closed() || linked(&session).await {
-            return;
-        }
-        tokio::time::sleep(poll).await;
-    }
-    let names = endpoints.join(", ");
-    let mut why = Vec::new();
-    for e in &endpoints {
-        if let Some(reason) = unresolved(e).await {
-            why.push(reason);
-        }
-    }
-    let why = if why.is_empty() {
-        "nothing answers there: check the address, and that the router runs and its port is open"
-            .to_string()
-    } else {
-        why.join("; ")
-    };
-    tracing::warn!("cannot reach {names}: {why}. Still trying in the background");
-    let mut told = tokio::time::Instant::now();
-    loop {
-        tokio::time::sleep(poll).await;
-        if session.is_closed() {
-            return;
-        }
-        if linked(&session).await {
-            tracing::warn!(
-                "reached {names} after {:.0} s",
-                started.elapsed().as_secs_f64()
-            );
-            return;
-        }
-        if told.elapsed() >= REACH_REMINDER {
-            told = tokio::time::Instant::now();
-            tracing::warn!(
-                "still cannot reach {names} after {:.0} s: still trying",
-                started.elapsed().as_secs_f64()
-            );
-        }
-    }
-}
-
-/// Why a `tcp/HOST:PORT` endpoint cannot be reached when its host name does not resolve.
-async fn unresolved(endpoint: &str) -> Option<String> {
-    let address = endpoint.strip_prefix("tcp/")?;
-    let address = address.split(['?', '#']).next()?;
-    let (host, _) = address.rsplit_once(':')?;
-    if host.starts_with('[') || host.parse::<std::net::Ipv4Addr>().is_ok() {
-        return None;
-    }
-    let host = host.to_string();
-    let lookup = tokio::task::spawn_blocking(move || {
-        std::net::ToSocketAddrs::to_socket_addrs(&(host.as_str(), 0))
-            .map(|_| ())
-            .map_err(|e| (host, e))
-    });
-    match lookup.await {
-        Ok(Err((host, e))) => Some(format!("the host name {host} does not resolve ({e})")),
-        _ => None,
     }
 }
 

@@ -26,16 +26,17 @@ pub struct MonitorArgs {
 
 pub fn run(args: &MonitorArgs) -> Result<ExitCode> {
     let only = args.run.as_deref().map(RunId::new).transpose()?;
-    let mut bus_args = args.bus.clone();
-    bus_args.no_shm = true;
     tokio::runtime::Runtime::new()?.block_on(async {
-        let bus = Bus::open(&bus_args).await?;
+        // --once says itself when nothing answers where it connects.
+        let bus = Bus::open_watcher(&args.bus, args.once).await?;
         let r = if args.once {
-            let lines = monitor::once(&bus, only.as_ref()).await;
-            lines
-                .iter()
-                .try_for_each(|l| outln!("{l}"))
-                .map_err(Into::into)
+            match monitor::once(&bus, only.as_ref()).await {
+                Ok(lines) => lines
+                    .iter()
+                    .try_for_each(|l| outln!("{l}"))
+                    .map_err(Into::into),
+                Err(e) => Err(e.into()),
+            }
         } else {
             let stop = graspopt_runner::signal::shutdown_signal();
             monitor::dashboard(&bus, only.as_ref(), stop).await

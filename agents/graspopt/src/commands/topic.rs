@@ -130,14 +130,12 @@ fn plan(what: &TopicCommand) -> Result<Plan> {
 
 pub fn run(args: &TopicArgs) -> Result<ExitCode> {
     let plan = plan(&args.what)?;
-    let mut bus_args = args.bus.clone();
-    // A watcher never takes part in the shared-memory cloud path.
-    bus_args.no_shm = true;
     tokio::runtime::Runtime::new()?.block_on(async {
-        let bus = Bus::open(&bus_args).await?;
+        // `list` says itself when nothing answers where it connects.
+        let bus = Bus::open_watcher(&args.bus, matches!(plan, Plan::List(..))).await?;
         let mut out = std::io::stdout();
         let result = match &plan {
-            Plan::List(run, format) => list(&bus, &bus_args.connect, run.as_ref(), *format).await,
+            Plan::List(run, format) => list(&bus, run.as_ref(), *format).await,
             Plan::Echo(s) => topic::echo(&bus, s, &mut out, shutdown_signal()).await,
             Plan::Rate(s) => topic::rate(&bus, s, &mut out, shutdown_signal()).await,
         };
@@ -146,16 +144,11 @@ pub fn run(args: &TopicArgs) -> Result<ExitCode> {
     })
 }
 
-async fn list(bus: &Bus, connect: &[String], run: Option<&RunId>, format: Format) -> Result<()> {
+async fn list(bus: &Bus, run: Option<&RunId>, format: Format) -> Result<()> {
     let rows = topic::list(bus, run).await?;
-    // An empty listing from an address where nothing answers is that address's fault, not
-    // an idle bus's.
-    if rows.is_empty() && !connect.is_empty() && !bus.is_linked().await {
-        anyhow::bail!(
-            "nothing answers at {}: check the address, and that the router runs and its port \
-             is open",
-            connect.join(", ")
-        );
+    // An empty listing where nothing answers is that address's fault, not an idle bus's.
+    if rows.is_empty() {
+        bus.check_linked().await?;
     }
     match format {
         Format::Json => outln!("{}", topic::rows_json(&rows))?,

@@ -225,3 +225,18 @@ fn a_negative_count_is_refused_naming_the_accepted_range() {
     }
     assert!(!out.exists(), "a refused command wrote {o}");
 }
+
+/// `monitor --once` at an address where nothing answers says so and fails (as `topic list`
+/// does), without a warning from the background connection as it exits.
+#[test]
+fn monitor_once_where_nothing_answers_says_so_without_a_warning() {
+    let out = graspopt(&["monitor", "--once", "--connect", "tcp/127.0.0.1:1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("nothing answers at tcp/127.0.0.1:1"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("WARN"), "{stderr}");
+    assert!(out.stdout.is_empty());
+}

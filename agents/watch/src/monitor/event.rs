@@ -4,7 +4,7 @@ use std::future::Future;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use graspopt_bus::Bus;
+use graspopt_bus::{Bus, BusError};
 use graspopt_protocol::keys::{STATE, STATUS, alive_key};
 use graspopt_protocol::{AgentKind, RunId, Runs};
 use tokio::sync::mpsc;
@@ -52,8 +52,10 @@ pub async fn ask_states(bus: &Bus, m: &mut Monitor) {
     }
 }
 
-/// The runs' state as text, once: each run's [`run_lines`] and an empty line.
-pub async fn once(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
+/// The runs' state as text, once: each run's [`run_lines`] and an empty line; an error
+/// when there is none and the endpoints the bus connects to were not reached
+/// ([`Bus::check_linked`]).
+pub async fn once(bus: &Bus, only: Option<&RunId>) -> Result<Vec<String>, BusError> {
     tokio::time::sleep(SETTLE).await;
     let mut m = Monitor::default();
     // Through a router, a coordinator's token can reach a session that just connected a
@@ -68,7 +70,11 @@ pub async fn once(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
     m.set_alive(&alive);
     ask_states(bus, &mut m).await;
     if m.runs.is_empty() {
-        return vec!["no runs: no live coordinator (check --connect)".into()];
+        // No run, and no link to the endpoints given: that is the endpoints' fault.
+        bus.check_linked().await?;
+        return Ok(vec![
+            "no runs: no live coordinator (check --connect)".into(),
+        ]);
     }
     let now = Instant::now();
     let mut out = Vec::new();
@@ -76,7 +82,7 @@ pub async fn once(bus: &Bus, only: Option<&RunId>) -> Vec<String> {
         out.extend(run_lines(name, view, now));
         out.push(String::new());
     }
-    out
+    Ok(out)
 }
 
 enum Key {
