@@ -173,6 +173,14 @@ impl Hand {
         ))
     }
 
+    /// Once something listens on `port` (loopback), starts the Python hand (if this is one)
+    /// there, as a user's own hand attaches to a run that runs.
+    fn attach_python(&self, dir: &Path, port: u16, run: &str) -> Option<Proc> {
+        self.python.as_ref()?;
+        wait_for_port(port, Duration::from_secs(60));
+        self.start_python(dir, &format!("tcp/127.0.0.1:{port}"), run, &[])
+    }
+
     /// Checks every trial's score against the same trial computed here.
     fn check_scores(&self, rows: &[TrialRow]) {
         match &self.recorded {
@@ -256,10 +264,7 @@ fn embedded(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
     args.extend(hand.sensing.iter().map(|s| s.to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let proc = Proc::start("run", &args, dir);
-    let _python = hand.python.as_ref().and_then(|_| {
-        wait_for_port(port, Duration::from_secs(60));
-        hand.start_python(dir, &endpoint, run, &[])
-    });
+    let _python = hand.attach_python(dir, port, run);
     let (status, stdout) = proc.wait_output(DEADLINE);
     assert!(
         status.success(),
@@ -324,10 +329,7 @@ fn launch(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
         name: "launch".into(),
         child,
     };
-    let _python = hand.python.as_ref().and_then(|_| {
-        wait_for_port(port, Duration::from_secs(60));
-        hand.start_python(dir, &endpoint, run, &[])
-    });
+    let _python = hand.attach_python(dir, port, run);
     let (status, stdout) = proc.wait_output(DEADLINE);
     assert!(
         status.success(),
