@@ -179,7 +179,7 @@ fn a_stopped_run_resumes_with_the_command_it_prints() {
     // The id reads as a name in messages.
     assert!(stdout.contains("run \"stopme\": "), "{stdout}");
     assert!(
-        text.contains("run \"stopme\": 12 trials completed"),
+        text.contains("run \"stopme\": 12 of 12 trials completed"),
         "{text}"
     );
 
