@@ -76,7 +76,7 @@ def wrenches_of(grasps, command, worker):
 def main():
     args = hand_agent.argument_parser(__doc__).parse_args()
     grasps = hand_agent.load_recording(args.recording, check_grasp)
-    hand_agent.serve(args, grasps, wrenches_of)
+    hand_agent.serve(args, grasps, wrenches_of, "wrenches")
 
 
 if __name__ == "__main__":

@@ -250,10 +250,11 @@ def argument_parser(description):
     return ap
 
 
-def serve(args, grasps, answer):
+def serve(args, grasps, answer, topic="clouds"):
     """Joins the run as hand `args.id` and answers each trial command sent to it with
     `answer(grasps, command, worker)`, which returns the topic (below `graspopt/<run>/`) and
-    the JSON message to put there, until interrupted."""
+    the JSON message to put there, until interrupted. `topic` is the one it publishes on
+    (clouds or wrenches): its liveliness token says so, for `graspopt topic list`."""
     if args.zenoh_config:
         conf = zenoh.Config.from_file(args.zenoh_config)
     else:
@@ -278,8 +279,9 @@ def serve(args, grasps, answer):
 
     place = take_place(session, prefix, args.id, wake)
     commands = session.declare_subscriber(f"{prefix}/hand/{args.id}/command", incoming.put)
-    # The trailing /json asks the coordinator for JSON commands.
-    token = session.liveliness().declare_token(f"{prefix}/alive/hand/{host}/{args.id}/json")
+    # The /json asks the coordinator for JSON commands; the last chunk names what it publishes.
+    token = session.liveliness().declare_token(
+        f"{prefix}/alive/hand/{host}/{args.id}/json/{topic}")
     print(f"{args.id}: {len(grasps)} recorded grasps, waiting for trials on {args.connect}",
           file=sys.stderr, flush=True)
 

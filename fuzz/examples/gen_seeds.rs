@@ -264,13 +264,14 @@ fn main() {
     reply.error = Some("no planner".into());
     out.message("decode_suggest_reply", "error", &reply, None);
 
-    let alive = alive_token(&run, AgentKind::Hand, "host-a", "hand-1");
+    let alive = alive_token(&run, AgentKind::Hand, "host-a", "hand-1", None);
     let keys = [
         ("alive", alive.clone()),
         ("alive-json", format!("{alive}/json")),
+        ("alive-json-wrenches", format!("{alive}/json/wrenches")),
         (
             "alive-coordinator",
-            alive_token(&run, AgentKind::Coordinator, "h", "c-1"),
+            alive_token(&run, AgentKind::Coordinator, "h", "c-1", None),
         ),
         ("object", OBJECT.key(Runs::One(&run)).to_string()),
         (

@@ -19,9 +19,12 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     if let Some(alive) = parse_alive_key(key) {
-        let mut rebuilt = alive_token(&alive.run, alive.kind, &alive.host, &alive.id);
+        let mut rebuilt = alive_token(&alive.run, alive.kind, &alive.host, &alive.id, None);
         if alive.encoding == Encoding::Json {
             rebuilt.push_str("/json");
+        }
+        if let Some(topic) = alive.publishes {
+            rebuilt = format!("{rebuilt}/{}", topic.entry().name);
         }
         assert_eq!(rebuilt, key, "{alive:?}");
     }

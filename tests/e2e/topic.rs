@@ -140,3 +140,79 @@ fn topic_tools_list_echo_and_time_a_running_pipeline() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("unknown topic \"results\""));
 }
+
+/// `topic list` names as publishers of a hand topic only the hands that publish it: a hand
+/// that senses clouds under `clouds`, a force-sensing hand under `wrenches`, and a hand
+/// written in another language (a Python hand's JSON token) under the topic its token names.
+#[test]
+fn topic_list_names_each_hand_under_the_topic_it_publishes() {
+    let c = crate::support::Cluster::start("topic-hands", "th");
+    let _clouds = c.agent("cloud-hand", &["hand", "--id", "cloud-hand"]);
+    let _ft = c.agent(
+        "ft-hand",
+        &[
+            "hand",
+            "--id",
+            "ft-hand",
+            "--hand",
+            "barrett_ft",
+            "--sensing",
+            "ft",
+        ],
+    );
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let python = runtime.block_on(async {
+        let bus = graspopt_bus::Bus::loopback_peer(&c.endpoint).await.unwrap();
+        let token = bus
+            .session()
+            .liveliness()
+            .declare_token("graspopt/th/alive/hand/lab-pc/py-ft/json/wrenches")
+            .await
+            .unwrap();
+        (bus, token)
+    });
+    let host = graspopt_bus::host_name();
+    let publishers = |rows: &serde_json::Value, key: &str| -> Vec<String> {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["key"] == key)
+            .map(|r| {
+                r["publishers"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|p| p.as_str().unwrap().to_string())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let want_clouds = vec![format!("cloud-hand@{host}")];
+    let mut want_wrenches = vec![format!("ft-hand@{host}"), "py-ft@lab-pc".to_string()];
+    want_wrenches.sort();
+    let start = Instant::now();
+    let rows = loop {
+        let rows: serde_json::Value = serde_json::from_str(&topic(
+            &c.endpoint,
+            &["list", "--run", "th", "--format", "json"],
+        ))
+        .unwrap();
+        let hands = publishers(&rows, "graspopt/th/clouds").len()
+            + publishers(&rows, "graspopt/th/wrenches").len();
+        if hands >= 3 || start.elapsed() > Duration::from_secs(30) {
+            break rows;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    assert_eq!(
+        publishers(&rows, "graspopt/th/clouds"),
+        want_clouds,
+        "{rows}"
+    );
+    assert_eq!(
+        publishers(&rows, "graspopt/th/wrenches"),
+        want_wrenches,
+        "{rows}"
+    );
+    drop(python);
+}

@@ -607,6 +607,7 @@ mod tests {
             host: "h".into(),
             id: id.into(),
             encoding: Encoding::Bincode,
+            publishes: None,
         }
     }
 

@@ -1,6 +1,6 @@
 //! What a hand driver is: the one trait a real robot's integrator implements.
 
-use graspopt_protocol::{FingerCloud, FingertipWrench, ObjectEstimate, Pose, TrialCommand};
+use graspopt_protocol::{FingerCloud, FingertipWrench, ObjectEstimate, Pose, Topic, TrialCommand};
 use serde::{Deserialize, Serialize};
 
 /// What a hand measures of its contacts.
@@ -30,6 +30,14 @@ impl Sensing {
     /// A kind from its name.
     pub fn parse(name: &str) -> Option<Sensing> {
         Self::ALL.into_iter().find(|s| s.name() == name.trim())
+    }
+
+    /// The topic a hand of this kind publishes its measurements on.
+    pub fn topic(self) -> Topic {
+        match self {
+            Sensing::Clouds => Topic::Clouds,
+            Sensing::Ft => Topic::Wrenches,
+        }
     }
 }
 

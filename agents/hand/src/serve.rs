@@ -41,8 +41,12 @@ pub async fn serve(
     let commands = bus.subscribe(&COMMAND.worker_key(run.into(), id)).await?;
     let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
     let sender = CloudSender::open(bus, run).await;
-    // Declared last: the coordinator sends commands once it sees the token.
-    let _token = bus.declare_alive(run, AgentKind::Hand, id).await?;
+    // Declared last: the coordinator sends commands once it sees the token, which says
+    // what this hand publishes.
+    let publishes = Some(driver.sensing().topic());
+    let _token = bus
+        .declare_alive_publishing(run, AgentKind::Hand, id, publishes)
+        .await?;
     let mut inbox = Inbox::new(format!("hand {id}"), run);
     loop {
         // A subscription that ends (`None`): the session closed.

@@ -6,7 +6,7 @@ use graspopt_protocol::keys::{
     AliveKey, Claim as ClaimKey, ClaimPhase, alive_key, alive_token, claim_slot_key, claim_token,
     parse_alive_key, parse_claim_key,
 };
-use graspopt_protocol::{AgentKind, RunId};
+use graspopt_protocol::{AgentKind, RunId, Topic};
 use tokio::sync::watch;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
@@ -207,8 +207,20 @@ impl Bus {
         kind: AgentKind,
         id: &str,
     ) -> Result<LivelinessToken, BusError> {
+        self.declare_alive_publishing(run, kind, id, None).await
+    }
+
+    /// [`Bus::declare_alive`], the token saying which topic of its kind the agent publishes
+    /// (a hand: clouds or wrenches), so that tools list it only there.
+    pub async fn declare_alive_publishing(
+        &self,
+        run: &RunId,
+        kind: AgentKind,
+        id: &str,
+        publishes: Option<Topic>,
+    ) -> Result<LivelinessToken, BusError> {
         graspopt_protocol::keys::check_agent_id(id).map_err(|e| BusError::Config(e.to_string()))?;
-        let key = alive_token(run, kind, self.host(), id);
+        let key = alive_token(run, kind, self.host(), id, publishes);
         self.session()
             .liveliness()
             .declare_token(key.clone())

@@ -153,6 +153,7 @@ fn agent(run: &RunId, kind: AgentKind, id: String) -> AliveKey {
         host: "bench".into(),
         id,
         encoding: Encoding::Bincode,
+        publishes: None,
     }
 }
 

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use graspopt_protocol::keys::AliveKey;
-use graspopt_protocol::keys::{COMMAND, TABLE};
+use graspopt_protocol::keys::{COMMAND, Entry, TABLE};
 use graspopt_protocol::{AgentKind, RunId, Runs};
 use serde_json::{Value, json};
 
@@ -30,10 +30,13 @@ pub fn topic_rows(agents: &[AliveKey]) -> Vec<Row> {
     let mut rows = Vec::new();
     for (run, agents) in by_run {
         let Ok(id) = RunId::new(&run) else { continue };
-        let of = |kind: AgentKind| -> Vec<String> {
+        // The agents of the row's kind; of those whose token says what they publish (a
+        // hand: clouds or wrenches), only the ones that publish the row's topic.
+        let of = |entry: Entry| -> Vec<String> {
             let mut v: Vec<String> = agents
                 .iter()
-                .filter(|a| a.kind == kind)
+                .filter(|a| a.kind == entry.by)
+                .filter(|a| a.publishes.is_none_or(|t| t.entry() == entry))
                 .map(|a| format!("{}@{}", a.id, a.host))
                 .collect();
             v.sort();
@@ -46,7 +49,7 @@ pub fn topic_rows(agents: &[AliveKey]) -> Vec<Row> {
             .collect();
         hands.sort();
         for entry in TABLE {
-            let publishers = of(entry.by);
+            let publishers = of(entry);
             if publishers.is_empty() {
                 continue;
             }
@@ -99,22 +102,27 @@ pub fn rows_table(rows: &[Row]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use graspopt_protocol::Topic;
 
     #[test]
     fn list_rows_follow_the_live_agents() {
         let run = RunId::new("r").unwrap();
-        let a = |kind, id: &str| AliveKey {
+        let a = |kind, id: &str, publishes| AliveKey {
             run: run.clone(),
             kind,
             host: "h".into(),
             id: id.into(),
             encoding: graspopt_protocol::Encoding::Bincode,
+            publishes,
         };
+        // hand-1 says it publishes clouds, hand-3 wrenches; hand-2 does not say (an older
+        // token): it is listed under both.
         let rows = topic_rows(&[
-            a(AgentKind::Metric, "metric"),
-            a(AgentKind::Hand, "hand-2"),
-            a(AgentKind::Hand, "hand-1"),
-            a(AgentKind::Coordinator, "coordinator"),
+            a(AgentKind::Metric, "metric", None),
+            a(AgentKind::Hand, "hand-2", None),
+            a(AgentKind::Hand, "hand-1", Some(Topic::Clouds)),
+            a(AgentKind::Hand, "hand-3", Some(Topic::Wrenches)),
+            a(AgentKind::Coordinator, "coordinator", None),
         ]);
         let keys: Vec<&str> = rows.iter().map(|r| r.key.as_str()).collect();
         assert_eq!(
@@ -124,6 +132,7 @@ mod tests {
                 "graspopt/r/coordinator/state",
                 "graspopt/r/hand/hand-1/command",
                 "graspopt/r/hand/hand-2/command",
+                "graspopt/r/hand/hand-3/command",
                 "graspopt/r/result",
                 "graspopt/r/status",
                 "graspopt/r/wrenches"
@@ -132,6 +141,7 @@ mod tests {
         let clouds = &rows[0];
         assert_eq!(clouds.message, "ContactClouds");
         assert_eq!(clouds.publishers, ["hand-1@h", "hand-2@h"]);
+        assert_eq!(rows[7].publishers, ["hand-2@h", "hand-3@h"]);
         let table = rows_table(&rows[..2]);
         assert_eq!(
             table,

@@ -9,7 +9,7 @@
 //! | `graspopt/<run>/status`               | [`RunStatus`]      | coordinator         |
 //! | `graspopt/<run>/planner/suggest`      | [`SuggestRequest`] -> [`SuggestReply`] (query) | planner answers |
 //! | `graspopt/<run>/coordinator/state`    | [`RunStatus`] (query) | coordinator answers |
-//! | `graspopt/<run>/alive/<kind>/<host>/<id>[/json]` | liveliness token (`/json`: send me JSON) | every agent |
+//! | `graspopt/<run>/alive/<kind>/<host>/<id>[/json][/<topic>]` | liveliness token (`/json`: send me JSON; `/<topic>`: the topic it publishes, `clouds` or `wrenches` for a hand) | every agent |
 //!
 //! One table ([`TABLE`], in `table.rs`) binds each key to the type of its messages: a
 //! [`Key<M>`] comes only from its row ([`RESULT`]`.key(run)`), and the bus sends and awaits
@@ -256,15 +256,26 @@ pub struct AliveKey {
     /// (`graspopt/<run>/alive/hand/<host>/<id>/json`) asks for JSON, so an agent written
     /// without bincode (a Python hand) gets its trial commands as JSON.
     pub encoding: Encoding,
+    /// Which of its kind's topics the agent publishes, when its token says (a last chunk
+    /// naming it: a hand's `clouds` or `wrenches`); `None`: it does not say.
+    pub publishes: Option<Topic>,
 }
 
-/// Parses `graspopt/<run>/alive/<kind>/<host>/<id>` and
-/// `graspopt/<run>/alive/<kind>/<host>/<id>/json`.
+/// Parses `graspopt/<run>/alive/<kind>/<host>/<id>`, optionally followed by `/json` and then
+/// by the name of a topic that agents of `kind` publish (`/clouds`, `/wrenches` for a hand).
 pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
     let parts: Vec<&str> = key.split('/').collect();
-    let (root, run, kind, host, id, encoding) = match parts.as_slice() {
-        [root, run, "alive", kind, host, id] => (root, run, kind, host, id, Encoding::Bincode),
-        [root, run, "alive", kind, host, id, "json"] => (root, run, kind, host, id, Encoding::Json),
+    let [root, run, "alive", kind, host, id, rest @ ..] = parts.as_slice() else {
+        return None;
+    };
+    let kind = AgentKind::parse(kind)?;
+    let (encoding, rest) = match rest {
+        ["json", rest @ ..] => (Encoding::Json, rest),
+        rest => (Encoding::Bincode, rest),
+    };
+    let publishes = match rest {
+        [] => None,
+        [name] => Some(Topic::named(name).filter(|t| t.publisher() == kind)?),
         _ => return None,
     };
     // Host and id become parts of other keys (a worker's command key): a token whose host
@@ -274,10 +285,11 @@ pub fn parse_alive_key(key: &str) -> Option<AliveKey> {
     }
     Some(AliveKey {
         run: RunId::new(run).ok()?,
-        kind: AgentKind::parse(kind)?,
+        kind,
         host: (*host).to_string(),
         id: (*id).to_string(),
         encoding,
+        publishes,
     })
 }
 

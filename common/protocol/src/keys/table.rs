@@ -325,13 +325,26 @@ pub const TABLE: [Entry; 8] = [
     STATE.entry,
 ];
 
-/// `graspopt/<run>/alive/<kind>/<host>/<id>`: an agent's liveliness token.
-pub fn alive_token(run: &RunId, kind: AgentKind, host: &str, id: &str) -> String {
-    format!(
+/// `graspopt/<run>/alive/<kind>/<host>/<id>`: an agent's liveliness token; with the topic
+/// it publishes when it says (`.../<id>/wrenches`: see [`AliveKey::publishes`]).
+///
+/// [`AliveKey::publishes`]: super::AliveKey::publishes
+pub fn alive_token(
+    run: &RunId,
+    kind: AgentKind,
+    host: &str,
+    id: &str,
+    publishes: Option<Topic>,
+) -> String {
+    let token = format!(
         "{}/alive/{}/{host}/{id}",
         prefix(Runs::One(run)),
         kind.as_str()
-    )
+    );
+    match publishes {
+        Some(topic) => format!("{token}/{}", topic.entry().name),
+        None => token,
+    }
 }
 
 /// The liveliness tokens of `kind` (of every kind if `None`) in `runs`:

@@ -69,7 +69,7 @@ fn keys_classify_back_to_their_topic() {
 #[test]
 fn alive_keys_parse() {
     let run = RunId::new("r1").unwrap();
-    let key = alive_token(&run, AgentKind::Hand, "host-a", "hand-1");
+    let key = alive_token(&run, AgentKind::Hand, "host-a", "hand-1", None);
     assert_eq!(key, "graspopt/r1/alive/hand/host-a/hand-1");
     let parsed = parse_alive_key(&key).unwrap();
     assert_eq!(parsed.kind, AgentKind::Hand);
@@ -84,6 +84,44 @@ fn alive_keys_parse() {
         ("hand-1", Encoding::Json)
     );
     assert!(parse_alive_key(&format!("{key}/xml")).is_none());
+    assert_eq!(parsed.publishes, None);
+    // A token that says which topic the agent publishes: one of its kind's, after `/json`.
+    let ft = alive_token(
+        &run,
+        AgentKind::Hand,
+        "host-a",
+        "hand-1",
+        Some(Topic::Wrenches),
+    );
+    assert_eq!(ft, "graspopt/r1/alive/hand/host-a/hand-1/wrenches");
+    let parsed = parse_alive_key(&ft).unwrap();
+    assert_eq!(
+        (parsed.publishes, parsed.encoding),
+        (Some(Topic::Wrenches), Encoding::Bincode)
+    );
+    let parsed = parse_alive_key(&format!("{key}/json/clouds")).unwrap();
+    assert_eq!(
+        (parsed.publishes, parsed.encoding),
+        (Some(Topic::Clouds), Encoding::Json)
+    );
+    for bad in [
+        "result",
+        "clouds/json",
+        "clouds/wrenches",
+        "json/json",
+        "wrenches/x",
+    ] {
+        assert!(parse_alive_key(&format!("{key}/{bad}")).is_none(), "{bad}");
+    }
+    // Only a topic the agent's kind publishes.
+    let metric = alive_token(&run, AgentKind::Metric, "h", "m", None);
+    assert!(parse_alive_key(&format!("{metric}/clouds")).is_none());
+    assert!(
+        parse_alive_key(&format!("{metric}/result"))
+            .unwrap()
+            .publishes
+            == Some(Topic::Result)
+    );
     assert!(parse_alive_key("graspopt/r/alive/hand/h/*").is_none());
     assert!(parse_alive_key("graspopt/r/alive/hand/**/h1").is_none());
 }
@@ -201,7 +239,7 @@ fn the_table_builds_every_documented_key() {
     );
     // Liveliness, claims, everything of a run, the shared-memory service.
     assert_eq!(
-        alive_token(&run, AgentKind::Hand, "h", "hand-1"),
+        alive_token(&run, AgentKind::Hand, "h", "hand-1", None),
         "graspopt/r1/alive/hand/h/hand-1"
     );
     assert_eq!(
