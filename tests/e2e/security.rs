@@ -269,8 +269,19 @@ fn the_routers_access_list_lets_each_role_publish_what_the_key_table_says() {
             }
         }
     }
-    for kind in AgentKind::ALL {
-        let token = alive_token(&RunId::new("r").unwrap(), kind, "host", "agent-1");
+    let run = RunId::new("r").unwrap();
+    let mut tokens: Vec<(AgentKind, String)> = AgentKind::ALL
+        .into_iter()
+        .map(|kind| (kind, alive_token(&run, kind, "host", "agent-1", None)))
+        .collect();
+    // A hand's token may name the topic it publishes.
+    for topic in graspopt_protocol::keys::Topic::ALL {
+        if topic.entry().by == AgentKind::Hand {
+            let token = alive_token(&run, AgentKind::Hand, "host", "h-1", Some(topic));
+            tokens.push((AgentKind::Hand, token));
+        }
+    }
+    for (kind, token) in tokens {
         if !allowed(&ingress_rules(kind.as_str()), "liveliness_token", &token) {
             missing.push(format!("{} may not declare {token}", kind.as_str()));
         }
