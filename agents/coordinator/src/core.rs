@@ -199,7 +199,7 @@ impl Coordinator {
                     error: error.clone(),
                     at_ms: now,
                 },
-                None => Write::Result(journal_result(result, now)),
+                None => Write::Result(Box::new(journal_result(result, now))),
             }));
         }
         log_disposition(result, self.state.on_result(result, now));

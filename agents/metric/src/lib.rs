@@ -10,7 +10,8 @@
 //! clouds; a reading that admits no contact is left out, with the reason in the log.
 //!
 //! Every result carries a force analysis (`TrialResult::forces`): the least forces in the
-//! friction cones that hold the object's weight, and for measured forces their net wrench and
+//! friction cones that hold the object's weight (or why they are unavailable, when the
+//! solver found no answer: the score stands), and for measured forces their net wrench and
 //! slip margins (`graspopt_trial::forces`).
 //!
 //! [`score_clouds`] and [`score_wrenches`] are the logic (no network); [`run`] wires them to
@@ -162,8 +163,10 @@ pub fn score_wrenches(
     (result, refused)
 }
 
-/// The force analysis for the result, or none when it failed (a solver that gives up on a
-/// degenerate grasp): the score stands without it, and the log says why.
+/// The force analysis for the result. Least forces the solver found no answer for are
+/// reported unavailable in it, with the reason (`ForceAnalysis::unavailable`), not logged.
+/// None when no analysis could be made (measured forces it refused): the score stands
+/// without it, and the log says why.
 fn analysed(
     forces: Result<GraspForces, TrialError>,
     result: &TrialResult,
@@ -244,6 +247,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
         .contacts
         .validate()
         .context("metric agent settings")?;
+    config.forces.validate().context("metric agent settings")?;
     let mut clouds = CloudReceiver::open(bus, run).await?;
     let wrenches = bus.subscribe(&WRENCHES.key(run.into())).await?;
     let objects = bus.subscribe(&OBJECT.key(run.into())).await?;

@@ -160,9 +160,10 @@ pub fn fingertip_wrench(sensor: &SensorReading, stamp_ms: i64) -> FingertipWrenc
 
 /// A trial's force analysis on the wire.
 pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
-    let (resisting_norm, resisting_max) = match &g.resisting {
-        Resisting::Forces { norm, .. } => (Some(*norm), g.resisting_max()),
-        Resisting::CannotResist { .. } => (None, None),
+    let (resisting_norm, resisting_max, unavailable) = match &g.resisting {
+        Resisting::Forces { norm, .. } => (Some(*norm), g.resisting_max(), None),
+        Resisting::CannotResist { .. } => (None, None, None),
+        Resisting::Unavailable { reason } => (None, None, Some(reason.clone())),
     };
     ForceAnalysis {
         external: g.external.into(),
@@ -174,6 +175,7 @@ pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
             .as_ref()
             .map(|m| m.margins.iter().map(|s| s.friction).collect())
             .unwrap_or_default(),
+        unavailable,
     }
 }
 
@@ -257,6 +259,44 @@ mod tests {
         let mut bad = estimate.clone();
         bad.object = "teapot".into();
         assert!(object_from_estimate(&bad).is_err());
+    }
+
+    #[test]
+    fn least_forces_that_are_unavailable_say_why_on_the_wire() {
+        let external = graspopt_quality::Wrench::new(0.0, 0.0, -4.905, 0.0, 0.0, 0.0);
+        let why = "the conic solver stopped without an answer";
+        let unknown = GraspForces {
+            external,
+            resisting: Resisting::Unavailable { reason: why.into() },
+            measured: None,
+        };
+        let f = force_analysis(&unknown);
+        assert_eq!(f.unavailable.as_deref(), Some(why));
+        assert_eq!(
+            (f.resisting_norm, f.resisting_max, f.can_resist()),
+            (None, None, None)
+        );
+        assert_eq!(f.external, [0.0, 0.0, -4.905, 0.0, 0.0, 0.0]);
+        let forces = graspopt_quality::ContactForces::without_torsion(vec![
+            Vector3::new(3.0, 0.0, 4.0),
+            Vector3::new(0.0, 1.0, 0.0),
+        ]);
+        let held = GraspForces {
+            resisting: Resisting::Forces {
+                forces,
+                norm: 26f64.sqrt(),
+            },
+            ..unknown
+        };
+        let f = force_analysis(&held);
+        assert_eq!(
+            (f.resisting_norm, f.resisting_max),
+            (Some(26f64.sqrt()), Some(5.0))
+        );
+        assert_eq!(
+            (f.unavailable.as_deref(), f.can_resist()),
+            (None, Some(true))
+        );
     }
 
     #[test]

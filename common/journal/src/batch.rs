@@ -32,8 +32,9 @@ pub enum Write {
         error: String,
         at_ms: i64,
     },
-    /// A trial's result ([`Journal::record_result`]).
-    Result(TrialResultRecord),
+    /// A trial's result ([`Journal::record_result`]), boxed: it is larger than the other
+    /// writes (its force analysis) by far.
+    Result(Box<TrialResultRecord>),
     /// The planner's engine after its last reply ([`Journal::set_planner_state`]).
     PlannerState { engine: Vec<u8>, at_ms: i64 },
 }

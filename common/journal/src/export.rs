@@ -8,7 +8,7 @@ use crate::journal::Journal;
 use crate::types::TrialRow;
 
 /// The columns after `completed_ms` and the parameter columns.
-const RESULT_COLUMNS: [&str; 16] = [
+const RESULT_COLUMNS: [&str; 17] = [
     "score",
     "rank",
     "force_closure",
@@ -24,6 +24,7 @@ const RESULT_COLUMNS: [&str; 16] = [
     "resisting_max",
     "net_force",
     "min_slip_margin",
+    "forces_unavailable",
     "error",
 ];
 
@@ -32,11 +33,13 @@ const RESULT_COLUMNS: [&str; 16] = [
 /// Header: `trial,state,attempts,worker,issued_ms,completed_ms,<param
 /// names...>,score,rank,force_closure,epsilon,volume,distance,bw,contacts,
 /// fingers_in_contact,cloud_points,can_resist,resisting_force,resisting_max,net_force,
-/// min_slip_margin,error`, without `volume` when no trial has one (only runs scored by the
-/// volume compute it). The force columns come from the result's force analysis
-/// ([`crate::ForceAnalysis`]): whether forces in the friction cones can resist the object's
-/// weight, the norm and the largest of the least such forces (N), and for hands that measure
-/// forces the net measured force (N) and the smallest slip margin (N). A missing value (`None`)
+/// min_slip_margin,forces_unavailable,error`, without `volume` when no trial has one (only
+/// runs scored by the volume compute it). The force columns come from the result's force
+/// analysis ([`crate::ForceAnalysis`]): whether forces in the friction cones can resist the
+/// object's weight, the 2-norm of the least such forces over all contacts and the largest at
+/// one contact (N), and for hands that measure forces the net measured force (N) and the
+/// smallest slip margin (N); when the least forces are unavailable (the solver found no
+/// answer) the first three are empty and `forces_unavailable` says why. A missing value (`None`)
 /// is an empty field, and so are the result columns of a trial without a
 /// result. Numbers are written
 /// so that they parse back to the same f64. Fields containing a comma, a
@@ -117,11 +120,16 @@ fn trial_fields(t: &TrialRow, volume: bool) -> Vec<Cow<'_, str>> {
     f.push(opt(has_result.then_some(t.fingers_in_contact)));
     f.push(opt(has_result.then_some(t.cloud_points)));
     let forces = t.forces.as_ref();
-    f.push(opt(forces.map(|a| a.can_resist())));
+    f.push(opt(forces.and_then(|a| a.can_resist())));
     f.push(opt(forces.and_then(|a| a.resisting_norm)));
     f.push(opt(forces.and_then(|a| a.resisting_max)));
     f.push(opt(forces.and_then(|a| a.net_force())));
     f.push(opt(forces.and_then(|a| a.min_slip_margin())));
+    f.push(
+        forces
+            .and_then(|a| a.unavailable.as_deref())
+            .map_or(Cow::Borrowed(""), Cow::Borrowed),
+    );
     f.push(t.error.as_deref().map_or(Cow::Borrowed(""), Cow::Borrowed));
     f
 }

@@ -9,6 +9,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::keys::RunId;
 
+mod forces;
+
+pub use forces::ForceAnalysis;
+use forces::ForceAnalysisBeforeUnavailable;
+
 /// Implemented by every message type.
 pub trait Message: Serialize + for<'de> Deserialize<'de> {
     /// The type name used in documents and tools.
@@ -446,90 +451,6 @@ pub struct TrialResult {
     pub forces: Option<ForceAnalysis>,
 }
 
-/// The contact-force analysis of a trial (the thesis's "contact force analysis"), reported
-/// beside its metrics. Wrenches are `[fx, fy, fz, tx, ty, tz]` in newtons and newton-metres,
-/// world axes, torques about the reference point of the metrics (the object's centre of
-/// mass by default).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ForceAnalysis {
-    /// The wrench the world applies to the object that the grasp must resist: the object's
-    /// weight by default.
-    pub external: [f64; 6],
-    /// The contact forces of least Euclidean norm, each inside its friction cone, that resist
-    /// `external`: their norm (N). `None`: no forces in the cones can ("cannot resist").
-    pub resisting_norm: Option<f64>,
-    /// The largest single contact force of that solution (N).
-    pub resisting_max: Option<f64>,
-    /// Measured forces only (a hand with force sensors): the net wrench the measured contact
-    /// forces apply to the object.
-    pub net_wrench: Option<[f64; 6]>,
-    /// Measured forces only: per sensed contact, `mu f_n - |f_t|` (N), how much more
-    /// tangential force the contact takes before it slips (negative: outside its cone).
-    pub slip_margins: Vec<f64>,
-}
-
-impl ForceAnalysis {
-    /// Whether forces in the friction cones can resist the external wrench.
-    pub fn can_resist(&self) -> bool {
-        self.resisting_norm.is_some()
-    }
-
-    /// The smallest slip margin of the measured contacts (N), if any were measured.
-    pub fn min_slip_margin(&self) -> Option<f64> {
-        self.slip_margins.iter().copied().reduce(f64::min)
-    }
-
-    /// The norm of the net measured force (N), if forces were measured.
-    pub fn net_force(&self) -> Option<f64> {
-        self.net_wrench
-            .map(|w| (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt())
-    }
-
-    /// The analysis for people, as the tools print it: "holds the load (4.905 N): least
-    /// contact forces 6.250 N (largest 3.500 N)" (their norm, and the largest one) or "cannot
-    /// hold the load (4.905 N)", then for measured forces "; measured: net force 0.012 N,
-    /// smallest slip margin 0.840 N".
-    pub fn describe(&self) -> String {
-        let e = &self.external;
-        let load = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-        let mut text = match (self.resisting_norm, self.resisting_max) {
-            (Some(norm), Some(max)) => format!(
-                "holds the load ({load:.3} N): least contact forces {norm:.3} N (largest {max:.3} N)"
-            ),
-            (Some(norm), None) => {
-                format!("holds the load ({load:.3} N): least contact forces {norm:.3} N")
-            }
-            (None, _) => format!("cannot hold the load ({load:.3} N)"),
-        };
-        if let Some(net) = self.net_force() {
-            text.push_str(&format!("; measured: net force {net:.3} N"));
-            if let Some(m) = self.min_slip_margin() {
-                text.push_str(&format!(", smallest slip margin {m:.3} N"));
-            }
-        }
-        text
-    }
-
-    /// Checks that every number is finite and the norms are >= 0; the error names the field.
-    pub fn validate(&self, field: &str) -> Result<(), String> {
-        finite(&format!("{field}.external"), &self.external)?;
-        for (name, v) in [
-            ("resisting_norm", self.resisting_norm),
-            ("resisting_max", self.resisting_max),
-        ] {
-            if let Some(v) = v
-                && !(v.is_finite() && v >= 0.0)
-            {
-                return Err(format!("{field}.{name} must be finite and >= 0, got {v}"));
-            }
-        }
-        if let Some(w) = &self.net_wrench {
-            finite(&format!("{field}.net_wrench"), w)?;
-        }
-        finite(&format!("{field}.slip_margins"), &self.slip_margins)
-    }
-}
-
 /// [`TrialResult`] as wire version 3 first had it, before `forces`.
 #[derive(Deserialize)]
 struct TrialResultBeforeForces {
@@ -568,8 +489,24 @@ impl Message for TrialResult {
         }
         Ok(())
     }
+    /// Two older layouts: before `forces.unavailable` (the fields up to `forces`, which
+    /// bincode writes as the pair below), and before `forces`.
     fn decode_older(body: &[u8]) -> Option<(Self, usize)> {
-        let (r, read) = crate::codec::decode_bincode_body::<TrialResultBeforeForces>(body).ok()?;
+        type BeforeUnavailable = (
+            TrialResultBeforeForces,
+            Option<ForceAnalysisBeforeUnavailable>,
+        );
+        let (r, forces, read) = match crate::codec::decode_bincode_body::<BeforeUnavailable>(body)
+            .ok()
+            .filter(|(_, read)| *read == body.len())
+        {
+            Some(((r, forces), read)) => (r, forces.map(ForceAnalysis::from), read),
+            None => {
+                let (r, read) =
+                    crate::codec::decode_bincode_body::<TrialResultBeforeForces>(body).ok()?;
+                (r, None, read)
+            }
+        };
         let result = TrialResult {
             run_id: r.run_id,
             trial_id: r.trial_id,
@@ -583,7 +520,7 @@ impl Message for TrialResult {
             cloud_points: r.cloud_points,
             cloud_transport: r.cloud_transport,
             error: r.error,
-            forces: None,
+            forces,
         };
         Some((result, read))
     }
@@ -897,22 +834,31 @@ impl Message for RunStatus {
         }
         Ok(())
     }
-    /// Two older layouts: before `best_forces` (the fields up to `waiting`, which bincode
-    /// writes as the pair below), and before `waiting`.
+    /// Three older layouts: before `best_forces.unavailable` (the fields up to
+    /// `best_forces`, which bincode writes as the triple below), before `best_forces` (the
+    /// pair), and before `waiting`.
     fn decode_older(body: &[u8]) -> Option<(Self, usize)> {
+        type BeforeUnavailable = (
+            RunStatusBeforeWaiting,
+            Vec<Waiting>,
+            Option<ForceAnalysisBeforeUnavailable>,
+        );
         let whole = |read: &usize| *read == body.len();
-        let (s, waiting, read) =
-            match crate::codec::decode_bincode_body::<(RunStatusBeforeWaiting, Vec<Waiting>)>(body)
-                .ok()
-                .filter(|(_, read)| whole(read))
-            {
-                Some(((s, waiting), read)) => (s, waiting, read),
-                None => {
-                    let (s, read) =
-                        crate::codec::decode_bincode_body::<RunStatusBeforeWaiting>(body).ok()?;
-                    (s, Vec::new(), read)
-                }
-            };
+        let decoded = crate::codec::decode_bincode_body::<BeforeUnavailable>(body)
+            .ok()
+            .filter(|(_, read)| whole(read))
+            .or_else(|| {
+                crate::codec::decode_bincode_body::<(RunStatusBeforeWaiting, Vec<Waiting>)>(body)
+                    .ok()
+                    .filter(|(_, read)| whole(read))
+                    .map(|((s, waiting), read)| ((s, waiting, None), read))
+            })
+            .or_else(|| {
+                crate::codec::decode_bincode_body::<RunStatusBeforeWaiting>(body)
+                    .ok()
+                    .map(|(s, read)| ((s, Vec::new(), None), read))
+            });
+        let ((s, waiting, best_forces), read) = decoded?;
         let status = RunStatus {
             run_id: s.run_id,
             phase: s.phase,
@@ -928,7 +874,7 @@ impl Message for RunStatus {
             errors: s.errors,
             stamp_ms: s.stamp_ms,
             waiting,
-            best_forces: None,
+            best_forces: best_forces.map(ForceAnalysis::from),
         };
         Some((status, read))
     }

@@ -357,6 +357,7 @@ fn a_result_from_before_forces_still_decodes() {
             resisting_max: Some(3.0),
             net_wrench: None,
             slip_margins: vec![0.25, 1.5],
+            unavailable: None,
         }),
         ..result()
     };
@@ -404,6 +405,7 @@ fn a_status_from_before_best_forces_still_decodes() {
         resisting_max: None,
         net_wrench: Some([0.1, 0.0, 4.8, 0.0, 0.01, 0.0]),
         slip_margins: vec![-0.5],
+        unavailable: None,
     });
     for enc in [Encoding::Bincode, Encoding::Json] {
         assert_eq!(

@@ -290,7 +290,8 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         .collect();
     let model = fingertip_model(settings.kind, &score.model);
     let reference = grasp_model(outcome, object, score)?.reference_point;
-    // A solver that fails on a degenerate grasp counts as "cannot resist": the tips squeeze.
+    // Least forces that are unavailable (a solver that stopped on a degenerate grasp) count
+    // as "cannot resist": the tips squeeze.
     forces.validate()?;
     let held = match analyse_contacts(&contacts, &model, &reference, object, forces, None) {
         Ok(g) => match g.resisting {

@@ -78,7 +78,7 @@ pub struct MeasuredForces {
 pub struct GraspForces {
     /// The wrench the world applies to the object (its weight).
     pub external: Wrench,
-    /// The least-norm forces that resist it, or why none can.
+    /// The least-norm forces that resist it, or why none can, or why they are unknown.
     pub resisting: Resisting,
     /// What the hand measured, if it measures forces.
     pub measured: Option<MeasuredForces>,
@@ -91,7 +91,7 @@ impl GraspForces {
             Resisting::Forces { forces, .. } => {
                 forces.forces.iter().map(|f| f.norm()).reduce(f64::max)
             }
-            Resisting::CannotResist { .. } => None,
+            Resisting::CannotResist { .. } | Resisting::Unavailable { .. } => None,
         }
     }
 }
@@ -99,7 +99,10 @@ impl GraspForces {
 /// The force analysis of `contacts` (world frame, normals into the object) under `model`,
 /// torques about `reference`, against the weight of `object` (centre of mass from the object)
 /// per `settings`; with `measured` forces (one per contact) when the hand measured them.
-/// No contacts: nothing resists, every force is zero.
+/// No contacts: nothing resists, every force is zero. Errors: settings or a load out of
+/// range, or measured forces that do not fit the contacts; the least resisting forces
+/// themselves never fail it ([`Resisting::Unavailable`], with the reason, when they are not
+/// found).
 pub fn analyse_contacts(
     contacts: &[Contact],
     model: &FrictionModel,
@@ -133,7 +136,13 @@ pub fn analyse_contacts(
             measured: None,
         });
     }
-    let resisting = resisting_forces(contacts, model, &external, reference)?;
+    // Past the settings and the load, the least forces never fail the analysis: a solver
+    // that stops is `Unavailable` already, and so is contact data it refused.
+    let resisting = resisting_forces(contacts, model, &external, reference).unwrap_or_else(|e| {
+        Resisting::Unavailable {
+            reason: e.to_string(),
+        }
+    });
     let measured = match measured {
         Some(forces) => Some(MeasuredForces {
             net: net_wrench(contacts, &forces, reference)?,
@@ -172,4 +181,37 @@ pub fn analyse_outcome(
         settings,
         None,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn least_forces_never_fail_the_analysis_bad_settings_do() {
+        let object = Object::by_name("sphere").unwrap();
+        let c = object.centre_of_mass().coords;
+        let model = FrictionModel::PointFriction { mu: 0.5, edges: 8 };
+        // A normal of length 2 (no simulated contact has one): the least forces refuse it,
+        // the analysis reports them unavailable with that reason, the load still known.
+        let contacts = [
+            Contact::new(c + Vector3::x() * 0.04, -Vector3::x() * 2.0),
+            Contact::new(c - Vector3::x() * 0.04, Vector3::x()),
+        ];
+        let settings = ForceSettings::default();
+        let g = analyse_contacts(&contacts, &model, &c, &object, &settings, None).unwrap();
+        let Resisting::Unavailable { reason } = &g.resisting else {
+            panic!("{g:?}");
+        };
+        assert!(reason.contains("normal"), "{reason}");
+        assert_eq!(g.external[2], -0.5 * 9.81);
+        assert_eq!(g.resisting_max(), None);
+        // A mass that is not one is the caller's error.
+        let negative = ForceSettings {
+            object_mass: -1.0,
+            ..settings
+        };
+        let e = analyse_contacts(&contacts, &model, &c, &object, &negative, None).unwrap_err();
+        assert!(e.to_string().contains("object_mass"), "{e}");
+    }
 }

@@ -178,7 +178,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                 forces.describe(),
                 match &grasp_forces.resisting {
                     Resisting::CannotResist { reason } => format!(": {reason}"),
-                    Resisting::Forces { .. } => String::new(),
+                    _ => String::new(), // held, or unavailable: `describe` says why
                 }
             )?;
         }

@@ -1,9 +1,10 @@
 //! The metric agent's scoring of fingertip force/torque readings (no bus): readings made
 //! from simulated fingertip contacts score as those contacts do, their measured forces are
-//! analysed, and readings that admit no contact are left out with their reason.
+//! analysed, and readings that admit no contact are left out with their reason. Clouds whose
+//! least forces the solver once gave up on get their force analysis.
 
-use graspopt_convert::pose;
-use graspopt_metric::{MetricConfig, score_wrenches};
+use graspopt_convert::{TrialTag, clouds_from_outcome, pose};
+use graspopt_metric::{MetricConfig, score_clouds, score_wrenches};
 use graspopt_protocol::{FingertipWrench, FingertipWrenches, RunId};
 use graspopt_sensing::SensorNoise;
 use graspopt_sim::hand::hand_by_name;
@@ -127,7 +128,7 @@ fn exact_readings_score_as_their_contacts_and_their_forces_hold_the_weight() {
         "{:?}",
         f.slip_margins
     );
-    assert!(f.can_resist());
+    assert_eq!(f.can_resist(), Some(true));
     let weight = ForceSettings::default().object_mass * 9.81;
     assert!((f.external[2] + weight).abs() <= 1e-12, "{:?}", f.external);
 }
@@ -161,4 +162,45 @@ fn a_hand_error_fails_the_trial_with_it() {
     let (result, _) = score_wrenches(&msg, &ev.object, &MetricConfig::default());
     assert_eq!(result.error.as_deref(), Some("sensor 2 saturated"));
     assert_eq!(result.forces, None);
+}
+
+/// A sphere trial whose least forces Clarabel gave up on when it solved the program once
+/// (issue 29: the agent logged "WARN ... the conic solver failed" in the middle of a run and
+/// the result had no force analysis). Its clouds now get one: solved again, the forces hold
+/// the weight, and they are linear in it (0.6 times the mass, 0.6 times the forces).
+#[test]
+fn clouds_the_solver_once_gave_up_on_get_their_force_analysis() {
+    let object = Object::by_name("sphere").unwrap();
+    let space =
+        TrialSpace::with_params(&object, &[ParamKind::Approach, ParamKind::Vertical]).unwrap();
+    let ev = Evaluator::new(object, hand_by_name("barrett").unwrap(), space);
+    let e = ev
+        .evaluate(&[0.012411758742978396, 0.0361960938036442])
+        .unwrap();
+    let tag = TrialTag {
+        run_id: RunId::new("forces").unwrap(),
+        trial_id: 9,
+        attempt: 1,
+        worker: "hand-1".into(),
+    };
+    let clouds = clouds_from_outcome(&tag, &e.outcome, 0);
+    let analysed = |mass: f64| {
+        let mut config = MetricConfig::default();
+        config.forces.object_mass = mass;
+        let result = score_clouds(&clouds, &ev.object, &config);
+        assert_eq!(result.error, None);
+        assert_eq!(result.score, e.score.score);
+        result.forces.expect("a force analysis")
+    };
+    let f = analysed(0.5);
+    assert_eq!(
+        (f.can_resist(), f.unavailable.as_deref()),
+        (Some(true), None)
+    );
+    let norm = f.resisting_norm.unwrap();
+    let lighter = analysed(0.3).resisting_norm.unwrap();
+    assert!(
+        (lighter / 0.6 - norm).abs() <= 1e-6 * norm,
+        "{norm} vs {lighter}"
+    );
 }

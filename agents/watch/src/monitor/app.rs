@@ -215,6 +215,7 @@ pub(crate) mod tests {
                 resisting_max: Some(3.5),
                 net_wrench: None,
                 slip_margins: Vec::new(),
+                unavailable: None,
             }),
         }
     }

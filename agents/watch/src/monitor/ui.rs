@@ -191,7 +191,7 @@ mod tests {
             "30/60 trials",
             "30 completed, 1 running, 0 failed",
             "best: trial 12 score 0.21230 at approach=-0.03100, vertical=0.01040, force closure",
-            "best's forces: holds the load (4.905 N): least contact forces 6.250 N (largest 3.500 N)",
+            "best's forces: holds the load (4.905 N): least contact forces 6.250 N in all",
             "hand-1@lab  trial 14",
             "hand-2@lab  idle",
             "2 duplicates",
@@ -199,6 +199,10 @@ mod tests {
         ] {
             assert!(screen.contains(want), "{want:?} not on screen:\n{screen}");
         }
+        // The whole line where there is room (`--once`, a wide terminal).
+        let forces = "best's forces: holds the load (4.905 N): least contact forces 6.250 N in all (2-norm over the contacts), 3.500 N at the most loaded contact";
+        let lines = run_lines("demo", &m.runs["demo"], Instant::now());
+        assert!(lines.iter().any(|l| l == forces), "{lines:?}");
     }
 
     #[test]

@@ -24,7 +24,7 @@ fn mixed_batch() -> Vec<Write> {
         Write::Issue(issue(RUN, 1, 1, "w1", 10)),
         Write::Issue(bad),
         Write::Issue(issue(RUN, 3, 1, "w3", 10)),
-        Write::Result(result(RUN, 1, 1, "w1", 20, score_for(1))),
+        Write::Result(Box::new(result(RUN, 1, 1, "w1", 20, score_for(1)))),
         Write::Failure {
             trial_id: 99,
             attempt: 1,
@@ -37,7 +37,7 @@ fn mixed_batch() -> Vec<Write> {
             error: "the hand dropped it".into(),
             at_ms: 21,
         },
-        Write::Result(result(RUN, 1, 1, "w1", 22, score_for(1))),
+        Write::Result(Box::new(result(RUN, 1, 1, "w1", 22, score_for(1)))),
         Write::PlannerState {
             engine: vec![1, 2, 3],
             at_ms: 23,
@@ -158,7 +158,7 @@ fn batch_child_writer() {
     while Instant::now() < deadline {
         let mut batch: Vec<Write> = running
             .iter()
-            .map(|&t| Write::Result(result(BATCH_RUN, t, 1, "child", 0, score_for(t))))
+            .map(|&t| Write::Result(Box::new(result(BATCH_RUN, t, 1, "child", 0, score_for(t)))))
             .collect();
         let mut refused = issue(BATCH_RUN, issued + 1, 1, "child", 0);
         refused.params[0] = f64::INFINITY;

@@ -13,14 +13,18 @@ fn analysis() -> ForceAnalysis {
         resisting_max: Some(3.25),
         net_wrench: Some([3.0, 0.0, 4.0, 0.0, 0.0, 0.0]),
         slip_margins: vec![0.5, -0.125, 2.0],
+        unavailable: None,
     }
 }
+
+/// Why the least forces of a trial were unavailable, as the solver reports it.
+const UNAVAILABLE: &str = "the conic solver stopped without an answer in each of the 4 ways it was tried (as posed: InsufficientProgress; scaled to a unit load: NumericalError)";
 
 #[test]
 fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
     let mut j = Journal::open_in_memory().unwrap();
     j.create_run(&run_record(RUN)).unwrap();
-    for t in 1..=2 {
+    for t in 1..=3 {
         j.record_issue(&issue(RUN, t, 1, "w1", 100)).unwrap();
     }
     let mut with = result(RUN, 1, 1, "w1", 200, 0.5);
@@ -35,7 +39,19 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
         ..analysis()
     });
     j.record_result(&cannot).unwrap();
+    // The least forces unknown: the score stands, the measured forces too.
+    let unknown = ForceAnalysis {
+        resisting_norm: None,
+        resisting_max: None,
+        unavailable: Some(UNAVAILABLE.into()),
+        ..analysis()
+    };
+    let mut unavailable = result(RUN, 3, 1, "w1", 400, 0.125);
+    unavailable.forces = Some(unknown.clone());
+    j.record_result(&unavailable).unwrap();
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap().forces, Some(analysis()));
+    assert_eq!(j.trial(RUN, 3).unwrap().unwrap().forces, Some(unknown));
+    assert_eq!(j.trial(RUN, 3).unwrap().unwrap().score, Some(0.125));
 
     let mut csv = Vec::new();
     write_csv(&j, RUN, &mut csv).unwrap();
@@ -46,7 +62,11 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
         let i = header.iter().position(|h| *h == name).unwrap();
         row.split(',').nth(i).unwrap().to_string()
     };
-    let (first, second) = (lines.next().unwrap(), lines.next().unwrap());
+    let (first, second, third) = (
+        lines.next().unwrap(),
+        lines.next().unwrap(),
+        lines.next().unwrap(),
+    );
     assert_eq!(column(first, "can_resist"), "true");
     assert_eq!(column(first, "resisting_force"), "5.5");
     assert_eq!(column(first, "resisting_max"), "3.25");
@@ -55,6 +75,15 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
     assert_eq!(column(second, "can_resist"), "false");
     assert_eq!(column(second, "resisting_force"), "");
     assert_eq!(column(second, "net_force"), "");
+    assert_eq!(column(first, "forces_unavailable"), "");
+    assert_eq!(column(second, "forces_unavailable"), "");
+    // Unavailable: neither "can" nor "cannot", the reason in its column.
+    assert_eq!(column(third, "score"), "0.125");
+    assert_eq!(column(third, "can_resist"), "");
+    assert_eq!(column(third, "resisting_force"), "");
+    assert_eq!(column(third, "resisting_max"), "");
+    assert_eq!(column(third, "net_force"), "5.0");
+    assert_eq!(column(third, "forces_unavailable"), UNAVAILABLE);
 
     let mut json = Vec::new();
     write_json(&j, RUN, &mut json).unwrap();
@@ -62,6 +91,11 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
     assert_eq!(json["trials"][0]["forces"]["resisting_norm"], 5.5);
     assert_eq!(
         json["trials"][1]["forces"]["resisting_norm"],
+        serde_json::Value::Null
+    );
+    assert_eq!(json["trials"][2]["forces"]["unavailable"], UNAVAILABLE);
+    assert_eq!(
+        json["trials"][0]["forces"]["unavailable"],
         serde_json::Value::Null
     );
 }

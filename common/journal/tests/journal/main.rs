@@ -482,10 +482,11 @@ fn csv_export_fields() {
             "resisting_max",
             "net_force",
             "min_slip_margin",
+            "forces_unavailable",
             "error"
         ]
     );
-    assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
+    assert!(records.iter().all(|r| r.len() == 26), "{records:?}");
     let f64_at = |rec: &[String], i: usize| rec[i].parse::<f64>().unwrap().to_bits();
 
     let done = &records[1];
@@ -506,12 +507,12 @@ fn csv_export_fields() {
     assert_eq!(f64_at(done, 13), m.volume.unwrap().to_bits());
     assert_eq!(f64_at(done, 14), m.distance.to_bits());
     assert_eq!(f64_at(done, 15), m.bw.to_bits());
-    assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", ""]);
+    assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", "", ""]);
 
     let failed = &records[2];
     assert_eq!(&failed[..6], ["2", "failed", "1", "w,2", "300", ""]);
-    assert!(failed[9..24].iter().all(String::is_empty), "{failed:?}");
-    assert_eq!(failed[24], message);
+    assert!(failed[9..25].iter().all(String::is_empty), "{failed:?}");
+    assert_eq!(failed[25], message);
 
     let no_metrics = &records[3];
     assert_eq!(no_metrics[9], "1.0");
@@ -521,7 +522,7 @@ fn csv_export_fields() {
     );
     assert_eq!(
         &no_metrics[16..],
-        ["7", "3", "4096", "", "", "", "", "", ""]
+        ["7", "3", "4096", "", "", "", "", "", "", ""]
     );
 
     let running = &records[4];
@@ -544,7 +545,7 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
     let records = parse_csv(&text);
     assert_eq!(records.len(), 3, "{text}");
     assert!(!records[0].contains(&"volume".to_string()), "{text}");
-    assert!(records.iter().all(|r| r.len() == 24), "{records:?}");
+    assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
     let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
     let m = metrics_for(1);
     assert_eq!(records[1][column("epsilon")], format!("{:?}", m.epsilon));

@@ -20,6 +20,15 @@
 //! lengths are first divided by a power of two near the largest of `|p_i - c|` and
 //! `gamma`, and forces by a power of two near the external wrench (exact in floating
 //! point): the result does not depend on the units of the input.
+//!
+//! An interior-point solver can stop without an answer near its tolerance on a program
+//! with dozens of nearly parallel contacts (the surface model's): `InsufficientProgress` or
+//! `NumericalError`, in 21 of 147,798 analyses of Barrett-hand trials on the mug, sphere and
+//! rotated cuboid (issue 29). The same program is then solved again in other ways
+//! ([`ATTEMPTS`]): with more regularization, scaled to a unit load (not a power of two, so
+//! every number rounds differently), and last to Clarabel's default tolerance (1e-8). When
+//! every way stops, the answer is [`Resisting::Unavailable`] with how each ended: the
+//! program was not decided, which says nothing about the grasp.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -33,12 +42,56 @@ use crate::error::QualityError;
 use crate::hull::power_of_two_scale;
 use crate::wrench::{Wrench, force, torque};
 
-/// Solver tolerance (gap and feasibility), relative to the scaled data (of order 1).
-const TOLERANCE: f64 = 1e-10;
+/// One way of solving the program, tried in turn while the solver stops without an answer.
+#[derive(Debug, Clone, Copy)]
+struct Attempt {
+    /// What the attempt changes, for the reason of an unavailable answer.
+    what: &'static str,
+    /// Solver tolerance (gap and feasibility), relative to the scaled data (of order 1).
+    tolerance: f64,
+    /// The tolerance of a solution the solver reports as almost solved (Clarabel's
+    /// default, 5e-5, would let the forces miss equilibrium by that much).
+    reduced: f64,
+    /// Clarabel's static regularization of the KKT system (its default is 1e-8).
+    regularization: f64,
+    /// Forces over the norm of the external wrench (a unit load) rather than over a power
+    /// of two near its largest component.
+    unit_load: bool,
+}
 
-/// The tolerance of a solution the solver reports as almost solved (Clarabel's default,
-/// 5e-5, would let the forces miss equilibrium by that much).
-const REDUCED_TOLERANCE: f64 = 1e-8;
+/// The ways of solving the program, in order (see the module documentation). Each of the
+/// retries alone gave forces on all 21 trials of the mug, sphere and rotated cuboid that
+/// stopped the first (`examples/force_failures.rs` in graspopt-trial; docs/benchmarks.md).
+const ATTEMPTS: [Attempt; 4] = [
+    Attempt {
+        what: "as posed",
+        tolerance: 1e-10,
+        reduced: 1e-8,
+        regularization: 1e-8,
+        unit_load: false,
+    },
+    Attempt {
+        what: "with 10 times the regularization",
+        tolerance: 1e-10,
+        reduced: 1e-8,
+        regularization: 1e-7,
+        unit_load: false,
+    },
+    Attempt {
+        what: "scaled to a unit load",
+        tolerance: 1e-10,
+        reduced: 1e-8,
+        regularization: 1e-8,
+        unit_load: true,
+    },
+    Attempt {
+        what: "to tolerance 1e-8",
+        tolerance: 1e-8,
+        reduced: 1e-8,
+        regularization: 1e-8,
+        unit_load: true,
+    },
+];
 
 /// The outcome of [`resisting_forces`].
 #[derive(Debug, Clone, PartialEq)]
@@ -49,13 +102,17 @@ pub enum Resisting {
     /// No contact forces inside the friction cones cancel the external wrench: the grasp
     /// cannot hold the object against it. `reason` says how the solver concluded so.
     CannotResist { reason: String },
+    /// The solver stopped without an answer in every way the program was tried (numerical
+    /// trouble, which says nothing about the grasp): `reason` names each way and how it
+    /// ended.
+    Unavailable { reason: String },
 }
 
 /// The contact forces of least norm, each inside its exact friction cone under `model`,
 /// whose net wrench on the object about `reference_point` cancels `external` (the
 /// wrench the world applies to the object, e.g. [`super::gravity_wrench`]); see the
-/// module documentation for the program and its objective. A zero external wrench needs
-/// zero forces.
+/// module documentation for the program, its objective and how a numerical failure is
+/// retried. A zero external wrench needs zero forces.
 pub fn resisting_forces(
     contacts: &[Contact],
     model: &FrictionModel,
@@ -70,10 +127,9 @@ pub fn resisting_forces(
         FrictionModel::PointFriction { mu, .. } => (mu, 0.0),
         FrictionModel::SoftFinger { mu, gamma, .. } => (mu, gamma),
     };
-    let m = contacts.len();
     if external.iter().all(|&x| x == 0.0) {
         return Ok(Resisting::Forces {
-            forces: ContactForces::without_torsion(vec![Vector3::zeros(); m]),
+            forces: ContactForces::without_torsion(vec![Vector3::zeros(); contacts.len()]),
             norm: 0.0,
         });
     }
@@ -89,52 +145,47 @@ pub fn resisting_forces(
     );
     let w_force = force(external);
     let w_torque = torque(external) / length;
-    let unit = power_of_two_scale(w_force.amax().max(w_torque.amax()));
-    let problem = Problem {
+    let mut problem = Problem {
         contacts,
         arms: arms.iter().map(|r| r / length).collect(),
         mu,
         gamma: gamma / length,
-        external: [w_force / unit, w_torque / unit],
+        external: [w_force, w_torque],
     };
-    let x = match problem.solve()? {
-        Ok(x) => x,
-        Err(reason) => return Ok(Resisting::CannotResist { reason }),
-    };
-    let mut forces = Vec::with_capacity(m);
-    let mut torsions = Vec::with_capacity(m);
-    let mut norm2 = 0.0;
-    for (i, c) in contacts.iter().enumerate() {
-        // The solver's point, moved onto its cones where it is outside them (by at most
-        // the solver's tolerance), so that every slip margin is >= 0.
-        let v = problem.variables(i);
-        let normal = x[v.normal].max(0.0);
-        let (t1, t2) = tangent_basis(&c.normal);
-        let mut f = c.normal * normal;
-        if let Some(a) = v.tangent {
-            let tangential = t1 * x[a] + t2 * x[a + 1];
-            let (limit, magnitude) = (mu * normal, tangential.norm());
-            f += if magnitude > limit {
-                tangential * (limit / magnitude)
-            } else {
-                tangential
-            };
+    let mut stopped = Vec::new();
+    for attempt in &ATTEMPTS {
+        let mut unit = power_of_two_scale(w_force.amax().max(w_torque.amax()));
+        if attempt.unit_load {
+            // The norm of the wrench already scaled by a power of two (no underflow).
+            unit *= ((w_force / unit).norm_squared() + (w_torque / unit).norm_squared()).sqrt();
         }
-        let s = v.torsion.map_or(0.0, |s| x[s].clamp(-normal, normal));
-        norm2 += f.norm_squared() + s * s;
-        forces.push(f * unit);
-        torsions.push(gamma * s * unit);
+        problem.external = [w_force / unit, w_torque / unit];
+        match problem.solve(attempt) {
+            Solved::Point(x) => match problem.forces(&x, unit, gamma) {
+                Some(forces) => return Ok(forces),
+                None => stopped.push(format!("{}: a solution that is not finite", attempt.what)),
+            },
+            Solved::Infeasible(reason) => return Ok(Resisting::CannotResist { reason }),
+            Solved::Stopped(why) => stopped.push(format!("{}: {why}", attempt.what)),
+        }
     }
-    let norm = norm2.sqrt() * unit;
-    if !norm.is_finite() {
-        return Err(QualityError::Solver(format!(
-            "contact forces: the solution is not finite ({norm})"
-        )));
-    }
-    Ok(Resisting::Forces {
-        forces: ContactForces::new(forces, torsions),
-        norm,
+    Ok(Resisting::Unavailable {
+        reason: format!(
+            "the conic solver stopped without an answer in each of the {} ways it was tried ({})",
+            ATTEMPTS.len(),
+            stopped.join("; ")
+        ),
     })
+}
+
+/// How one solve ended.
+enum Solved {
+    /// The solver's variables.
+    Point(Vec<f64>),
+    /// The solver proved the program infeasible: why, for people.
+    Infeasible(String),
+    /// The solver stopped without an answer (or could not start): its status.
+    Stopped(String),
 }
 
 /// The program in scaled units.
@@ -170,6 +221,11 @@ impl Problem<'_> {
         1 + 2 * usize::from(self.tangential()) + usize::from(self.torsional())
     }
 
+    /// The number of variables.
+    fn columns(&self) -> usize {
+        1 + self.contacts.len() * self.per_contact()
+    }
+
     /// Contact `i`'s columns; column 0 is `t`.
     fn variables(&self, i: usize) -> Variables {
         let normal = 1 + i * self.per_contact();
@@ -184,10 +240,47 @@ impl Problem<'_> {
         }
     }
 
-    /// The solver's variables, or `Err(reason)` when it proves the program infeasible.
-    fn solve(&self) -> Result<Result<Vec<f64>, String>, QualityError> {
+    /// The contact forces of the solver's point `x` in the units of the input (`unit`: the
+    /// force unit, `gamma` unscaled), or `None` if they are not finite.
+    fn forces(&self, x: &[f64], unit: f64, gamma: f64) -> Option<Resisting> {
         let m = self.contacts.len();
-        let n = 1 + m * self.per_contact();
+        let mut forces = Vec::with_capacity(m);
+        let mut torsions = Vec::with_capacity(m);
+        let mut norm2 = 0.0;
+        for (i, c) in self.contacts.iter().enumerate() {
+            // The solver's point, moved onto its cones where it is outside them (by at
+            // most the solver's tolerance), so that every slip margin is >= 0.
+            let v = self.variables(i);
+            let normal = x[v.normal].max(0.0);
+            let (t1, t2) = tangent_basis(&c.normal);
+            let mut f = c.normal * normal;
+            if let Some(a) = v.tangent {
+                let tangential = t1 * x[a] + t2 * x[a + 1];
+                let (limit, magnitude) = (self.mu * normal, tangential.norm());
+                f += if magnitude > limit {
+                    tangential * (limit / magnitude)
+                } else {
+                    tangential
+                };
+            }
+            let s = v.torsion.map_or(0.0, |s| x[s].clamp(-normal, normal));
+            norm2 += f.norm_squared() + s * s;
+            forces.push(f * unit);
+            torsions.push(gamma * s * unit);
+        }
+        let norm = norm2.sqrt() * unit;
+        let finite = norm.is_finite() && torsions.iter().all(|t| t.is_finite());
+        finite.then(|| Resisting::Forces {
+            forces: ContactForces::new(forces, torsions),
+            norm,
+        })
+    }
+
+    /// The constraints `A x + s = b`, `s` in the cones: equilibrium, the friction cones
+    /// and the objective's cone.
+    fn constraints(&self) -> (CscMatrix<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
+        let m = self.contacts.len();
+        let n = self.columns();
         let mut a = Triplets::default();
         // Zero cone, rows 0..6: the contact wrenches sum to -external.
         for (i, contact) in self.contacts.iter().enumerate() {
@@ -251,37 +344,49 @@ impl Problem<'_> {
             b[k] = -self.external[0][k];
             b[3 + k] = -self.external[1][k];
         }
+        (a, b, cones)
+    }
+
+    /// Solves the program as `attempt` says.
+    fn solve(&self, attempt: &Attempt) -> Solved {
+        let n = self.columns();
+        let (a, b, cones) = self.constraints();
         let p = CscMatrix::zeros((n, n));
         let mut q = vec![0.0; n];
         q[0] = 1.0;
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
-            .tol_gap_abs(TOLERANCE)
-            .tol_gap_rel(TOLERANCE)
-            .tol_feas(TOLERANCE)
-            .reduced_tol_gap_abs(REDUCED_TOLERANCE)
-            .reduced_tol_gap_rel(REDUCED_TOLERANCE)
-            .reduced_tol_feas(REDUCED_TOLERANCE)
-            .build()
-            .map_err(|e| QualityError::Solver(format!("contact forces: {e:?}")))?;
-        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-            .map_err(|e| QualityError::Solver(format!("contact forces: {e:?}")))?;
+            .static_regularization_constant(attempt.regularization)
+            .tol_gap_abs(attempt.tolerance)
+            .tol_gap_rel(attempt.tolerance)
+            .tol_feas(attempt.tolerance)
+            .reduced_tol_gap_abs(attempt.reduced)
+            .reduced_tol_gap_rel(attempt.reduced)
+            .reduced_tol_feas(attempt.reduced)
+            .build();
+        let solver = settings
+            .map_err(|e| format!("settings {e:?}"))
+            .and_then(|s| {
+                DefaultSolver::new(&p, &q, &a, &b, &cones, s).map_err(|e| format!("{e:?}"))
+            });
+        let mut solver = match solver {
+            Ok(solver) => solver,
+            Err(why) => return Solved::Stopped(why),
+        };
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok(Ok(std::mem::take(&mut solver.solution.x)))
+                Solved::Point(std::mem::take(&mut solver.solution.x))
             }
-            SolverStatus::PrimalInfeasible => Ok(Err(
+            SolverStatus::PrimalInfeasible => Solved::Infeasible(
                 "the solver proved that no contact forces in the friction cones cancel the external wrench"
                     .into(),
-            )),
-            SolverStatus::AlmostPrimalInfeasible => Ok(Err(
+            ),
+            SolverStatus::AlmostPrimalInfeasible => Solved::Infeasible(
                 "the solver found, to reduced accuracy, that no contact forces in the friction cones cancel the external wrench"
                     .into(),
-            )),
-            other => Err(QualityError::Solver(format!(
-                "contact forces: status {other:?}"
-            ))),
+            ),
+            other => Solved::Stopped(format!("{other:?}")),
         }
     }
 }

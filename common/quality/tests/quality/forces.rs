@@ -538,6 +538,7 @@ fn force_closure_grasps_resist_any_wrench() {
                 assert!(!metrics.force_closure, "{contacts:?} {external:?}");
                 refused += 1;
             }
+            Resisting::Unavailable { reason } => panic!("{contacts:?} {external:?}: {reason}"),
         }
         closed += usize::from(metrics.force_closure);
     }
@@ -583,8 +584,8 @@ fn extreme_valid_input_gives_forces_or_a_named_error() {
                 );
                 assert!(norm.is_finite());
             }
-            Err(QualityError::Solver(status)) if model == point(1e6) => {
-                assert!(status.contains("status"), "{status}");
+            Ok(Resisting::Unavailable { reason }) if model == point(1e6) => {
+                println!("{reason}");
             }
             other => panic!("{model:?} {external:?}: {other:?}"),
         }

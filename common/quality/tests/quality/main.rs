@@ -3,6 +3,7 @@
 
 mod bad_input;
 mod forces;
+mod forces_numerical;
 mod known_values;
 mod properties;
 mod reference_cases;
