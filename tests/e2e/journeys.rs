@@ -108,7 +108,8 @@ impl Hand {
             recorded: Recorded::None,
         };
         match source {
-            Source::Builtin => {}
+            // Turned 45 degrees in the world: the hands must see it where perception does.
+            Source::Builtin => hand.object = "rotated_cuboid",
             Source::File => {
                 let file = copy_test_hand(dir);
                 // In a launch file, as a user writes it: relative to the folder it runs in.
