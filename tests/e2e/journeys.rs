@@ -222,6 +222,23 @@ impl Hand {
     }
 }
 
+/// The flags that say what a journey's run is: object, hand (by the coordinator's name for
+/// it), budget, seed.
+fn run_flags(hand: &Hand) -> Vec<String> {
+    [
+        "--object",
+        hand.object,
+        "--hand",
+        &hand.coordinator_hand,
+        "--trials",
+        &TRIALS.to_string(),
+        "--seed",
+        SEED,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
 /// A shared-memory prefix of its own for one journey.
 fn shm_prefix(run: &str) -> String {
     let tag: String = run.chars().filter(char::is_ascii_alphanumeric).collect();
@@ -238,28 +255,20 @@ fn embedded(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let shm = shm_prefix(run);
-    let mut args: Vec<String> = [
-        "run",
-        "--run",
-        run,
-        "--object",
-        hand.object,
-        "--hand",
-        &hand.coordinator_hand,
-        "--trials",
-        &TRIALS.to_string(),
-        "--seed",
-        SEED,
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--listen",
-        &endpoint,
-        "--shm-prefix",
-        &shm,
-    ]
-    .map(String::from)
-    .to_vec();
+    let mut args: Vec<String> = ["run", "--run", run].map(String::from).to_vec();
+    args.extend(run_flags(hand));
+    args.extend(
+        [
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--listen",
+            &endpoint,
+            "--shm-prefix",
+            &shm,
+        ]
+        .map(String::from),
+    );
     let workers = if hand.python.is_some() { "0" } else { "2" };
     args.extend(["--workers".into(), workers.into()]);
     args.extend(hand.sensing.iter().map(|s| s.to_string()));
@@ -299,20 +308,8 @@ fn launch(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
             quoted(&hand.agent_flags())
         );
     }
-    let coordinator: Vec<String> = [
-        "--object",
-        hand.object,
-        "--hand",
-        &hand.coordinator_hand,
-        "--trials",
-        &TRIALS.to_string(),
-        "--seed",
-        SEED,
-        "--journal",
-        &format!("results/{run}/journal.sqlite"),
-    ]
-    .map(String::from)
-    .to_vec();
+    let mut coordinator = run_flags(hand);
+    coordinator.extend(["--journal".into(), format!("results/{run}/journal.sqlite")]);
     file += &format!(
         "[[agent]]\nkind = \"coordinator\"\nargs = [{}]\n",
         quoted(&coordinator)

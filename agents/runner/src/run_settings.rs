@@ -234,11 +234,12 @@ impl RecordedSettings {
 }
 
 impl RunSettings {
-    /// The spec these settings ask for, with `bounds` (a resumed run's recorded ones).
-    fn spec(&self, object: String, bounds: Option<Vec<[f64; 2]>>) -> Result<RunSpec> {
+    /// The spec these settings ask for, of the hand called `hand` (its name: see
+    /// [`graspopt_sim::hand_name`]), with `bounds` (a resumed run's recorded ones).
+    fn spec(&self, object: String, hand: String, bounds: Option<Vec<[f64; 2]>>) -> Result<RunSpec> {
         Ok(RunSpec {
             object,
-            hand: graspopt_sim::hand_name(&self.trial.hand)?,
+            hand,
             params: self.params.clone(),
             bounds,
             trials: self.trials,
@@ -331,6 +332,7 @@ impl RunSettings {
             // The run's ranges are recorded with it (a resumed run keeps them).
             spec: self.spec(
                 object,
+                evaluator.hand.name().to_string(),
                 Some(graspopt_coordinator::bounds_of(&evaluator.space)),
             )?,
             workers: self.workers,
@@ -384,7 +386,8 @@ impl RunSettings {
                 graspopt_coordinator::quoted_runs(&runs),
             );
         };
-        let mut given = self.spec(self.trial.object.clone(), recorded.bounds.clone())?;
+        let hand = graspopt_sim::hand_name(&self.trial.hand)?;
+        let mut given = self.spec(self.trial.object.clone(), hand, recorded.bounds.clone())?;
         given.settings = None;
         let mut conflicts = graspopt_coordinator::resume_conflicts(&recorded, &given, explicit);
         let recorded_settings = recorded
