@@ -22,7 +22,8 @@ pub struct MapLine {
 }
 
 /// The lines of the first ```` ```crate-edges ```` block of `doc`: `crate -> a, b` (or
-/// `crate ->` for none); `#` starts a comment.
+/// `crate ->` for none; a crate's edges may go on over consecutive lines); `#` starts a
+/// comment.
 pub fn parse_map(doc: &str) -> Result<Vec<MapLine>, String> {
     let mut lines = doc.lines().skip_while(|l| l.trim() != "```crate-edges");
     if lines.next().is_none() {
@@ -120,12 +121,15 @@ pub fn mismatches(
     let mut out = Vec::new();
     let mut listed: BTreeMap<&str, usize> = BTreeMap::new();
     for (i, line) in map.iter().enumerate() {
-        if listed.insert(&line.krate, i).is_some() {
+        // A crate's edges may go on over consecutive lines.
+        let continued = i > 0 && map[i - 1].krate == line.krate;
+        if listed.contains_key(line.krate.as_str()) && !continued {
             out.push(format!(
-                "{MAP} lists crate `{}` twice: merge its lines",
+                "{MAP} lists crate `{}` in two places: put its lines together",
                 line.krate
             ));
         }
+        listed.entry(&line.krate).or_insert(i);
         if !crates.contains_key(&line.krate) {
             out.push(format!(
                 "{MAP} lists crate `{}`, which is no workspace member: remove its line",
@@ -177,6 +181,35 @@ pub fn mismatches(
     out
 }
 
+/// The crates of the workspace, but the binary, that depend on `anyhow` or `clap` (normal or
+/// build dependencies): library crates return typed errors and take plain settings.
+pub fn binary_only_dependencies(metadata: &Value) -> Vec<String> {
+    let mut out = Vec::new();
+    let members: BTreeSet<&str> = metadata["workspace_members"]
+        .as_array()
+        .expect("metadata workspace_members")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    let packages = metadata["packages"].as_array().expect("metadata packages");
+    for p in packages
+        .iter()
+        .filter(|p| p["id"].as_str().is_some_and(|id| members.contains(id)))
+    {
+        let name = p["name"].as_str().expect("a package name");
+        if name == "graspopt" {
+            continue;
+        }
+        for d in p["dependencies"].as_array().expect("package dependencies") {
+            let dep = d["name"].as_str().expect("a dependency name");
+            if matches!(dep, "anyhow" | "clap") && d["kind"].as_str() != Some("dev") {
+                out.push(format!("{name} depends on {dep}"));
+            }
+        }
+    }
+    out
+}
+
 fn metadata() -> Value {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = root().join("Cargo.toml");
@@ -218,12 +251,23 @@ fn the_crate_edges_of_the_map_are_the_cargo_toml_files() {
 }
 
 #[test]
+fn only_the_binary_uses_anyhow_and_clap() {
+    let wrong = binary_only_dependencies(&metadata());
+    assert!(
+        wrong.is_empty(),
+        "library crates return typed errors (an error.rs with a thiserror enum) and take plain \
+         settings; anyhow and clap belong to agents/graspopt only:\n  {}",
+        wrong.join("\n  ")
+    );
+}
+
+#[test]
 fn a_stale_map_is_named_edge_by_edge() {
     let map = parse_map(
-        "x\n```crate-edges\n# comment\nsim ->\ntrial -> sim, quality # why\nquality ->\n```\n",
+        "x\n```crate-edges\n# comment\nsim ->\ntrial -> sim\ntrial -> quality # why\nquality ->\nsim ->\n```\n",
     )
     .unwrap();
-    assert_eq!(map[1].deps, ["sim", "quality"]);
+    assert_eq!(map[2].deps, ["quality"]);
     let crates: BTreeMap<String, String> = ["sim", "trial", "quality", "new"]
         .iter()
         .map(|c| (c.to_string(), format!("common/{c}/Cargo.toml")))
@@ -242,12 +286,13 @@ fn a_stale_map_is_named_edge_by_edge() {
         "edge sim -> quality (common/sim/Cargo.toml [dependencies]) is not in",
         "lists edge trial -> quality, but common/trial/Cargo.toml has no such",
         "`trial` depends on `quality`, listed below it",
+        "lists crate `sim` in two places",
     ] {
         assert!(
             wrong.contains(expected),
             "{expected:?} missing from:\n{wrong}"
         );
     }
-    assert_eq!(wrong.lines().count(), 4, "{wrong}");
+    assert_eq!(wrong.lines().count(), 5, "{wrong}");
     assert!(parse_map("no block").is_err());
 }
