@@ -38,15 +38,7 @@ pub use table::*;
 /// The first chunk of every key.
 pub const ROOT: &str = "graspopt";
 
-/// A key chunk that is not valid (empty, too long or with a character outside the allowed set).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "invalid {what} {value:?}: use 1 to 64 ASCII letters, digits, '-', '_' or '.' (not starting with '.')"
-)]
-pub struct KeyError {
-    pub what: &'static str,
-    pub value: String,
-}
+pub use crate::error::KeyError;
 
 fn check_chunk(what: &'static str, value: &str) -> Result<(), KeyError> {
     let ok = !value.is_empty()
