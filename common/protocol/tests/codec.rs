@@ -277,6 +277,12 @@ fn a_topic_decodes_to_its_message_fields() {
         // Another topic's type does not decode from these bytes.
         assert!(decode_topic(Topic::Object, &bytes, enc).is_err());
     }
+    // Each topic decodes its own row's message type.
+    for topic in Topic::ALL {
+        let e = decode_topic(topic, &[], Encoding::Bincode).unwrap_err();
+        let message_type = topic.message_type();
+        assert_eq!(e, DecodeError::Empty { message_type }, "{topic:?}");
+    }
 }
 
 /// `msg` encoded with bincode (which carries any number) is refused on decoding, naming
