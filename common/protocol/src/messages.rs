@@ -8,9 +8,9 @@
 //! (`clouds.rs`, `wrenches.rs`), a trial's score (`result.rs`, `forces.rs`), the planner's
 //! query (`planner.rs`) and the run's state (`status.rs`); `pose.rs` is shared.
 //!
-//! To add a message: its struct and `impl Message` in the module of its concept (a new one
-//! for a new concept, re-exported below), then, for a topic, its row in the key table
-//! ([`crate::keys`]).
+//! To add a message: its struct and `impl Message` in the module of its concept (a new module
+//! for a new concept, declared and re-exported below), then, for a topic, its row in the key
+//! table ([`crate::keys`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -27,18 +27,15 @@ mod result;
 mod status;
 mod wrenches;
 
-pub use clouds::{CloudPoint, ContactClouds, FingerCloud};
-pub use command::TrialCommand;
-pub use forces::ForceAnalysis;
-pub use object::{MeshData, ObjectEstimate};
-pub use planner::{Observation, PlannerMethod, SuggestReply, SuggestRequest};
-pub use pose::Pose;
-pub use result::{MetricValues, TrialResult};
-pub use status::{
-    BestTrial, ErrorCounts, RunPhase, RunStatus, WaitReason, Waiting, WorkerStatus, describe_waits,
-    named_params,
-};
-pub use wrenches::{FingertipSurface, FingertipWrench, FingertipWrenches};
+pub use clouds::*;
+pub use command::*;
+pub use forces::*;
+pub use object::*;
+pub use planner::*;
+pub use pose::*;
+pub use result::*;
+pub use status::*;
+pub use wrenches::*;
 
 /// Implemented by every message type.
 pub trait Message: Serialize + for<'de> Deserialize<'de> {
