@@ -298,7 +298,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                     if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
                         && a.run_id == *run
                     {
-                        let failed = invalid_measurement_result(a, "contact clouds", detail, &config.id, r.path.as_str());
+                        let failed = invalid_measurement_result(a, "contact clouds", &detail.to_string(), &config.id, r.path.as_str());
                         if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
                             tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
                         }
@@ -317,7 +317,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Resul
                     if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
                         && a.run_id == *run
                     {
-                        let failed = invalid_measurement_result(a, "fingertip readings", detail, &config.id, "zenoh");
+                        let failed = invalid_measurement_result(a, "fingertip readings", &detail.to_string(), &config.id, "zenoh");
                         if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
                             tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
                         }
