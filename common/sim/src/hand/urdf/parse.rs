@@ -305,7 +305,11 @@ fn assign_roles(
     }
     for dof in d.dofs.iter_mut() {
         let joint = &robot.joints[dof.joint];
-        let s = settings.joints.get(&joint.name).cloned().unwrap_or_default();
+        let s = settings
+            .joints
+            .get(&joint.name)
+            .cloned()
+            .unwrap_or_default();
         match &joint.mimic {
             Some(m) => mimic_role(file, robot, &d.dof_of_joint, dof, m, &s)?,
             None => closing_role(file, dof, &s)?,
@@ -468,10 +472,7 @@ fn listed_fingers(
                 ));
             }
             if finger_of_link[i].is_some() {
-                return Err(bad(
-                    file,
-                    format!("settings: link `{l}` is in two fingers"),
-                ));
+                return Err(bad(file, format!("settings: link `{l}` is in two fingers")));
             }
             finger_of_link[i] = Some(f);
         }
