@@ -182,24 +182,66 @@ where
         let v = f(&x);
         if v.is_finite() { -v } else { 1e300 }
     };
-    let mut evals = 0usize;
-    let c0 = vec![0.5; d];
-    let f0 = eval(&c0, &mut evals);
-    let levels0 = vec![0u32; d];
-    let mut rects = vec![Rect {
-        size: rect_size(&levels0),
-        center: c0,
-        levels: levels0,
-        f: f0,
-    }];
-    let mut best = 0usize;
-    let mut groups = Groups::default();
-    groups.insert(rects[0].size, rects[0].f, 0);
+    let mut search = Search::start(d, &mut eval);
     loop {
+        let selected = search.potentially_optimal(settings);
+        if selected.is_empty() {
+            break;
+        }
+        let mut stop = false;
+        for j in selected {
+            if !search.divide(j, settings.max_evals, &mut eval) {
+                stop = true;
+                break;
+            }
+        }
+        if stop || search.evals >= settings.max_evals {
+            break;
+        }
+    }
+    Ok(search.result(to_x, top_k))
+}
+
+/// The state of a DIRECT run: the rectangles (unit cube, minimisation values), grouped by
+/// size, the best one and the evaluations used.
+struct Search {
+    rects: Vec<Rect>,
+    groups: Groups,
+    best: usize,
+    evals: usize,
+}
+
+impl Search {
+    /// The whole cube, evaluated at its centre.
+    fn start(d: usize, eval: &mut impl FnMut(&[f64], &mut usize) -> f64) -> Search {
+        let mut evals = 0usize;
+        let c0 = vec![0.5; d];
+        let f0 = eval(&c0, &mut evals);
+        let levels0 = vec![0u32; d];
+        let rects = vec![Rect {
+            size: rect_size(&levels0),
+            center: c0,
+            levels: levels0,
+            f: f0,
+        }];
+        let mut groups = Groups::default();
+        groups.insert(rects[0].size, rects[0].f, 0);
+        Search {
+            rects,
+            groups,
+            best: 0,
+            evals,
+        }
+    }
+
+    /// The potentially optimal rectangles that may still be divided: the best of each size,
+    /// on the lower convex hull of (size, value), passing the epsilon test.
+    fn potentially_optimal(&mut self, settings: &DirectSettings) -> Vec<usize> {
+        let rects = &self.rects;
         // Best rectangle per size (ties: the earliest); sizes ascending (positive f64 bit
         // patterns order like the values).
-        let fmin = rects[best].f;
-        let reps = groups.representatives(&rects);
+        let fmin = rects[self.best].f;
+        let reps = self.groups.representatives(rects);
         // Start at the group whose best value is the global minimum (largest such size).
         let mut start = 0;
         for (k, &i) in reps.iter().enumerate() {
@@ -207,23 +249,7 @@ where
                 start = k;
             }
         }
-        let pts: Vec<usize> = reps[start..].to_vec();
-        // Lower convex hull of (size, f), sizes increasing.
-        let mut hull: Vec<usize> = Vec::new();
-        for &p in &pts {
-            while hull.len() >= 2 {
-                let o = &rects[hull[hull.len() - 2]];
-                let a = &rects[hull[hull.len() - 1]];
-                let b = &rects[p];
-                let cross = (a.size - o.size) * (b.f - o.f) - (a.f - o.f) * (b.size - o.size);
-                if cross <= 0.0 {
-                    hull.pop();
-                } else {
-                    break;
-                }
-            }
-            hull.push(p);
-        }
+        let hull = lower_hull(rects, &reps[start..]);
         // Epsilon test with the largest admissible Lipschitz constant (slope to the next).
         let thresh = fmin - settings.epsilon * fmin.abs();
         let mut selected = Vec::new();
@@ -240,67 +266,96 @@ where
                 selected.push(j);
             }
         }
-        if selected.is_empty() {
-            break;
+        selected
+    }
+
+    /// Trisects rectangle `j` along its longest sides, the side with the best new centre
+    /// first (eq. 3.18); `false` (and nothing divided) when that would exceed `max_evals`.
+    fn divide(
+        &mut self,
+        j: usize,
+        max_evals: usize,
+        eval: &mut impl FnMut(&[f64], &mut usize) -> f64,
+    ) -> bool {
+        let rects = &mut self.rects;
+        let d = rects[j].levels.len();
+        let minl = rects[j].levels.iter().min().copied().unwrap_or(0);
+        let dims: Vec<usize> = (0..d).filter(|&i| rects[j].levels[i] == minl).collect();
+        if self.evals + 2 * dims.len() > max_evals {
+            return false;
         }
-        let mut stop = false;
-        for j in selected {
-            let minl = rects[j].levels.iter().min().copied().unwrap_or(0);
-            let dims: Vec<usize> = (0..d).filter(|&i| rects[j].levels[i] == minl).collect();
-            if evals + 2 * dims.len() > settings.max_evals {
-                stop = true;
-                break;
-            }
-            let delta = 3f64.powi(-(minl as i32 + 1));
-            let mut trial: Vec<Trial> = Vec::new();
-            for &i in &dims {
-                let mut cp = rects[j].center.clone();
-                cp[i] += delta;
-                let fp = eval(&cp, &mut evals);
-                let mut cm = rects[j].center.clone();
-                cm[i] -= delta;
-                let fm = eval(&cm, &mut evals);
-                trial.push((i, cp, fp, cm, fm));
-            }
-            trial.sort_by(|a, b| a.2.min(a.4).total_cmp(&b.2.min(b.4)));
-            let mut levels = rects[j].levels.clone();
-            for (i, cp, fp, cm, fm) in trial {
-                levels[i] += 1;
-                let size = rect_size(&levels);
-                for (c, fv) in [(cp, fp), (cm, fm)] {
-                    rects.push(Rect {
-                        center: c,
-                        levels: levels.clone(),
-                        f: fv,
-                        size,
-                    });
-                    groups.insert(size, fv, rects.len() - 1);
-                    if fv < rects[best].f {
-                        best = rects.len() - 1;
-                    }
+        let delta = 3f64.powi(-(minl as i32 + 1));
+        let mut trial: Vec<Trial> = Vec::new();
+        for &i in &dims {
+            let mut cp = rects[j].center.clone();
+            cp[i] += delta;
+            let fp = eval(&cp, &mut self.evals);
+            let mut cm = rects[j].center.clone();
+            cm[i] -= delta;
+            let fm = eval(&cm, &mut self.evals);
+            trial.push((i, cp, fp, cm, fm));
+        }
+        trial.sort_by(|a, b| a.2.min(a.4).total_cmp(&b.2.min(b.4)));
+        let mut levels = rects[j].levels.clone();
+        for (i, cp, fp, cm, fm) in trial {
+            levels[i] += 1;
+            let size = rect_size(&levels);
+            for (c, fv) in [(cp, fp), (cm, fm)] {
+                rects.push(Rect {
+                    center: c,
+                    levels: levels.clone(),
+                    f: fv,
+                    size,
+                });
+                self.groups.insert(size, fv, rects.len() - 1);
+                if fv < rects[self.best].f {
+                    self.best = rects.len() - 1;
                 }
             }
-            rects[j].size = rect_size(&levels);
-            rects[j].levels = levels;
-            groups.insert(rects[j].size, rects[j].f, j);
         }
-        if stop || evals >= settings.max_evals {
-            break;
+        rects[j].size = rect_size(&levels);
+        rects[j].levels = levels;
+        self.groups.insert(rects[j].size, rects[j].f, j);
+        true
+    }
+
+    /// The best point, its value and the `top_k` best centres (original coordinates).
+    fn result(&self, to_x: impl Fn(&[f64]) -> Vec<f64>, top_k: usize) -> DirectResult {
+        let rects = &self.rects;
+        let mut order: Vec<usize> = (0..rects.len()).collect();
+        order.sort_by(|&a, &b| rects[a].f.total_cmp(&rects[b].f));
+        let top = order
+            .iter()
+            .take(top_k)
+            .map(|&i| (to_x(&rects[i].center), -rects[i].f))
+            .collect();
+        DirectResult {
+            x: to_x(&rects[self.best].center),
+            value: -rects[self.best].f,
+            evals: self.evals,
+            top,
         }
     }
-    let mut order: Vec<usize> = (0..rects.len()).collect();
-    order.sort_by(|&a, &b| rects[a].f.total_cmp(&rects[b].f));
-    let top = order
-        .iter()
-        .take(top_k)
-        .map(|&i| (to_x(&rects[i].center), -rects[i].f))
-        .collect();
-    Ok(DirectResult {
-        x: to_x(&rects[best].center),
-        value: -rects[best].f,
-        evals,
-        top,
-    })
+}
+
+/// Lower convex hull of the rectangles `pts` in the (size, value) plane, sizes increasing.
+fn lower_hull(rects: &[Rect], pts: &[usize]) -> Vec<usize> {
+    let mut hull: Vec<usize> = Vec::new();
+    for &p in pts {
+        while hull.len() >= 2 {
+            let o = &rects[hull[hull.len() - 2]];
+            let a = &rects[hull[hull.len() - 1]];
+            let b = &rects[p];
+            let cross = (a.size - o.size) * (b.f - o.f) - (a.f - o.f) * (b.size - o.size);
+            if cross <= 0.0 {
+                hull.pop();
+            } else {
+                break;
+            }
+        }
+        hull.push(p);
+    }
+    hull
 }
 
 /// Local polish: maximise `f` (value and gradient) from `x0` within `[lower, upper]` by a short

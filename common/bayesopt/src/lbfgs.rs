@@ -96,7 +96,6 @@ pub fn minimize_problem<P: Problem + ?Sized>(
             evals,
         };
     }
-    let m = 6;
     let mut s_hist: Vec<Vec<f64>> = Vec::new();
     let mut y_hist: Vec<Vec<f64>> = Vec::new();
     let mut xn = vec![0.0; n];
@@ -110,83 +109,30 @@ pub fn minimize_problem<P: Problem + ?Sized>(
         if pg_norm <= gtol {
             break;
         }
-        // Two-loop recursion on the free variables.
-        let mut q = pg.clone();
-        let k = s_hist.len();
-        let mut alphas = vec![0.0; k];
-        for j in (0..k).rev() {
-            let rho = 1.0 / dot(&y_hist[j], &s_hist[j]);
-            alphas[j] = rho * dot(&s_hist[j], &q);
-            for i in 0..n {
-                q[i] -= alphas[j] * y_hist[j][i];
-            }
-        }
-        if k > 0 {
-            let gamma = dot(&s_hist[k - 1], &y_hist[k - 1]) / dot(&y_hist[k - 1], &y_hist[k - 1]);
-            q.iter_mut().for_each(|v| *v *= gamma);
-        } else {
-            // First step: unit-ish length.
-            let norm = dot(&pg, &pg).sqrt();
-            let scale = if iter == 0 {
-                (1.0 / norm).min(1.0)
-            } else {
-                1.0
-            };
-            q.iter_mut().for_each(|v| *v *= scale);
-        }
-        for j in 0..k {
-            let rho = 1.0 / dot(&y_hist[j], &s_hist[j]);
-            let beta = rho * dot(&y_hist[j], &q);
-            for i in 0..n {
-                q[i] += s_hist[j][i] * (alphas[j] - beta);
-            }
-        }
+        let q = two_loop(&pg, &s_hist, &y_hist, iter);
         let mut d: Vec<f64> = (0..n).map(|i| if free[i] { -q[i] } else { 0.0 }).collect();
         if dot(&d, &pg) >= 0.0 {
             d = pg.iter().map(|v| -v).collect();
             s_hist.clear();
             y_hist.clear();
         }
-        // Backtracking line search on the projected path.
-        let mut t = 1.0;
-        let mut accepted = false;
-        let mut fnew = f64::INFINITY;
-        for _ in 0..30 {
-            for i in 0..n {
-                xn[i] = x[i] + t * d[i];
-            }
-            project(&mut xn, lo, hi);
-            let step: Vec<f64> = (0..n).map(|i| xn[i] - x[i]).collect();
-            if step.iter().all(|v| *v == 0.0) {
-                break;
-            }
-            fnew = p.value(&xn);
-            evals += 1;
-            // Armijo condition first: the gradient is only needed at an accepted point.
-            if fnew.is_finite() && fnew <= fx + 1e-4 * dot(&g, &step) {
-                p.gradient(&xn, &mut gn);
-                if gn.iter().all(|v| v.is_finite()) {
-                    accepted = true;
-                    break;
-                }
-            }
-            t *= 0.5;
-        }
-        if !accepted {
+        let step = line_search(p, &x, &d, fx, &g, (lo, hi), (&mut xn, &mut gn));
+        evals += step.evals;
+        let Some(fnew) = step.value else {
             if s_hist.is_empty() {
                 break;
             }
             s_hist.clear();
             y_hist.clear();
             continue;
-        }
+        };
         let s: Vec<f64> = (0..n).map(|i| xn[i] - x[i]).collect();
         let yv: Vec<f64> = (0..n).map(|i| gn[i] - g[i]).collect();
         let sy = dot(&s, &yv);
         if sy > 1e-12 * dot(&yv, &yv).max(1e-300) {
             s_hist.push(s);
             y_hist.push(yv);
-            if s_hist.len() > m {
+            if s_hist.len() > MEMORY {
                 s_hist.remove(0);
                 y_hist.remove(0);
             }
@@ -200,6 +146,93 @@ pub fn minimize_problem<P: Problem + ?Sized>(
         }
     }
     Minimum { x, f: fx, evals }
+}
+
+/// How many steps the L-BFGS memory keeps.
+const MEMORY: usize = 6;
+
+/// The two-loop recursion on the free variables' gradient `pg`: the quasi-Newton step (before
+/// its sign), scaled to unit-ish length at the first iteration.
+fn two_loop(pg: &[f64], s_hist: &[Vec<f64>], y_hist: &[Vec<f64>], iter: usize) -> Vec<f64> {
+    let n = pg.len();
+    let mut q = pg.to_vec();
+    let k = s_hist.len();
+    let mut alphas = vec![0.0; k];
+    for j in (0..k).rev() {
+        let rho = 1.0 / dot(&y_hist[j], &s_hist[j]);
+        alphas[j] = rho * dot(&s_hist[j], &q);
+        for i in 0..n {
+            q[i] -= alphas[j] * y_hist[j][i];
+        }
+    }
+    if k > 0 {
+        let gamma = dot(&s_hist[k - 1], &y_hist[k - 1]) / dot(&y_hist[k - 1], &y_hist[k - 1]);
+        q.iter_mut().for_each(|v| *v *= gamma);
+    } else {
+        // First step: unit-ish length.
+        let norm = dot(pg, pg).sqrt();
+        let scale = if iter == 0 {
+            (1.0 / norm).min(1.0)
+        } else {
+            1.0
+        };
+        q.iter_mut().for_each(|v| *v *= scale);
+    }
+    for j in 0..k {
+        let rho = 1.0 / dot(&y_hist[j], &s_hist[j]);
+        let beta = rho * dot(&y_hist[j], &q);
+        for i in 0..n {
+            q[i] += s_hist[j][i] * (alphas[j] - beta);
+        }
+    }
+    q
+}
+
+/// A line search's outcome: the accepted value (`None`: no acceptable step) and the
+/// evaluations it used.
+struct Step {
+    value: Option<f64>,
+    evals: usize,
+}
+
+/// Backtracking line search from `x` (value `fx`, gradient `g`) along `d` on the path
+/// projected onto the box; writes the accepted point and its gradient into `(xn, gn)`.
+fn line_search<P: Problem + ?Sized>(
+    p: &mut P,
+    x: &[f64],
+    d: &[f64],
+    fx: f64,
+    g: &[f64],
+    (lo, hi): (&[f64], &[f64]),
+    (xn, gn): (&mut [f64], &mut [f64]),
+) -> Step {
+    let n = x.len();
+    let mut evals = 0;
+    let mut t = 1.0;
+    for _ in 0..30 {
+        for i in 0..n {
+            xn[i] = x[i] + t * d[i];
+        }
+        project(xn, lo, hi);
+        let step: Vec<f64> = (0..n).map(|i| xn[i] - x[i]).collect();
+        if step.iter().all(|v| *v == 0.0) {
+            break;
+        }
+        let fnew = p.value(xn);
+        evals += 1;
+        // Armijo condition first: the gradient is only needed at an accepted point.
+        if fnew.is_finite() && fnew <= fx + 1e-4 * dot(g, &step) {
+            p.gradient(xn, gn);
+            if gn.iter().all(|v| v.is_finite()) {
+                return Step {
+                    value: Some(fnew),
+                    evals,
+                };
+            }
+        }
+        t *= 0.5;
+    }
+    Step { value: None, evals }
 }
 
 #[cfg(test)]

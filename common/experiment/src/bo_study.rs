@@ -186,6 +186,78 @@ fn settings_error<T>(text: String) -> Result<T, ExperimentError> {
     Err(ExperimentError::Settings(text))
 }
 
+/// The grid of the 2D scan from `--steps` (one count for both axes, or two).
+fn grid_steps(steps: &str) -> Result<[usize; 2], ExperimentError> {
+    let counts: Vec<usize> = steps
+        .split(',')
+        .map(|s| s.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| {
+            ExperimentError::Settings(format!(
+                "--steps {:?}: expected counts like 67,33: {e}",
+                steps
+            ))
+        })?;
+    let [nx, ny] = match counts[..] {
+        [n] => [n, n],
+        [nx, ny] => [nx, ny],
+        _ => {
+            return settings_error(format!(
+                "--steps {:?}: expected one count or two, like 67,33",
+                steps
+            ));
+        }
+    };
+    if ![nx, ny].iter().all(|n| (2..=MAX_STEPS).contains(n)) {
+        return settings_error(format!(
+            "--steps {:?}: each count must be between 2 and {MAX_STEPS}",
+            steps
+        ));
+    }
+    Ok([nx, ny])
+}
+
+/// Each part's budget: more than the engine's initial design (a run no longer than it never
+/// uses the model) and at most [`MAX_BUDGET`].
+fn check_budgets(r: &BoRequest) -> Result<(), ExperimentError> {
+    for (flag, budget, dim, part) in [
+        ("--budget", r.budget, 2, Part::TwoD),
+        ("--budget-6d", r.budget_6d, 6, Part::SixD),
+    ] {
+        let init = Settings::default_n_init(dim);
+        if r.parts.contains(&part) && !(init < budget && budget <= MAX_BUDGET) {
+            return settings_error(format!(
+                "{flag} must be more than the engine's {init} initial-design trials in {dim}D and at most {MAX_BUDGET}, got {budget}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The objects of `--objects` (all built-in objects when none), each known, without
+/// repeats.
+fn object_names(objects: &[String]) -> Result<Vec<String>, ExperimentError> {
+    let mut unique: Vec<String> = Vec::new();
+    let named: Vec<String> = if objects.is_empty() {
+        graspopt_sim::Object::names()
+            .into_iter()
+            .map(String::from)
+            .collect()
+    } else {
+        objects.iter().map(|s| s.trim().to_string()).collect()
+    };
+    for o in named {
+        if o.is_empty() {
+            return settings_error("--objects has an empty name (two commas in a row?)".into());
+        }
+        graspopt_sim::Object::by_name(&o)?;
+        if !unique.contains(&o) {
+            unique.push(o);
+        }
+    }
+    Ok(unique)
+}
+
 impl BoStudy {
     /// Checks the request (error messages name the flags of `graspopt experiment bo`).
     pub fn plan(r: &BoRequest) -> Result<BoStudy, ExperimentError> {
@@ -211,63 +283,9 @@ impl BoStudy {
                 "--model-cap must be at least {MIN_MODEL_CAP} observations, got {n}"
             ));
         }
-        let steps: Vec<usize> = r
-            .steps
-            .split(',')
-            .map(|s| s.trim().parse::<usize>())
-            .collect::<Result<_, _>>()
-            .map_err(|e| {
-                ExperimentError::Settings(format!(
-                    "--steps {:?}: expected counts like 67,33: {e}",
-                    r.steps
-                ))
-            })?;
-        let [nx, ny] = match steps[..] {
-            [n] => [n, n],
-            [nx, ny] => [nx, ny],
-            _ => {
-                return settings_error(format!(
-                    "--steps {:?}: expected one count or two, like 67,33",
-                    r.steps
-                ));
-            }
-        };
-        if ![nx, ny].iter().all(|n| (2..=MAX_STEPS).contains(n)) {
-            return settings_error(format!(
-                "--steps {:?}: each count must be between 2 and {MAX_STEPS}",
-                r.steps
-            ));
-        }
-        // A run no longer than the engine's initial design never uses the model.
-        for (flag, budget, dim, part) in [
-            ("--budget", r.budget, 2, Part::TwoD),
-            ("--budget-6d", r.budget_6d, 6, Part::SixD),
-        ] {
-            let init = Settings::default_n_init(dim);
-            if r.parts.contains(&part) && !(init < budget && budget <= MAX_BUDGET) {
-                return settings_error(format!(
-                    "{flag} must be more than the engine's {init} initial-design trials in {dim}D and at most {MAX_BUDGET}, got {budget}"
-                ));
-            }
-        }
-        let mut objects: Vec<String> = Vec::new();
-        let named: Vec<String> = if r.objects.is_empty() {
-            graspopt_sim::Object::names()
-                .into_iter()
-                .map(String::from)
-                .collect()
-        } else {
-            r.objects.iter().map(|s| s.trim().to_string()).collect()
-        };
-        for o in named {
-            if o.is_empty() {
-                return settings_error("--objects has an empty name (two commas in a row?)".into());
-            }
-            graspopt_sim::Object::by_name(&o)?;
-            if !objects.contains(&o) {
-                objects.push(o);
-            }
-        }
+        let [nx, ny] = grid_steps(&r.steps)?;
+        check_budgets(r)?;
+        let objects = object_names(&r.objects)?;
         Ok(BoStudy {
             hand: r.hand.clone(),
             engine: r.engine,
@@ -284,7 +302,6 @@ impl BoStudy {
         })
     }
 
-    /// Whether the plan runs `part`.
     /// The engine's settings: the preset's, with the model cap of [`BoStudy::model_cap`].
     pub fn engine_settings(&self) -> Settings {
         let mut s = self.engine.settings();
@@ -296,6 +313,7 @@ impl BoStudy {
         s
     }
 
+    /// Whether the plan runs `part`.
     pub fn runs(&self, part: Part) -> bool {
         self.parts.contains(&part)
     }

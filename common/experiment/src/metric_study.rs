@@ -4,11 +4,12 @@
 //! - 4.3-4.5 ([`approach_metrics`]): Largest Sphere, Grasp Wrench Volume and BW along the
 //!   approach axis with mean-point contacts (the volume needs the full hull, too slow for
 //!   surface models);
-//! - 4.6 ([`contact_models`]): BW with the mean-point, circular-patch and surface models;
+//! - 4.6 ([`MetricStudy::contact_models`]): BW with the mean-point, circular-patch and surface models;
 //! - 4.7 ([`sphere_map`]): 2D BW maps of the sphere, mean point and surface model;
 //! - 4.8 ([`frames`]): BW in the object, world and hand frames (torque scale fixed);
 //! - 4.9-4.15 ([`object_map`]): 2D BW maps of all seven objects.
 
+use graspopt_sim::contact::oldest_first;
 use graspopt_sim::{ContactModel, ParamKind};
 use graspopt_trial::scan::ScanPoint;
 use graspopt_trial::{Metric, ReferenceFrame};
@@ -29,12 +30,6 @@ pub const APPROACH_FIGURES: [(&str, &str); 3] = [
 ];
 /// Figure 4.6's objects.
 pub const CONTACT_MODEL_OBJECTS: [&str; 2] = ["cuboid", "sphere"];
-/// Figure 4.6's contact models and their names.
-pub const CONTACT_MODELS: [(&str, ContactModel); 3] = [
-    ("mean point", ContactModel::MeanPoint),
-    ("circular patch", ContactModel::CircularPatch),
-    ("surface", ContactModel::Surface),
-];
 /// Figure 4.7's contact models and their names.
 pub const SPHERE_MAP_MODELS: [(&str, ContactModel); 2] = [
     ("mean-point", ContactModel::MeanPoint),
@@ -158,15 +153,18 @@ impl MetricStudy {
         })
     }
 
-    /// Figure 4.6: BW along the approach axis of `object` with each of [`CONTACT_MODELS`].
+    /// Figure 4.6: BW along the approach axis of `object` with each registered contact model
+    /// ([`graspopt_sim::contact::MODELS`]), oldest first as the thesis orders them, each named
+    /// by its label.
     pub fn contact_models(&self, object: &str) -> Result<Vec<Variant>, ExperimentError> {
-        CONTACT_MODELS
-            .iter()
-            .map(|&(name, model)| {
+        oldest_first()
+            .into_iter()
+            .map(|(_, e)| e.model)
+            .map(|model| {
                 let mut ev = evaluator(&self.hand, object, &[ParamKind::Approach])?;
                 ev.score.contacts = model;
                 Ok(Variant {
-                    name,
+                    name: model.label(),
                     scan: scan(&ev, &[self.steps], self.threads)?,
                 })
             })

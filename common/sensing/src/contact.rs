@@ -277,6 +277,51 @@ fn solve(
     surface.validate()?;
     settings.validate()?;
     reading.validate()?;
+    let (f, torque) = applied_wrench(reading, settings)?;
+    let soft = settings.kind == ContactKind::SoftFinger;
+    let candidates: Vec<Candidate> = surface
+        .pieces()
+        .iter()
+        .flat_map(|piece| piece_candidates(piece, &f, &torque, soft))
+        .collect();
+    if let Some(found) = from_candidates(surface, &candidates, &f, settings) {
+        return found;
+    }
+    // Point contact whose line of action misses the surface: within the tolerance, the
+    // surface point nearest the line.
+    let f_norm = f.norm();
+    let tol = settings.surface_tolerance;
+    let line_point = f.cross(&torque) / (f_norm * f_norm);
+    let direction = Unit::new_unchecked(f / f_norm);
+    let (point, distance) = surface.nearest_to_line(&line_point, &direction);
+    if distance > tol {
+        return Err(NoContact::MissesSurface { distance });
+    }
+    match surface.base_z() {
+        Some(base_z) if !usable(Some(base_z), tol, &point.coords) => {
+            Err(NoContact::OnMount { z: point.z, base_z })
+        }
+        _ => Ok(SensedContact {
+            point,
+            normal: surface.outward_normal(&point),
+            force: -f,
+            torsion: 0.0,
+        }),
+    }
+}
+
+/// Whether `p` is on the fingertip's usable surface: above its mount's base (`base`, if any)
+/// less the tolerance.
+fn usable(base: Option<f64>, tol: f64, p: &Vector3<f64>) -> bool {
+    base.is_none_or(|b| p.z >= b - tol)
+}
+
+/// The reading's force and the torque to explain: above the force threshold; for a point
+/// contact, with no more torsion than the pitch tolerance allows, and that torsion removed.
+fn applied_wrench(
+    reading: &Reading,
+    settings: &SensingSettings,
+) -> Result<(Vector3<f64>, Vector3<f64>), NoContact> {
     let f = reading.force;
     let f_norm = f.norm();
     let threshold = settings.force_threshold.max(MIN_FORCE);
@@ -286,9 +331,8 @@ fn solve(
             threshold,
         });
     }
-    let soft = settings.kind == ContactKind::SoftFinger;
     let mut torque = reading.torque;
-    if !soft {
+    if settings.kind != ContactKind::SoftFinger {
         let torsion = torque.dot(&f) / f_norm;
         let pitch = torsion / f_norm;
         if pitch.abs() > settings.pitch_tolerance {
@@ -300,29 +344,34 @@ fn solve(
         }
         torque -= f * (torque.dot(&f) / (f_norm * f_norm));
     }
-    let candidates: Vec<Candidate> = surface
-        .pieces()
-        .iter()
-        .flat_map(|piece| piece_candidates(piece, &f, &torque, soft))
-        .collect();
+    Ok((f, torque))
+}
+
+/// The contact among the pieces' `candidates` for the force `f`, or why there is none;
+/// `None` for a point contact whose line of action misses every piece (see [`solve`]).
+fn from_candidates(
+    surface: &FingertipSurface,
+    candidates: &[Candidate],
+    f: &Vector3<f64>,
+    settings: &SensingSettings,
+) -> Option<Result<SensedContact, NoContact>> {
     let tol = settings.surface_tolerance;
     let base = surface.base_z();
-    let usable = |p: &Vector3<f64>| base.is_none_or(|b| p.z >= b - tol);
+    let usable_at = |p: &Vector3<f64>| usable(base, tol, p);
     let contact = |c: &Candidate| SensedContact {
         point: Point3::from(c.point),
         normal: c.normal,
         force: -f,
         torsion: c.torsion,
     };
-
     // A pushing solution on its piece and on the usable surface: the contact, unless
     // there are two distinct ones.
     let exact: Vec<&Candidate> = candidates
         .iter()
-        .filter(|c| c.pushing && c.excess == 0.0 && usable(&c.point))
+        .filter(|c| c.pushing && c.excess == 0.0 && usable_at(&c.point))
         .collect();
     if !exact.is_empty() {
-        return one_point(&exact).map(|c| contact(&c));
+        return Some(one_point(&exact).map(|c| contact(&c)));
     }
     // Just beyond a capsule seam (noise): the least outside, snapped onto the surface.
     let near = candidates
@@ -336,10 +385,10 @@ fn solve(
                 ..*c
             }
         })
-        .filter(|c| usable(&c.point))
+        .filter(|c| usable_at(&c.point))
         .min_by(|a, b| a.excess.total_cmp(&b.excess));
     if let Some(c) = near {
-        return Ok(contact(&c));
+        return Some(Ok(contact(&c)));
     }
     // A pushing solution exists but only on the mount.
     if let (Some(base_z), Some(mounted)) = (
@@ -348,8 +397,8 @@ fn solve(
     ) {
         let pulling = candidates
             .iter()
-            .find(|c| !c.pushing && c.excess <= tol && usable(&c.point));
-        return Err(match pulling {
+            .find(|c| !c.pushing && c.excess <= tol && usable_at(&c.point));
+        return Some(Err(match pulling {
             Some(c) => NoContact::Pulling {
                 normal_force: -f.dot(&c.normal),
             },
@@ -357,33 +406,17 @@ fn solve(
                 z: mounted.point.z,
                 base_z,
             },
-        });
+        }));
     }
-    if soft {
+    if settings.kind == ContactKind::SoftFinger {
         let distance = candidates
             .iter()
             .filter(|c| c.pushing)
             .map(|c| c.excess)
             .fold(f64::INFINITY, f64::min);
-        return Err(NoContact::MissesSurface { distance });
+        return Some(Err(NoContact::MissesSurface { distance }));
     }
-    // Point contact whose line of action misses the surface: within the tolerance, the
-    // surface point nearest the line.
-    let line_point = f.cross(&torque) / (f_norm * f_norm);
-    let direction = Unit::new_unchecked(f / f_norm);
-    let (point, distance) = surface.nearest_to_line(&line_point, &direction);
-    if distance > tol {
-        return Err(NoContact::MissesSurface { distance });
-    }
-    match base {
-        Some(base_z) if !usable(&point.coords) => Err(NoContact::OnMount { z: point.z, base_z }),
-        _ => Ok(SensedContact {
-            point,
-            normal: surface.outward_normal(&point),
-            force: -f,
-            torsion: 0.0,
-        }),
-    }
+    None
 }
 
 /// The one point of `candidates` (not empty), or [`NoContact::Ambiguous`] when two lie

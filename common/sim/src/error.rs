@@ -136,3 +136,20 @@ pub(crate) fn ensure_finite(values: &[f64], what: &str) -> Result<()> {
         })
     }
 }
+
+/// Why a set of points has no convex hull ([`crate::mesh::convex_hull`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum HullError {
+    /// Fewer than four points.
+    #[error("{0} points are fewer than the four a volume needs")]
+    TooFewPoints(usize),
+    /// A point with a NaN or infinite coordinate (the point, as debug text).
+    #[error("a point is not finite ({0})")]
+    NotFinite(String),
+    /// Points parry cannot build a hull from (its reason, as debug text).
+    #[error("its points are degenerate, no hull can be built ({0})")]
+    Degenerate(String),
+    /// Points that span no volume.
+    #[error("its points are flat: they enclose no volume")]
+    Flat,
+}

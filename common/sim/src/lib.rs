@@ -42,7 +42,7 @@ pub mod scene;
 pub mod trial;
 
 pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint, NoiseSettings};
-pub use error::SimError;
+pub use error::{HullError, SimError};
 pub use hand::{
     BarrettHand, BuiltinHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec,
     ParallelJawGripper, UrdfHand, builtin_hand, builtin_hands, hand_by_name, hand_name, hand_names,

@@ -16,7 +16,7 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use crate::error::{Result, SimError};
+use crate::error::{HullError, Result, SimError};
 
 /// Vertices closer than this fraction of a loaded mesh's bounding-box diagonal are one vertex
 /// ([`TriangleMesh::welded`]): about 16 float32 rounding steps, far below any feature a hand
@@ -493,22 +493,19 @@ pub fn extrude_star_shaped(polygon: &[(f64, f64)], z0: f64, z1: f64) -> Triangle
 /// The convex hull of `points` as a closed mesh oriented outward, or why there is none
 /// (fewer than four points, a coordinate not finite, points that span no volume, or parry
 /// unable to build it from degenerate input: its `convex_hull` would panic there).
-pub fn convex_hull(points: &[Point3<f64>]) -> Result<TriangleMesh, String> {
+pub fn convex_hull(points: &[Point3<f64>]) -> Result<TriangleMesh, HullError> {
     if points.len() < 4 {
-        return Err(format!(
-            "{} points are fewer than the four a volume needs",
-            points.len()
-        ));
+        return Err(HullError::TooFewPoints(points.len()));
     }
     if let Some(p) = points
         .iter()
         .find(|p| !p.coords.iter().all(|c| c.is_finite()))
     {
-        return Err(format!("a point is not finite ({p:?})"));
+        return Err(HullError::NotFinite(format!("{p:?}")));
     }
     let pts: Vec<_> = points.iter().map(crate::convert::p2g).collect();
     let (vertices, triangles) = parry3d_f64::transformation::try_convex_hull(&pts)
-        .map_err(|e| format!("its points are degenerate, no hull can be built ({e:?})"))?;
+        .map_err(|e| HullError::Degenerate(format!("{e:?}")))?;
     let hull = TriangleMesh::new(
         vertices.into_iter().map(crate::convert::g2p).collect(),
         triangles,
@@ -516,7 +513,7 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<TriangleMesh, String> {
     if hull.triangles.len() >= 4 && hull.signed_volume().abs() > 0.0 {
         Ok(hull.oriented_outward())
     } else {
-        Err("its points are flat: they enclose no volume".into())
+        Err(HullError::Flat)
     }
 }
 
@@ -700,12 +697,17 @@ mod tests {
         for (what, points) in [("same", same), ("line", line), ("flat", flat)] {
             assert!(convex_hull(&points).is_err(), "{what}: a hull");
         }
-        let e = convex_hull(&[p(0.0, 0.0, 0.0); 3]).unwrap_err();
+        let e = convex_hull(&[p(0.0, 0.0, 0.0); 3]).unwrap_err().to_string();
         assert!(e.contains("3 points are fewer than the four"), "{e}");
         let mut cube: Vec<_> = box_mesh(&Vector3::new(0.1, 0.1, 0.1)).vertices;
         assert_eq!(convex_hull(&cube).unwrap().vertices.len(), 8);
         cube[2].y = f64::NAN;
-        assert!(convex_hull(&cube).unwrap_err().contains("not finite"));
+        assert!(
+            convex_hull(&cube)
+                .unwrap_err()
+                .to_string()
+                .contains("not finite")
+        );
     }
 
     #[test]

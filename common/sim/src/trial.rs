@@ -1,19 +1,18 @@
 //! One simulated grasp trial: place the hand, close it on the object, extract each finger's raw
-//! contact cloud and its three contact models. A trial that touches nothing is a valid outcome
+//! contact cloud and its contacts under every contact model ([`crate::contact::MODELS`]). A trial that touches nothing is a valid outcome
 //! with empty clouds (the scorer decides its score).
 
 use nalgebra::Isometry3;
 
 use crate::contact::{
-    ContactCloud, ContactModel, ContactModelSettings, ContactPoint, add_noise, circular_patch,
-    link_cloud, mean_point, surface_model,
+    ContactCloud, ContactModel, ContactModelSettings, ContactPoint, ModelContacts, link_cloud,
 };
 use crate::error::{Result, ensure_finite};
 use crate::hand::{Grasp, Hand, LinkGeometry};
 use crate::object::Object;
 
 /// Contacts of one finger (or of the palm).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FingerOutcome {
     /// Finger index, `None` for the palm.
     pub finger: Option<usize>,
@@ -21,15 +20,35 @@ pub struct FingerOutcome {
     pub links: Vec<String>,
     /// The raw contact cloud (empty when the finger touches nothing).
     pub cloud: ContactCloud,
-    /// Mean-point model (`None` when the cloud is empty).
-    pub mean_point: Option<ContactPoint>,
-    /// Circular-patch model.
-    pub circular_patch: Vec<ContactPoint>,
-    /// Surface model (section 2.3).
-    pub surface: Vec<ContactPoint>,
+    /// Its contacts under each contact model (none when the cloud is empty).
+    #[serde(flatten)]
+    pub models: ModelContacts,
 }
 
 impl FingerOutcome {
+    /// A finger's outcome from its raw cloud: every model's contacts computed on `object`,
+    /// without noise.
+    pub fn from_cloud(
+        finger: Option<usize>,
+        links: Vec<String>,
+        cloud: ContactCloud,
+        object: &Object,
+        settings: &ContactModelSettings,
+    ) -> FingerOutcome {
+        let models = ModelContacts::of_cloud(&cloud.points, object, settings);
+        FingerOutcome {
+            finger,
+            links,
+            cloud,
+            models,
+        }
+    }
+
+    /// The mean-point contact (`None` when the cloud is empty).
+    pub fn mean_point(&self) -> Option<ContactPoint> {
+        self.models.get(ContactModel::MeanPoint).first().copied()
+    }
+
     /// Whether this finger touches the object.
     pub fn touches(&self) -> bool {
         !self.cloud.is_empty()
@@ -37,11 +56,7 @@ impl FingerOutcome {
 
     /// The contacts of the given model.
     pub fn contacts(&self, model: ContactModel) -> Vec<ContactPoint> {
-        match model {
-            ContactModel::MeanPoint => self.mean_point.into_iter().collect(),
-            ContactModel::CircularPatch => self.circular_patch.clone(),
-            ContactModel::Surface => self.surface.clone(),
-        }
+        self.models.get(model).to_vec()
     }
 }
 
@@ -89,7 +104,8 @@ impl TrialOutcome {
 /// Runs one trial: `hand.close(object, palm_pose)`, then contact clouds and models.
 ///
 /// Noise (if configured) is added to the modelled contacts, never to the raw clouds, with one
-/// random stream per finger and model derived from the seed.
+/// random stream per finger and model derived from the seed
+/// ([`crate::contact::noise_stream`]).
 pub fn run_trial(
     object: &Object,
     hand: &dyn Hand,
@@ -121,24 +137,12 @@ pub fn run_trial(
                 points.extend_from_slice(pts);
             }
         }
-        let mut mean = mean_point(&points);
-        let mut patch = circular_patch(&points, settings);
-        let mut surface = surface_model(&points, object, settings);
+        let mut out =
+            FingerOutcome::from_cloud(finger, names, ContactCloud { points }, object, settings);
         if let Some(noise) = &settings.noise {
-            if let Some(m) = mean.as_mut() {
-                add_noise(std::slice::from_mut(m), noise, 3 * stream);
-            }
-            add_noise(&mut patch, noise, 3 * stream + 1);
-            add_noise(&mut surface, noise, 3 * stream + 2);
+            out.models.add_noise(noise, stream);
         }
-        FingerOutcome {
-            finger,
-            links: names,
-            cloud: ContactCloud { points },
-            mean_point: mean,
-            circular_patch: patch,
-            surface,
-        }
+        out
     };
     let fingers: Vec<FingerOutcome> = (0..hand.finger_count())
         .map(|f| group(Some(f), f as u64 + 1))

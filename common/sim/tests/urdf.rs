@@ -406,7 +406,7 @@ fn jaw_normals(hand: &UrdfHand) -> Vec<nalgebra::Vector3<f64>> {
     assert!(!out.palm.touches());
     out.fingers
         .iter()
-        .map(|f| f.mean_point.unwrap().normal)
+        .map(|f| f.mean_point().unwrap().normal)
         .collect()
 }
 

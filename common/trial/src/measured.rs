@@ -3,7 +3,6 @@
 //! surface model on the estimated object), then scored exactly as [`score_outcome`] scores a
 //! simulated trial, so a trial scored from its clouds equals the same trial scored whole.
 
-use graspopt_sim::contact::{circular_patch, mean_point, surface_model};
 use graspopt_sim::{
     ContactCloud, ContactModelSettings, ContactPoint, FingerOutcome, Grasp, Object, TrialOutcome,
 };
@@ -83,15 +82,11 @@ impl MeasuredTrial {
 
     /// Rebuilds a trial outcome on `object`: contact models from the raw clouds.
     pub fn to_outcome(&self, object: &Object, settings: &ContactModelSettings) -> TrialOutcome {
-        let model = |m: &MeasuredFinger| FingerOutcome {
-            finger: m.finger,
-            links: m.links.clone(),
-            cloud: ContactCloud {
+        let model = |m: &MeasuredFinger| {
+            let cloud = ContactCloud {
                 points: m.points.clone(),
-            },
-            mean_point: mean_point(&m.points),
-            circular_patch: circular_patch(&m.points, settings),
-            surface: surface_model(&m.points, object, settings),
+            };
+            FingerOutcome::from_cloud(m.finger, m.links.clone(), cloud, object, settings)
         };
         let fingers: Vec<FingerOutcome> = self
             .fingers
@@ -104,14 +99,7 @@ impl MeasuredTrial {
             .iter()
             .find(|f| f.finger.is_none())
             .map(model)
-            .unwrap_or(FingerOutcome {
-                finger: None,
-                links: Vec::new(),
-                cloud: ContactCloud::default(),
-                mean_point: None,
-                circular_patch: Vec::new(),
-                surface: Vec::new(),
-            });
+            .unwrap_or_default();
         let touched = self.fingers.iter().any(|f| !f.points.is_empty());
         TrialOutcome {
             object: object.name().to_string(),

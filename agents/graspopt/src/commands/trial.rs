@@ -143,7 +143,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
                     .finger
                     .map_or("palm".to_string(), |i| format!("finger {}", i + 1));
                 let modelled = f.contacts(ev.score.contacts);
-                match f.mean_point {
+                match f.mean_point() {
                     Some(m) => outln!(
                         "  {name}: {} cloud points, {} modelled contacts, mean at ({:.4}, {:.4}, {:.4}) normal ({:.3}, {:.3}, {:.3})",
                         f.cloud.points.len(),

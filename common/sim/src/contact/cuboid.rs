@@ -242,47 +242,7 @@ fn disc_polygon(poly: &[[f64; 2]], r: f64) -> Option<(f64, [f64; 2])> {
     // circle).
     let mut segments: Vec<([f64; 2], [f64; 2], bool)> = Vec::with_capacity(ccw.len());
     for i in 0..ccw.len() {
-        let (p, q) = (ccw[i], ccw[(i + 1) % ccw.len()]);
-        let d = [q[0] - p[0], q[1] - p[1]];
-        let a = d[0] * d[0] + d[1] * d[1];
-        if a == 0.0 {
-            continue;
-        }
-        let b = p[0] * d[0] + p[1] * d[1];
-        let c = p[0] * p[0] + p[1] * p[1] - r * r;
-        let disc = b * b - a * c;
-        if disc <= 0.0 {
-            continue;
-        }
-        let sq = disc.sqrt();
-        // Roots without cancellation.
-        let (t0, t1) = if b >= 0.0 {
-            let t0 = (-b - sq) / a;
-            (
-                t0,
-                if t0 != 0.0 {
-                    c / (a * t0)
-                } else {
-                    (-b + sq) / a
-                },
-            )
-        } else {
-            let t1 = (-b + sq) / a;
-            (
-                if t1 != 0.0 {
-                    c / (a * t1)
-                } else {
-                    (-b - sq) / a
-                },
-                t1,
-            )
-        };
-        let (lo, hi) = (t0.max(0.0), t1.min(1.0));
-        if lo >= hi {
-            continue;
-        }
-        let at = |t: f64| [p[0] + d[0] * t, p[1] + d[1] * t];
-        segments.push((at(lo), at(hi), t1 < 1.0));
+        segments.extend(edge_in_disc(ccw[i], ccw[(i + 1) % ccw.len()], r));
     }
     let mut area = 0.0;
     let mut m = [0.0, 0.0];
@@ -316,6 +276,51 @@ fn disc_polygon(poly: &[[f64; 2]], r: f64) -> Option<(f64, [f64; 2])> {
         }
     }
     (area > 0.0).then_some((area, m))
+}
+
+/// The part of the edge `p -> q` inside the disc of radius `r` centred on the origin: its start,
+/// its end and whether it ends on the circle (`None` when the edge misses the disc's interior).
+fn edge_in_disc(p: [f64; 2], q: [f64; 2], r: f64) -> Option<([f64; 2], [f64; 2], bool)> {
+    let d = [q[0] - p[0], q[1] - p[1]];
+    let a = d[0] * d[0] + d[1] * d[1];
+    if a == 0.0 {
+        return None;
+    }
+    let b = p[0] * d[0] + p[1] * d[1];
+    let c = p[0] * p[0] + p[1] * p[1] - r * r;
+    let disc = b * b - a * c;
+    if disc <= 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    // Roots without cancellation.
+    let (t0, t1) = if b >= 0.0 {
+        let t0 = (-b - sq) / a;
+        (
+            t0,
+            if t0 != 0.0 {
+                c / (a * t0)
+            } else {
+                (-b + sq) / a
+            },
+        )
+    } else {
+        let t1 = (-b + sq) / a;
+        (
+            if t1 != 0.0 {
+                c / (a * t1)
+            } else {
+                (-b - sq) / a
+            },
+            t1,
+        )
+    };
+    let (lo, hi) = (t0.max(0.0), t1.min(1.0));
+    if lo >= hi {
+        return None;
+    }
+    let at = |t: f64| [p[0] + d[0] * t, p[1] + d[1] * t];
+    Some((at(lo), at(hi), t1 < 1.0))
 }
 
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {

@@ -18,6 +18,9 @@
 //! points, the outermost at `0.89 r`, so that every segment has a non-zero length.
 //!
 //! Raw clouds (contact regions) are computed in `region.rs` (and `cuboid.rs` for box links).
+//!
+//! The models are registered in one table, [`MODELS`] (`models.rs`): to add a contact model, see
+//! there (a variant, its function, its row).
 
 use nalgebra::{Point3, Vector3};
 use rand::SeedableRng;
@@ -80,57 +83,6 @@ impl ContactCloud {
     /// The mean-point model of this cloud.
     pub fn mean_point(&self) -> Option<ContactPoint> {
         mean_point(&self.points)
-    }
-}
-
-/// Which contact model to use. Settings files and journals name it as `--contacts` does
-/// ([`ContactModel::name`]); the longer names of earlier versions are still read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ContactModel {
-    /// One contact per finger at the cloud's mean.
-    #[serde(rename = "mean", alias = "mean_point")]
-    MeanPoint,
-    /// Grid points on a disc around the mean, all with the mean normal.
-    #[serde(rename = "patch", alias = "circular_patch")]
-    CircularPatch,
-    /// The surface model of thesis section 2.3.
-    Surface,
-}
-
-impl ContactModel {
-    /// Every model, in the order `--help` lists them.
-    pub const ALL: [ContactModel; 3] = [
-        ContactModel::Surface,
-        ContactModel::CircularPatch,
-        ContactModel::MeanPoint,
-    ];
-
-    /// A model from its name ([`ContactModel::name`]).
-    pub fn parse(name: &str) -> crate::error::Result<ContactModel> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == name.trim())
-            .ok_or_else(|| {
-                crate::error::SimError::InvalidInput(format!(
-                    "unknown contact model {name:?}: expected surface, patch or mean"
-                ))
-            })
-    }
-
-    /// The name users type and see (`--contacts`): `mean`, `patch`, `surface`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ContactModel::MeanPoint => "mean",
-            ContactModel::CircularPatch => "patch",
-            ContactModel::Surface => "surface",
-        }
-    }
-}
-
-impl std::fmt::Display for ContactModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
     }
 }
 
@@ -347,18 +299,14 @@ pub fn surface_model(
     out
 }
 
-/// The given model of a cloud.
+/// The given model of a cloud (its row's [`ModelEntry::contacts`]).
 pub fn model_contacts(
     model: ContactModel,
     cloud: &[ContactPoint],
     object: &Object,
     settings: &ContactModelSettings,
 ) -> Vec<ContactPoint> {
-    match model {
-        ContactModel::MeanPoint => mean_point(cloud).into_iter().collect(),
-        ContactModel::CircularPatch => circular_patch(cloud, settings),
-        ContactModel::Surface => surface_model(cloud, object, settings),
-    }
+    (model.entry().contacts)(cloud, object, settings)
 }
 
 /// Adds Gaussian noise to positions and normals (normals stay unit). `stream` separates the
@@ -377,30 +325,18 @@ pub fn add_noise(points: &mut [ContactPoint], noise: &NoiseSettings, stream: u64
 }
 
 mod cuboid;
+mod models;
 mod region;
+
+pub use models::{
+    ContactModel, MODELS, ModelContacts, ModelEntry, ModelFn, noise_stream, oldest_first,
+};
 
 pub(crate) use region::link_cloud;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_contact_model_has_one_name_in_flags_files_and_journals() {
-        for m in ContactModel::ALL {
-            let json = serde_json::to_string(&m).unwrap();
-            assert_eq!(json, format!("\"{}\"", m.name()));
-            assert_eq!(serde_json::from_str::<ContactModel>(&json).unwrap(), m);
-            assert_eq!(ContactModel::parse(m.name()).unwrap(), m);
-        }
-        // Journals and settings files written before still read.
-        for (old, m) in [
-            ("\"mean_point\"", ContactModel::MeanPoint),
-            ("\"circular_patch\"", ContactModel::CircularPatch),
-        ] {
-            assert_eq!(serde_json::from_str::<ContactModel>(old).unwrap(), m);
-        }
-    }
 
     #[test]
     fn default_grid_has_21_points_inside_the_disc() {

@@ -170,6 +170,44 @@ impl LinkQuery {
     }
 }
 
+/// The distance from the probe's point to a box link (axes, origin and half extents in the
+/// part frame), its direction and whether the box is smooth there.
+fn probe_cuboid(p: &mut Probe, axes: &Matrix, origin: Vector, half: Vector) {
+    let local = axes.transpose() * (p.q - origin);
+    let excess = (local.abs() - half).max(Vector::ZERO);
+    let d2 = excess.length_squared();
+    if d2 > 0.0 {
+        p.d = d2.sqrt();
+        p.u = *axes * (excess * local.signum() / p.d);
+        // Smooth where one axis holds the excess: the face's normal then differs
+        // from the direction by the other axes' share (the ray test's tolerance).
+        let largest = excess.max_element();
+        p.smooth = d2 - largest * largest < (SMOOTH_TOLERANCE * p.d) * (SMOOTH_TOLERANCE * p.d);
+    }
+}
+
+/// The distance from the probe's point to a cylinder link (along its frame's `y`), its
+/// direction and whether the cylinder is smooth there.
+fn probe_cylinder(p: &mut Probe, axes: &Matrix, origin: Vector, radius: f64, half_height: f64) {
+    let local = axes.transpose() * (p.q - origin);
+    let rho = local.x.hypot(local.z);
+    let side = (rho - radius).max(0.0);
+    let cap = (local.y.abs() - half_height).max(0.0);
+    let d2 = side * side + cap * cap;
+    if d2 > 0.0 {
+        p.d = d2.sqrt();
+        let radial = if rho > 0.0 {
+            Vector::new(local.x / rho, 0.0, local.z / rho)
+        } else {
+            Vector::ZERO
+        };
+        let dir = radial * side + Vector::Y * (cap * local.y.signum());
+        p.u = *axes * (dir / p.d);
+        let smaller = side.min(cap);
+        p.smooth = smaller < SMOOTH_TOLERANCE * p.d;
+    }
+}
+
 impl RegionBuilder<'_> {
     fn probe(&self, patch: &SurfacePatch, pre: Vector) -> Probe {
         let q = patch.point(pre);
@@ -186,44 +224,13 @@ impl RegionBuilder<'_> {
             smooth: false,
         };
         match &self.query {
-            LinkQuery::Cuboid { axes, origin, half } => {
-                let local = axes.transpose() * (q - *origin);
-                let excess = (local.abs() - *half).max(Vector::ZERO);
-                let d2 = excess.length_squared();
-                if d2 > 0.0 {
-                    p.d = d2.sqrt();
-                    p.u = *axes * (excess * local.signum() / p.d);
-                    // Smooth where one axis holds the excess: the face's normal then differs
-                    // from the direction by the other axes' share (the ray test's tolerance).
-                    let largest = excess.max_element();
-                    p.smooth = d2 - largest * largest
-                        < (SMOOTH_TOLERANCE * p.d) * (SMOOTH_TOLERANCE * p.d);
-                }
-            }
+            LinkQuery::Cuboid { axes, origin, half } => probe_cuboid(&mut p, axes, *origin, *half),
             LinkQuery::Cylinder {
                 axes,
                 origin,
                 radius,
                 half_height,
-            } => {
-                let local = axes.transpose() * (q - *origin);
-                let rho = local.x.hypot(local.z);
-                let side = (rho - radius).max(0.0);
-                let cap = (local.y.abs() - half_height).max(0.0);
-                let d2 = side * side + cap * cap;
-                if d2 > 0.0 {
-                    p.d = d2.sqrt();
-                    let radial = if rho > 0.0 {
-                        Vector::new(local.x / rho, 0.0, local.z / rho)
-                    } else {
-                        Vector::ZERO
-                    };
-                    let dir = radial * side + Vector::Y * (cap * local.y.signum());
-                    p.u = *axes * (dir / p.d);
-                    let smaller = side.min(cap);
-                    p.smooth = smaller < SMOOTH_TOLERANCE * p.d;
-                }
-            }
+            } => probe_cylinder(&mut p, axes, *origin, *radius, *half_height),
             LinkQuery::Ball { centre, radius } => {
                 let v = q - *centre;
                 let l = v.length();
@@ -356,8 +363,21 @@ impl RegionBuilder<'_> {
             self.flush(patch, &own, out);
             return;
         }
-        let flat = patch.is_flat();
-        if flat
+        if self.cuboid_closed_form(patch, &v, sums) || self.settled(patch, &v, depth, diam, sums) {
+            return;
+        }
+        self.subdivide(patch, v, depth, sums, out);
+    }
+
+    /// A flat patch under a box link, not hidden by another part: its exact region in closed
+    /// form (`cuboid.rs`). Whether it applied.
+    fn cuboid_closed_form(
+        &self,
+        patch: &SurfacePatch,
+        v: &[Probe; 3],
+        sums: &mut PatchSums,
+    ) -> bool {
+        if patch.is_flat()
             && let LinkQuery::Cuboid { axes, origin, half } = &self.query
             && v.iter().all(|p| !p.hidden)
             && !(self.object.is_union()
@@ -368,8 +388,23 @@ impl RegionBuilder<'_> {
                 ))
         {
             self.cuboid_region(patch, v.map(|p| p.q), axes, *origin, *half, sums);
-            return;
+            return true;
         }
+        false
+    }
+
+    /// Settles the patch with corners `v` without subdividing it where a rule allows: the whole
+    /// patch within the contact distance and closest to one face, none of it within reach, or
+    /// its region clipped exactly (or at the finest level). Whether it did.
+    fn settled(
+        &self,
+        patch: &SurfacePatch,
+        v: &[Probe; 3],
+        depth: usize,
+        diam: f64,
+        sums: &mut PatchSums,
+    ) -> bool {
+        let flat = patch.is_flat();
         let [a, b, cc] = [v[0].q, v[1].q, v[2].q];
         let chord_area = 0.5 * (b - a).cross(cc - a).length();
         // Every link is convex, so the distance to it is a convex function: a flat triangle
@@ -383,13 +418,13 @@ impl RegionBuilder<'_> {
         {
             // ... and closest to one face of the link everywhere (its region is convex too).
             self.add(sums, v[0].u, chord_area, (a + b + cc) / 3.0);
-            return;
+            return true;
         }
         let c = self.probe(patch, (v[0].pre + v[1].pre + v[2].pre) / 3.0);
         let reach = v.iter().map(|p| (p.q - c.q).length()).fold(0.0, f64::max) + patch.bulge(diam);
         let f = |p: &Probe| p.d - self.d_c;
         if f(&c) > reach {
-            return; // the whole patch is farther than the contact distance
+            return true; // the whole patch is farther than the contact distance
         }
         let same_u = c.d > 0.0 && v.iter().all(|p| (p.u - c.u).length() < SAME_DIRECTION);
         let same_hidden = v.iter().all(|p| p.hidden == c.hidden);
@@ -397,7 +432,7 @@ impl RegionBuilder<'_> {
         if (corners_within || f(&c) < -reach) && same_hidden {
             // The whole patch is within the contact distance.
             if c.hidden {
-                return;
+                return true;
             }
             // One face of the link closest over the whole triangle (its cell is convex). No
             // such rule holds for edges and corners: a face's cell can pass between corners
@@ -406,24 +441,36 @@ impl RegionBuilder<'_> {
             if uniform || leaf || (!flat && diam <= CURVED_MERGE * self.h) {
                 let at = if flat { (a + b + cc) / 3.0 } else { c.q };
                 self.add(sums, self.normal(patch, &c), chord_area, at);
-                return;
+                return true;
             }
-        } else if flat && same_u && same_hidden && !c.hidden && self.on_one_plane(&v) {
+        } else if flat && same_u && same_hidden && !c.hidden && self.on_one_plane(v) {
             // The link's closest points lie on one of its faces, so the distance is linear over
             // the triangle: clipping it where the distance is the contact distance is exact.
             if let Some((area, at)) = clip([a, b, cc], v.map(|p| p.d - self.d_c)) {
                 self.add(sums, self.normal(patch, &c), area, at);
             }
-            return;
+            return true;
         } else if leaf {
             if c.hidden {
-                return;
+                return true;
             }
             if let Some((area, at)) = clip([a, b, cc], v.map(|p| p.d - self.d_c)) {
                 self.add(sums, self.normal(patch, &c), area, at);
             }
-            return;
+            return true;
         }
+        false
+    }
+
+    /// Refines the four sub-triangles through the edges' midpoints.
+    fn subdivide(
+        &self,
+        patch: &SurfacePatch,
+        v: [Probe; 3],
+        depth: usize,
+        sums: &mut PatchSums,
+        out: &mut Vec<ContactPoint>,
+    ) {
         let mid = |i: usize, j: usize| self.probe(patch, (v[i].pre + v[j].pre) * 0.5);
         let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
         for t in [

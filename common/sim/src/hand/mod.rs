@@ -465,9 +465,6 @@ pub fn advance_until_contact(
     t1: f64,
     rates: &[f64],
 ) -> Result<Advance> {
-    let tol = CONTACT_TOLERANCE;
-    let touching = |d: &[f64]| d.iter().position(|&di| di > 0.0 && di <= tol);
-    let intersecting = |d: &[f64]| d.iter().any(|&di| di <= 0.0);
     let mut t = t0;
     let mut d = distances(t)?;
     if let Some(k) = touching(&d).or_else(|| d.iter().position(|&di| di <= 0.0)) {
@@ -485,82 +482,114 @@ pub fn advance_until_contact(
                 touched: None,
             });
         }
-        let safe = d
-            .iter()
-            .zip(rates)
-            .map(|(&di, &r)| (di - 0.5 * tol) / r.max(1e-12))
-            .fold(f64::INFINITY, f64::min);
-        let mut step = safe;
-        if let Some((tp, dp)) = &prev {
-            let dt = t - tp;
-            let secant = d
-                .iter()
-                .zip(dp)
-                .filter_map(|(&di, &dpi)| {
-                    let slope = (dpi - di) / dt;
-                    (slope > 0.0).then(|| 0.9 * (di - 0.6 * tol) / slope)
-                })
-                .fold(f64::INFINITY, f64::min);
-            // Never let a link move more than MAX_OVERSHOOT beyond its current distance, so an
-            // optimistic extrapolation cannot jump through a feature thicker than that.
-            let cap = d
-                .iter()
-                .zip(rates)
-                .map(|(&di, &r)| (di + MAX_OVERSHOOT) / r.max(1e-12))
-                .fold(f64::INFINITY, f64::min);
-            if secant.is_finite() {
-                step = step.max(secant.min(cap));
-            }
-        }
+        let step = next_step(&d, prev.as_ref(), t, rates);
         let t_new = (t + step).min(t1);
         let d_new = distances(t_new)?;
-        if !intersecting(&d_new) {
-            prev = Some((t, std::mem::replace(&mut d, d_new)));
-            t = t_new;
-            if let Some(k) = touching(&d) {
-                return Ok(Advance {
-                    t,
-                    touched: Some(k),
-                });
-            }
-            continue;
+        if intersecting(&d_new) {
+            // Overshot into the object: bisect between the clear t and t_new.
+            return bisect_overshoot(&mut distances, t, t_new, d, rates);
         }
-        // Overshot into the object: bisect between the clear t and t_new.
-        let (mut lo, mut hi) = (t, t_new);
-        let max_rate = rates.iter().fold(0.0_f64, |a, &r| a.max(r));
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            let dm = distances(mid)?;
-            if intersecting(&dm) {
-                hi = mid;
-            } else if let Some(k) = touching(&dm) {
-                return Ok(Advance {
-                    t: mid,
-                    touched: Some(k),
-                });
-            } else {
-                lo = mid;
-                d = dm;
-            }
-            if (hi - lo) * max_rate < 1e-9 {
-                break;
-            }
+        prev = Some((t, std::mem::replace(&mut d, d_new)));
+        t = t_new;
+        if let Some(k) = touching(&d) {
+            return Ok(Advance {
+                t,
+                touched: Some(k),
+            });
         }
-        // Round-off limits: stop at the last clear parameter, reporting the nearest link.
-        let k = d
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(k, _)| k);
-        return Ok(Advance { t: lo, touched: k });
     }
     // Grazing approach: stop here and report the nearest link.
-    let k = d
-        .iter()
+    Ok(Advance {
+        t,
+        touched: nearest_link(&d),
+    })
+}
+
+/// Whether some link touches (within the tolerance, not intersecting): the first such link.
+fn touching(d: &[f64]) -> Option<usize> {
+    d.iter().position(|&di| di > 0.0 && di <= CONTACT_TOLERANCE)
+}
+
+/// Whether some link intersects the object.
+fn intersecting(d: &[f64]) -> bool {
+    d.iter().any(|&di| di <= 0.0)
+}
+
+/// The link nearest the object.
+fn nearest_link(d: &[f64]) -> Option<usize> {
+    d.iter()
         .enumerate()
         .min_by(|a, b| a.1.total_cmp(b.1))
-        .map(|(k, _)| k);
-    Ok(Advance { t, touched: k })
+        .map(|(k, _)| k)
+}
+
+/// The next step of [`advance_until_contact`] from `t` (distances `d`; `prev`: the previous
+/// parameter and its distances): the safe step, or the secant extrapolation when larger.
+fn next_step(d: &[f64], prev: Option<&(f64, Vec<f64>)>, t: f64, rates: &[f64]) -> f64 {
+    let tol = CONTACT_TOLERANCE;
+    let safe = d
+        .iter()
+        .zip(rates)
+        .map(|(&di, &r)| (di - 0.5 * tol) / r.max(1e-12))
+        .fold(f64::INFINITY, f64::min);
+    let mut step = safe;
+    if let Some((tp, dp)) = prev {
+        let dt = t - tp;
+        let secant = d
+            .iter()
+            .zip(dp)
+            .filter_map(|(&di, &dpi)| {
+                let slope = (dpi - di) / dt;
+                (slope > 0.0).then(|| 0.9 * (di - 0.6 * tol) / slope)
+            })
+            .fold(f64::INFINITY, f64::min);
+        // Never let a link move more than MAX_OVERSHOOT beyond its current distance, so an
+        // optimistic extrapolation cannot jump through a feature thicker than that.
+        let cap = d
+            .iter()
+            .zip(rates)
+            .map(|(&di, &r)| (di + MAX_OVERSHOOT) / r.max(1e-12))
+            .fold(f64::INFINITY, f64::min);
+        if secant.is_finite() {
+            step = step.max(secant.min(cap));
+        }
+    }
+    step
+}
+
+/// A step of [`advance_until_contact`] that ended intersecting the object: bisects between
+/// the clear `lo` (distances `d`) and `hi` until a link touches; at the round-off limit, stops
+/// at the last clear parameter, reporting the nearest link.
+fn bisect_overshoot(
+    distances: &mut impl FnMut(f64) -> Result<Vec<f64>>,
+    mut lo: f64,
+    mut hi: f64,
+    mut d: Vec<f64>,
+    rates: &[f64],
+) -> Result<Advance> {
+    let max_rate = rates.iter().fold(0.0_f64, |a, &r| a.max(r));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        let dm = distances(mid)?;
+        if intersecting(&dm) {
+            hi = mid;
+        } else if let Some(k) = touching(&dm) {
+            return Ok(Advance {
+                t: mid,
+                touched: Some(k),
+            });
+        } else {
+            lo = mid;
+            d = dm;
+        }
+        if (hi - lo) * max_rate < 1e-9 {
+            break;
+        }
+    }
+    Ok(Advance {
+        t: lo,
+        touched: nearest_link(&d),
+    })
 }
 
 /// Builds the [`Grasp`] of a closed hand: world link poses, final distances and touching flags.

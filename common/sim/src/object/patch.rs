@@ -111,104 +111,117 @@ impl SurfacePatch {
 
 /// Surface patches of a part's geometry (part frame).
 pub(super) fn surface_patches(geom: &PartGeom) -> Vec<SurfacePatch> {
+    match geom {
+        PartGeom::Mesh(m) => mesh_patches(m),
+        PartGeom::Cuboid(c) => cuboid_patches(c),
+        PartGeom::Ball(b) => ball_patches(b),
+        PartGeom::Cylinder(c) => cylinder_patches(c),
+    }
+}
+
+/// A mesh's triangles, each with its outward normal.
+fn mesh_patches(m: &MeshGeom) -> Vec<SurfacePatch> {
+    m.mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let [a, b, c] = t.map(|k| p2g(&m.mesh.vertices[k as usize]));
+            SurfacePatch::new(
+                [a, b, c],
+                PatchMap::Flat,
+                m.normals.get(i).copied().unwrap_or(Vector::Z),
+            )
+        })
+        .collect()
+}
+
+/// A box's twelve triangles.
+fn cuboid_patches(c: &Cuboid) -> Vec<SurfacePatch> {
     let flat = |a: Vector, b: Vector, c: Vector| {
         let n = (b - a).cross(c - a).normalize_or(Vector::Z);
         SurfacePatch::new([a, b, c], PatchMap::Flat, n)
     };
-    match geom {
-        PartGeom::Mesh(m) => m
-            .mesh
-            .triangles
-            .iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let [a, b, c] = t.map(|k| p2g(&m.mesh.vertices[k as usize]));
-                SurfacePatch::new(
-                    [a, b, c],
-                    PatchMap::Flat,
-                    m.normals.get(i).copied().unwrap_or(Vector::Z),
-                )
-            })
-            .collect(),
-        PartGeom::Cuboid(c) => {
-            let m = mesh::box_mesh(&crate::convert::g2v(c.half_extents));
-            m.triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|k| p2g(&m.vertices[k as usize]));
-                    flat(a, b, c)
-                })
-                .collect()
-        }
-        PartGeom::Ball(b) => {
-            // An octahedron subdivided twice (128 triangles), centrally projected.
-            let r = b.radius;
-            let axes = [Vector::X, Vector::Y, Vector::Z];
-            let mut tris: Vec<[Vector; 3]> = Vec::new();
-            for sx in [-1.0, 1.0] {
-                for sy in [-1.0, 1.0] {
-                    for sz in [-1.0, 1.0] {
-                        tris.push([axes[0] * sx * r, axes[1] * sy * r, axes[2] * sz * r]);
-                    }
-                }
+    let m = mesh::box_mesh(&crate::convert::g2v(c.half_extents));
+    m.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|k| p2g(&m.vertices[k as usize]));
+            flat(a, b, c)
+        })
+        .collect()
+}
+
+/// A sphere's patches.
+fn ball_patches(b: &Ball) -> Vec<SurfacePatch> {
+    // An octahedron subdivided twice (128 triangles), centrally projected.
+    let r = b.radius;
+    let axes = [Vector::X, Vector::Y, Vector::Z];
+    let mut tris: Vec<[Vector; 3]> = Vec::new();
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                tris.push([axes[0] * sx * r, axes[1] * sy * r, axes[2] * sz * r]);
             }
-            for _ in 0..2 {
-                let mid = |a: Vector, b: Vector| ((a + b) * 0.5).normalize() * r;
-                tris = tris
-                    .iter()
-                    .flat_map(|&[a, b, c]| {
-                        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-                        [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-                    })
-                    .collect();
-            }
-            tris.into_iter()
-                .map(|t| SurfacePatch::new(t, PatchMap::Sphere(r), Vector::Z))
-                .collect()
-        }
-        PartGeom::Cylinder(c) => {
-            // parry's axis is y. Side: near-square cells; caps: fans of sectors.
-            let (r, hh) = (c.radius, c.half_height);
-            let n = 32;
-            let rows = ((2.0 * hh) / (std::f64::consts::TAU * r / n as f64))
-                .ceil()
-                .max(1.0) as usize;
-            let at = |k: usize, y: f64| {
-                let a = std::f64::consts::TAU * k as f64 / n as f64;
-                Vector::new(r * a.cos(), y, r * a.sin())
-            };
-            let mut out = Vec::new();
-            for k in 0..n {
-                for j in 0..rows {
-                    let y0 = -hh + 2.0 * hh * j as f64 / rows as f64;
-                    let y1 = -hh + 2.0 * hh * (j + 1) as f64 / rows as f64;
-                    let (a, b, c2, d) = (at(k, y0), at(k + 1, y0), at(k + 1, y1), at(k, y1));
-                    out.push(SurfacePatch::new(
-                        [a, b, c2],
-                        PatchMap::CylinderSide(r),
-                        Vector::X,
-                    ));
-                    out.push(SurfacePatch::new(
-                        [a, c2, d],
-                        PatchMap::CylinderSide(r),
-                        Vector::X,
-                    ));
-                }
-                let a = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
-                let map = PatchMap::CylinderCap {
-                    radius: r,
-                    mid: Vector::new(a.cos(), 0.0, a.sin()),
-                    chord: r * (std::f64::consts::PI / n as f64).cos(),
-                };
-                for y in [-hh, hh] {
-                    out.push(SurfacePatch::new(
-                        [Vector::new(0.0, y, 0.0), at(k, y), at(k + 1, y)],
-                        map,
-                        Vector::new(0.0, y.signum(), 0.0),
-                    ));
-                }
-            }
-            out
         }
     }
+    for _ in 0..2 {
+        let mid = |a: Vector, b: Vector| ((a + b) * 0.5).normalize() * r;
+        tris = tris
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    tris.into_iter()
+        .map(|t| SurfacePatch::new(t, PatchMap::Sphere(r), Vector::Z))
+        .collect()
+}
+
+/// A cylinder's patches.
+fn cylinder_patches(c: &Cylinder) -> Vec<SurfacePatch> {
+    // parry's axis is y. Side: near-square cells; caps: fans of sectors.
+    let (r, hh) = (c.radius, c.half_height);
+    let n = 32;
+    let rows = ((2.0 * hh) / (std::f64::consts::TAU * r / n as f64))
+        .ceil()
+        .max(1.0) as usize;
+    let at = |k: usize, y: f64| {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        Vector::new(r * a.cos(), y, r * a.sin())
+    };
+    let mut out = Vec::new();
+    for k in 0..n {
+        for j in 0..rows {
+            let y0 = -hh + 2.0 * hh * j as f64 / rows as f64;
+            let y1 = -hh + 2.0 * hh * (j + 1) as f64 / rows as f64;
+            let (a, b, c2, d) = (at(k, y0), at(k + 1, y0), at(k + 1, y1), at(k, y1));
+            out.push(SurfacePatch::new(
+                [a, b, c2],
+                PatchMap::CylinderSide(r),
+                Vector::X,
+            ));
+            out.push(SurfacePatch::new(
+                [a, c2, d],
+                PatchMap::CylinderSide(r),
+                Vector::X,
+            ));
+        }
+        let a = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
+        let map = PatchMap::CylinderCap {
+            radius: r,
+            mid: Vector::new(a.cos(), 0.0, a.sin()),
+            chord: r * (std::f64::consts::PI / n as f64).cos(),
+        };
+        for y in [-hh, hh] {
+            out.push(SurfacePatch::new(
+                [Vector::new(0.0, y, 0.0), at(k, y), at(k + 1, y)],
+                map,
+                Vector::new(0.0, y.signum(), 0.0),
+            ));
+        }
+    }
+    out
 }

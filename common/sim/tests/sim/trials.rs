@@ -83,9 +83,9 @@ fn sphere_grasped_at_its_centre() {
                 "normal not towards the centre"
             );
         }
-        let m = f.mean_point.unwrap();
+        let m = f.mean_point().unwrap();
         assert!(angle_deg(&m.normal, &(c - m.position)) < 1.0);
-        for s in &f.surface {
+        for s in f.models.get(ContactModel::Surface) {
             assert!(((s.position - c).norm() - SPHERE_RADIUS).abs() <= 1e-6 * SPHERE_RADIUS);
             assert!(
                 angle_deg(&s.normal, &(c - s.position)) < 1e-6,
@@ -215,7 +215,7 @@ fn parallel_jaw_on_the_cuboid_faces() {
     let out = trial(&cuboid, &hand, &reference_pose(&cuboid));
     assert_eq!(out.fingers_in_contact(), 2);
     for (f, expect) in out.fingers.iter().zip([Vector3::y(), -Vector3::y()]) {
-        for p in &f.surface {
+        for p in f.models.get(ContactModel::Surface) {
             assert!(
                 (p.normal - expect).norm() < 1e-9,
                 "{:?} vs {expect:?}",
@@ -234,7 +234,7 @@ fn parallel_jaw_on_the_cuboid_faces() {
             }
         }
         assert!(on_face >= 0.95 * total, "{on_face} of {total}");
-        assert_eq!(f.surface.len(), 21);
+        assert_eq!(f.models.get(ContactModel::Surface).len(), 21);
     }
 }
 
@@ -259,7 +259,7 @@ fn every_object_is_touched_at_its_reference_pose() {
         let round = matches!(name, "sphere" | "cylinder");
         let smooth = matches!(name, "sphere" | "cylinder" | "mug" | "wine_glass");
         for f in &out.fingers {
-            if smooth && let Some(m) = f.mean_point {
+            if smooth && let Some(m) = f.mean_point() {
                 let sp = o.closest_point(&m.position).unwrap();
                 assert!(
                     m.normal.dot(&sp.outward_normal) < -0.8,
@@ -319,9 +319,9 @@ fn a_far_pose_touches_nothing() {
         for f in out.fingers.iter().chain([&out.palm]) {
             assert!(
                 f.cloud.is_empty()
-                    && f.mean_point.is_none()
-                    && f.circular_patch.is_empty()
-                    && f.surface.is_empty()
+                    && ContactModel::ALL
+                        .iter()
+                        .all(|&m| f.models.get(m).is_empty())
             );
         }
         assert!(out.contacts(ContactModel::Surface, true).is_empty());
@@ -457,6 +457,37 @@ fn noise_is_seeded_and_keeps_normals_unit() {
     );
     for p in a.contacts(ContactModel::Surface, true) {
         assert!((p.normal.norm() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn each_contact_model_keeps_its_noise_stream() {
+    // Finger f's model with noise key k draws from stream 3 (f + 1) + k, as before the models
+    // were registered: the noisy outputs of earlier versions stay the same.
+    let mug = Object::by_name("mug").unwrap();
+    let hand = BarrettHand::default();
+    let pose = reference_pose(&mug);
+    let noise = NoiseSettings {
+        position_std: 5e-4,
+        normal_std: 0.05,
+        seed: 11,
+    };
+    let settings = ContactModelSettings {
+        noise: Some(noise),
+        ..Default::default()
+    };
+    let noisy = run_trial(&mug, &hand, &pose, &settings).unwrap();
+    let clean = trial(&mug, &hand, &pose);
+    for (f, (a, b)) in noisy.fingers.iter().zip(&clean.fingers).enumerate() {
+        for (model, key) in [
+            (ContactModel::MeanPoint, 0),
+            (ContactModel::CircularPatch, 1),
+            (ContactModel::Surface, 2),
+        ] {
+            let mut expect = b.contacts(model);
+            graspopt_sim::contact::add_noise(&mut expect, &noise, 3 * (f as u64 + 1) + key);
+            assert_eq!(a.contacts(model), expect, "finger {f} {model}");
+        }
     }
 }
 

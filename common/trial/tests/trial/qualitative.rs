@@ -109,7 +109,7 @@ fn sample(ev: &Evaluator, e: &Evaluation) -> Sample {
         .outcome
         .fingers
         .iter()
-        .filter_map(|f| f.mean_point)
+        .filter_map(|f| f.mean_point())
         .collect();
     let contact_offset = (!points.is_empty()).then(|| {
         let sum = points

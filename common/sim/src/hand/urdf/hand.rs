@@ -242,20 +242,10 @@ impl UrdfHand {
         levers
     }
 
-    /// Advances dof `a` (with the joints that mimic it) towards its closed limit until one of
-    /// the bodies it moves touches the object or it reaches the limit; then releases its
-    /// breakaway followers. `dir`: +1 towards the upper limit, -1 towards the lower.
-    fn advance(
-        &self,
-        object: &Object,
-        palm: &Isometry3<f64>,
-        q: &mut Vec<f64>,
-        detached: &mut [bool],
-        a: usize,
-        dir: f64,
-    ) -> Result<()> {
-        let followers: Vec<(usize, f64, f64, bool)> = self
-            .dofs
+    /// The joints that mimic dof `a` and still follow it: `(dof, multiplier, offset,
+    /// breakaway)`.
+    fn followers(&self, a: usize, detached: &[bool]) -> Vec<(usize, f64, f64, bool)> {
+        self.dofs
             .iter()
             .enumerate()
             .filter_map(|(f, d)| match d.role {
@@ -267,7 +257,12 @@ impl UrdfHand {
                 } if master == a && !detached[f] => Some((f, multiplier, offset, breakaway)),
                 _ => None,
             })
-            .collect();
+            .collect()
+    }
+
+    /// The bodies that dof `a` and its `followers` move, each with how far it moves per unit of
+    /// `a` at most.
+    fn moved_bodies(&self, a: usize, followers: &[(usize, f64, f64, bool)]) -> Vec<(usize, f64)> {
         let mut moved: Vec<(usize, f64)> = Vec::new();
         for b in 0..self.bodies.len() {
             let mut rate = 0.0;
@@ -284,6 +279,23 @@ impl UrdfHand {
                 moved.push((b, rate));
             }
         }
+        moved
+    }
+
+    /// Advances dof `a` (with the joints that mimic it) towards its closed limit until one of
+    /// the bodies it moves touches the object or it reaches the limit; then releases its
+    /// breakaway followers. `dir`: +1 towards the upper limit, -1 towards the lower.
+    fn advance(
+        &self,
+        object: &Object,
+        palm: &Isometry3<f64>,
+        q: &mut Vec<f64>,
+        detached: &mut [bool],
+        a: usize,
+        dir: f64,
+    ) -> Result<()> {
+        let followers = self.followers(a, detached);
+        let moved = self.moved_bodies(a, &followers);
         let (lo, hi) = self.dofs[a].limits;
         let config = |base: &[f64], t: f64| -> Vec<f64> {
             let mut c = base.to_vec();
