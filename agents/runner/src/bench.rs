@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use graspopt_bayesopt::benchmark::median;
-use graspopt_bus::{Bus, BusArgs, CloudPath, CloudReceiver, CloudSender, free_loopback_port};
+use graspopt_bus::{Bus, BusConfig, CloudPath, CloudReceiver, CloudSender, free_loopback_port};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, PlannerMethod, Pose, RunId, RunStatus,
 };
@@ -86,7 +86,7 @@ fn bench_run(
     cost: u64,
     method: PlannerMethod,
 ) -> Result<Embedded> {
-    RunSettings {
+    let settings = RunSettings {
         run: format!("bench-{tag}"),
         trial: bench_trial(),
         workers,
@@ -98,8 +98,8 @@ fn bench_run(
         trial_cost_ms: cost,
         lease_ms: 60_000,
         ..RunSettings::default()
-    }
-    .embedded()
+    };
+    Ok(settings.embedded()?)
 }
 
 /// Runs an embedded run and returns the instants at which each trial completed.
@@ -272,10 +272,10 @@ pub fn cloud_message(run: &RunId, trial: u64, points: usize) -> ContactClouds {
 async fn cloud_latency(shm: bool, points: usize, messages: usize) -> Result<(CloudPath, Vec<f64>)> {
     let port = free_loopback_port()?;
     let prefix = format!("graspopt_bench_{}_{}_", std::process::id(), u8::from(shm));
-    let mut a = BusArgs::loopback(vec![format!("tcp/127.0.0.1:{port}")], vec![]);
+    let mut a = BusConfig::loopback(vec![format!("tcp/127.0.0.1:{port}")], vec![]);
     a.shm_prefix = Some(prefix.clone());
     a.no_shm = !shm;
-    let mut b = BusArgs::loopback(vec![], vec![format!("tcp/127.0.0.1:{port}")]);
+    let mut b = BusConfig::loopback(vec![], vec![format!("tcp/127.0.0.1:{port}")]);
     b.shm_prefix = Some(prefix);
     b.no_shm = !shm;
     let hand_bus = Bus::open(&a).await?;

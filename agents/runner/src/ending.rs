@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use crate::error::RunnerError;
 use graspopt_journal::{FailureReason, Journal};
 use graspopt_protocol::text::rounded;
 use graspopt_protocol::{RunPhase, RunStatus, named_params};
@@ -30,14 +30,12 @@ pub struct RunEnd {
 impl RunEnd {
     /// The end of the run whose final status is `status`, with the failure reasons of the
     /// journal at `journal`.
-    pub fn read(status: RunStatus, journal: &Path) -> Result<RunEnd> {
+    pub fn read(status: RunStatus, journal: &Path) -> Result<RunEnd, RunnerError> {
         let failures = Journal::open_existing(journal)
             .and_then(|j| j.failure_reasons(status.run_id.as_str()))
-            .with_context(|| {
-                format!(
-                    "cannot read why trials failed from the journal {}",
-                    journal.display()
-                )
+            .map_err(|source| RunnerError::Failures {
+                journal: journal.to_path_buf(),
+                source,
             })?;
         Ok(RunEnd { status, failures })
     }
@@ -89,7 +87,7 @@ impl RunEnd {
     }
 
     /// The final status as JSON, with `failures`: `[{"reason": ..., "trials": n}, ...]`.
-    pub fn json(&self) -> Result<serde_json::Value> {
+    pub fn json(&self) -> Result<serde_json::Value, serde_json::Error> {
         let mut v = serde_json::to_value(&self.status)?;
         if let Some(map) = v.as_object_mut() {
             map.insert("failures".into(), serde_json::to_value(&self.failures)?);

@@ -11,7 +11,9 @@
 
 use std::io::Write;
 
-use anyhow::{Context, Result, bail};
+use crate::error::RunnerError;
+
+type Result<T> = std::result::Result<T, RunnerError>;
 use graspopt_convert::{TrialTag, clouds_from_outcome, fingertip_wrench, isometry};
 use graspopt_hand::Sensing;
 use graspopt_hand::replay::RecordedTrial;
@@ -28,11 +30,9 @@ use rand_chacha::rand_core::SeedableRng;
 /// say): writing the recording would replace it.
 pub fn refuse_database(out: &std::path::Path) -> Result<()> {
     if graspopt_journal::output::holds_database(out) {
-        bail!(
-            "{} is an SQLite database (a run's journal?): a recording would replace it; \
-             write it elsewhere",
-            out.display()
-        );
+        return Err(RunnerError::Database {
+            path: out.to_path_buf(),
+        });
     }
     Ok(())
 }
@@ -60,10 +60,13 @@ pub fn record_grid(
     let total: usize = axes.iter().map(Vec::len).product();
     for flat in 0..total {
         let params = graspopt_trial::scan::grid_point(axes, flat);
-        let at = || format!("grasp at {params:?}");
+        let at = |e: RunnerError| RunnerError::Grasp {
+            params: params.clone(),
+            source: Box::new(e),
+        };
         let trial = match sensing {
             Sensing::Clouds => {
-                let e = ev.evaluate(&params).with_context(at)?;
+                let e = ev.evaluate(&params).map_err(|e| at(e.into()))?;
                 let clouds = clouds_from_outcome(&tag, &e.outcome, 0);
                 RecordedTrial {
                     params,
@@ -78,7 +81,7 @@ pub fn record_grid(
             }
             Sensing::Ft => {
                 let mut rng = ChaCha8Rng::seed_from_u64(flat as u64);
-                fingertip_trial(ev, params.clone(), tips, &mut rng).with_context(at)?
+                fingertip_trial(ev, params.clone(), tips, &mut rng).map_err(at)?
             }
         };
         trial.write_line(out)?;
@@ -117,7 +120,7 @@ pub fn fingertip_trial(
     };
     let (scored, _) = graspopt_metric::score_wrenches(&readings, &ev.object, &config);
     if let Some(e) = scored.error {
-        bail!("the metric agent cannot score its fingertip readings: {e}");
+        return Err(RunnerError::FingertipScore(e));
     }
     let truth: Vec<_> = simulated
         .iter()
