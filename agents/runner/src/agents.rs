@@ -66,6 +66,9 @@ pub type Served<'a> = Pin<Box<dyn Future<Output = Result<Option<RunEnd>, RunnerE
 pub struct AgentRow {
     pub kind: AgentKind,
     pub about: &'static str,
+    /// Reads its settings as `run` would, to refuse them before anything starts (a launch
+    /// file's processes).
+    pub check: fn(&Standalone) -> Result<(), RunnerError>,
     pub run: for<'a> fn(&'a Standalone) -> Served<'a>,
 }
 
@@ -74,6 +77,7 @@ const fn row<A: Agent>(run: for<'a> fn(&'a Standalone) -> Served<'a>) -> AgentRo
     AgentRow {
         kind: A::KIND,
         about: A::ABOUT,
+        check: |s| settings::<A>(s).map(drop),
         run,
     }
 }

@@ -135,6 +135,12 @@ pub enum RunnerError {
         #[source]
         source: graspopt_journal::JournalError,
     },
+    #[error("cannot read the launch file {}", file.display())]
+    LaunchRead {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
     /// A launch file that cannot be used: the file and why.
     #[error("launch file {}: {why}", file.display())]
     LaunchFile { file: PathBuf, why: String },

@@ -241,6 +241,40 @@ impl LaunchFile {
     }
 }
 
+/// The launch file at `path` and the processes this machine, `host`, runs of it, in start
+/// order; `endpoint` replaces the file's router endpoint (a router in the file then listens
+/// on it); with `resume`, the coordinator resumes its run. An error if nothing runs here.
+pub fn prepare(
+    path: &Path,
+    host: &str,
+    endpoint: Option<&str>,
+    resume: bool,
+) -> Result<(LaunchFile, Vec<Planned>)> {
+    let text = std::fs::read_to_string(path).map_err(|source| RunnerError::LaunchRead {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let mut file = LaunchFile::parse(&text, path)?;
+    if let Some(e) = endpoint {
+        file.endpoint = e.to_string();
+        if let Some(r) = &mut file.router {
+            r.listen = None;
+        }
+    }
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut plan = file.plan(host, &base)?;
+    if plan.is_empty() {
+        return Err(RunnerError::LaunchFile {
+            file: path.to_path_buf(),
+            why: format!("nothing runs on host {host:?} (use --host to pick an entry's host)"),
+        });
+    }
+    if resume {
+        resume_coordinator(&mut plan, host)?;
+    }
+    Ok((file, plan))
+}
+
 /// Makes the coordinator of `plan` resume its run (`--resume`, once). An error if `plan`
 /// has no coordinator: only the machine that runs it can resume the run.
 pub fn resume_coordinator(plan: &mut [Planned], host: &str) -> Result<()> {

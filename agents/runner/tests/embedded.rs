@@ -253,12 +253,11 @@ async fn a_run_records_its_ranges_and_a_resumed_run_keeps_them() {
         },
         ..again.clone()
     };
-    let msg = format!(
-        "{:#}",
-        contrary
+    let msg = graspopt_runner::error::chain(
+        &contrary
             .resolve(&|name| name == "range")
             .err()
-            .expect("a contrary range must be refused")
+            .expect("a contrary range must be refused"),
     );
     assert!(
         msg.contains("--range rz=-2:2 (the run has rz=-3:3)"),

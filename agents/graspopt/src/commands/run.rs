@@ -9,13 +9,13 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Args;
-use graspopt_bus::BusArgs;
 use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
+use super::bus::BusArgs;
 use super::setup::{SimArgs, count, planner_method, sensing, trial_param};
 use crate::out::outln;
 use graspopt_coordinator::{MAX_TRIALS, MAX_WAIT_MS};
@@ -106,7 +106,7 @@ impl RunArgs {
             lease_ms: self.lease_ms,
             position_noise: self.position_noise,
             rotation_noise: self.rotation_noise,
-            bus: self.bus.clone(),
+            bus: self.bus.config(),
         }
     }
 }

@@ -10,7 +10,7 @@ use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::text::grouped;
-use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec};
+use graspopt_sim::{ContactModel, ParamKind, ParamSpec};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
@@ -121,11 +121,6 @@ impl SimArgs {
             torque_scale: self.torque_scale,
             ranges: self.range.clone(),
         }
-    }
-
-    /// The object named by the flags.
-    pub fn object(&self) -> Result<Object> {
-        Ok(self.settings().object()?)
     }
 
     /// An evaluator over the trial space with the given parameters (default bounds, or
