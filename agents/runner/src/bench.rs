@@ -28,6 +28,7 @@ use tokio::sync::watch;
 use crate::{Embedded, RunSettings, placeholder, run_embedded};
 
 pub mod coordinator;
+pub mod functions;
 
 /// What [`pipeline`] measures.
 #[derive(Debug, Clone)]
