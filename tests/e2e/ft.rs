@@ -103,7 +103,15 @@ fn a_run_with_a_force_sensing_hand_scores_like_its_true_contacts() {
     let c = Cluster::start("ftsim", "ftsim");
     let hand = c.agent(
         "ft-hand",
-        &["hand", "--id", "ft-hand", "--hand", HAND, "--sensing", "ft"],
+        &[
+            "hand",
+            "--id",
+            "ft-hand",
+            "--set",
+            &format!("hand={HAND}"),
+            "--set",
+            "sensing=ft",
+        ],
     );
     let rows = optimize_with(&c, hand, "ft-hand", 30);
     let ev = evaluator();
@@ -242,8 +250,8 @@ fn replay_hand_answers_with_recorded_fingertip_readings() {
             "hand",
             "--id",
             "replay-ft-hand",
-            "--replay",
-            rec.to_str().unwrap(),
+            "--set",
+            &format!("replay={}", rec.display()),
         ],
     );
     let rows = optimize_with(&c, hand, "replay-ft-hand", 10);
@@ -266,8 +274,8 @@ fn replay_hand_answers_with_recorded_fingertip_readings() {
     let o = graspopt(&[
         "agent",
         "hand",
-        "--replay",
-        bad.to_str().unwrap(),
+        "--set",
+        &format!("replay={}", bad.display()),
         "--connect",
         &c.endpoint,
         "--no-multicast-scouting",
@@ -393,7 +401,7 @@ fn bad_fingertip_readings_fail_their_trial_and_the_run_goes_on() {
         OBJECT,
         "6",
         "2",
-        &["--hand", HAND, "--method", "random", "--lease-ms", "60000"],
+        &["--hand", HAND, "--method", "random", "--set", "lease_ms=60000"],
     );
     let started = Instant::now();
     let status = c.final_status(coordinator, Duration::from_secs(60));

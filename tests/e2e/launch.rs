@@ -88,10 +88,10 @@ kind = "planner"
 kind = "metric"
 [[agent]]
 kind = "hand"
-args = ["--trial-cost-ms", "100"]
+args = ["--set", "trial_cost_ms=100"]
 [[agent]]
 kind = "coordinator"
-args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journal", "results/lr/journal.sqlite"]
+args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--set", "journal=results/lr/journal.sqlite"]
 "#
         ),
     )
