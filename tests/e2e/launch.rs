@@ -81,7 +81,7 @@ endpoint = "tcp/127.0.0.1:{port}"
 [router]
 [[agent]]
 kind = "perception"
-args = ["--object", "cylinder"]
+args = ["--set", "object=cylinder"]
 [[agent]]
 kind = "planner"
 [[agent]]
