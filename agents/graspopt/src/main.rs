@@ -34,7 +34,7 @@ enum Command {
     /// Grid-scan a metric over trial parameters (CSV; SVG and PNG images for one or two).
     Scan(commands::scan::ScanArgs),
     /// Record a grid of simulated grasps' contact clouds, or fingertip readings with
-    /// `--sensing ft` (for `agent hand --replay`).
+    /// `--sensing ft` (for `agent hand --set replay=FILE`).
     Record(commands::record::RecordArgs),
     /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15; `bo`: figures
     /// 4.16-4.27 and Table 4.1).

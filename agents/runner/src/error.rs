@@ -168,7 +168,7 @@ pub enum RunnerError {
         source: std::io::Error,
     },
     #[error("cannot create {}", path.display())]
-    LogFile {
+    Create {
         path: PathBuf,
         #[source]
         source: std::io::Error,
@@ -178,6 +178,17 @@ pub enum RunnerError {
         name: String,
         #[source]
         source: std::io::Error,
+    },
+    /// A process of a launch stopped before the run finished.
+    #[error(
+        "{name} stopped ({status}) before the run finished; everything was stopped. Its log ({}):\n{tail}",
+        log.display()
+    )]
+    Died {
+        name: String,
+        status: String,
+        log: PathBuf,
+        tail: String,
     },
     #[error("the router does not accept connections on {addr} after 20 s")]
     RouterSilent { addr: String },
@@ -192,6 +203,15 @@ pub enum RunnerError {
         #[source]
         source: Box<RunnerError>,
     },
+    /// Settings given with `flags` that cannot be used.
+    #[error("{flags}")]
+    Flags {
+        flags: &'static str,
+        #[source]
+        source: Boxed,
+    },
+    #[error("--force-resolution and --torque-resolution need --sensing ft")]
+    NeedsFt,
     #[error("the metric agent cannot score its fingertip readings: {0}")]
     FingertipScore(String),
     #[error(transparent)]

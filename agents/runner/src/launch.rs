@@ -332,6 +332,46 @@ pub enum Outcome {
     Interrupted,
 }
 
+impl Outcome {
+    /// How a launch of `file` that ended so ends: its exit status and what to say (the
+    /// coordinator's end, or a Ctrl-C), or the error of a process that stopped first.
+    pub fn ending(self, file: &Path) -> Result<(u8, Option<String>)> {
+        match self {
+            Outcome::Coordinator(Some(0), _) => Ok((0, None)),
+            Outcome::Coordinator(code, log) => {
+                let log = log.unwrap_or_default();
+                let no_trial = i32::from(crate::ending::NO_TRIAL_COMPLETED);
+                let what = if code == Some(no_trial) {
+                    "no trial of the run completed"
+                } else {
+                    "the coordinator failed"
+                };
+                let said = format!(
+                    "graspopt launch: {what}; the coordinator's log ({}):\n{}",
+                    log.display(),
+                    tail(&log, 20)
+                );
+                // Its exit status is launch's (1 if it was killed by a signal).
+                let code = code.and_then(|c| u8::try_from(c).ok()).unwrap_or(1);
+                Ok((code, Some(said)))
+            }
+            Outcome::Died(name, status, log) => Err(RunnerError::Died {
+                name,
+                status,
+                tail: tail(&log, 20),
+                log,
+            }),
+            Outcome::Interrupted => Ok((
+                130,
+                Some(format!(
+                    "graspopt launch: interrupted, every process stopped; continue the run with graspopt launch --resume {}",
+                    file.display()
+                )),
+            )),
+        }
+    }
+}
+
 impl Children {
     /// Starts `plan` in order: `exe` with each process's arguments, stderr to
     /// `<logs>/<name>.log`, stdout passed through; after the router, waits (at most 20 s)
@@ -349,7 +389,7 @@ impl Children {
         let mut children = Children(Vec::new());
         for p in plan {
             let log = logs.join(format!("{}.log", p.name));
-            let err = std::fs::File::create(&log).map_err(|source| RunnerError::LogFile {
+            let err = std::fs::File::create(&log).map_err(|source| RunnerError::Create {
                 path: log.clone(),
                 source,
             })?;

@@ -1,5 +1,5 @@
 //! Recordings for the replay hand (`graspopt record`): a grid of simulated grasps written as
-//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --replay` and the Python
+//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --set replay=FILE` and the Python
 //! hands answer trials from, standing in for a robot's logged data.
 //!
 //! With [`Sensing::Clouds`] each line holds the grasp's raw contact clouds and its score.
@@ -20,7 +20,9 @@ use graspopt_hand::replay::RecordedTrial;
 use graspopt_protocol::{FingertipWrenches, RunId};
 use graspopt_sim::{TrialOutcome, run_trial};
 use graspopt_trial::Evaluator;
-use graspopt_trial::fingertips::{FingertipSettings, fingertip_score, simulate_readings};
+use graspopt_trial::fingertips::{
+    FingertipSettings, fingertip_score, fingertips, simulate_readings,
+};
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use rand_chacha::ChaCha8Rng;
@@ -35,6 +37,56 @@ pub fn refuse_database(out: &std::path::Path) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The fingertip sensors of a recording of `sensing` by `hand`: the default noise, or the
+/// resolutions given, which only [`Sensing::Ft`] takes.
+pub fn fingertip_settings(
+    sensing: Sensing,
+    hand: &str,
+    force_resolution: Option<f64>,
+    torque_resolution: Option<f64>,
+) -> Result<FingertipSettings> {
+    let mut tips = FingertipSettings::default();
+    if sensing != Sensing::Ft {
+        if force_resolution.is_some() || torque_resolution.is_some() {
+            return Err(RunnerError::NeedsFt);
+        }
+        return Ok(tips);
+    }
+    let noise = &mut tips.noise;
+    noise.force_resolution = force_resolution.unwrap_or(noise.force_resolution);
+    noise.torque_resolution = torque_resolution.unwrap_or(noise.torque_resolution);
+    noise.validate().map_err(|e| RunnerError::Flags {
+        flags: "--force-resolution / --torque-resolution",
+        source: e.into(),
+    })?;
+    let hand = graspopt_sim::hand_by_name(hand)?;
+    fingertips(hand.as_ref()).map_err(|e| RunnerError::Flags {
+        flags: "--sensing ft",
+        source: e.into(),
+    })?;
+    Ok(tips)
+}
+
+/// Records the grid `axes` (see [`record_grid`]) to the file `out`, its folder created;
+/// returns how many grasps.
+pub fn write_recording(
+    out: &std::path::Path,
+    ev: &Evaluator,
+    axes: &[Vec<f64>],
+    sensing: Sensing,
+    tips: &FingertipSettings,
+) -> Result<usize> {
+    let create = |path: &std::path::Path| {
+        let path = path.to_path_buf();
+        move |source| RunnerError::Create { path, source }
+    };
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(create(dir))?;
+    }
+    let file = std::fs::File::create(out).map_err(create(out))?;
+    record_grid(ev, axes, sensing, tips, &mut std::io::BufWriter::new(file))
 }
 
 /// The tag of every recorded grasp (a recording belongs to no run).

@@ -9,13 +9,11 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, Command, FromArgMatches};
-use graspopt_coordinator::MAX_TRIALS;
-use graspopt_protocol::{AgentKind, PlannerMethod};
+use graspopt_protocol::AgentKind;
 use graspopt_runner::{AGENTS, SpecSettings, Standalone};
-use graspopt_sim::ParamKind;
 
 use super::bus::BusArgs;
-use super::setup::{SimArgs, count, planner_method, trial_param};
+use super::setup::SpecArgs;
 use crate::out::outln;
 
 /// `graspopt agent <kind> [flags]`.
@@ -48,35 +46,6 @@ pub struct Common {
     pub id: Option<String>,
     #[command(flatten)]
     pub bus: BusArgs,
-}
-
-/// The run a coordinator serves.
-#[derive(Args, Debug, Clone)]
-pub struct SpecArgs {
-    #[command(flatten)]
-    sim: SimArgs,
-    /// Number of trials (with --resume: raises the recorded budget).
-    #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
-    trials: u64,
-    /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
-    #[arg(long, visible_alias = "axes", default_value = "x,y", value_delimiter = ',',
-          value_parser = trial_param())]
-    params: Vec<ParamKind>,
-    /// How trials are proposed: bo or random.
-    #[arg(long, default_value = "bo", value_parser = planner_method())]
-    method: PlannerMethod,
-    /// Size of the initial design (space-filling, not model-based) (default: the
-    /// engine's).
-    #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
-    initial: Option<u32>,
-    /// Seed of the planner's random choices (the same seed proposes the same trials).
-    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
-    seed: u64,
-    /// Continue the run recorded in the journal (its only run, unless --run names one),
-    /// with its recorded settings. Without --resume, a run recorded with no trial (a
-    /// start that stopped before its first) starts afresh.
-    #[arg(long)]
-    resume: bool,
 }
 
 impl Args for AgentArgs {

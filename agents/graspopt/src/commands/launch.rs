@@ -7,8 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, FromArgMatches};
-use graspopt_runner::ending::NO_TRIAL_COMPLETED;
-use graspopt_runner::launch::{Children, Outcome, Planned, prepare, tail};
+use graspopt_runner::launch::{Children, Planned, prepare};
 
 use super::agent::AgentArgs;
 use crate::out::outln;
@@ -68,7 +67,11 @@ pub fn run(args: &LaunchArgs) -> Result<ExitCode> {
         let stop = graspopt_runner::signal::shutdown_signal();
         children.supervise(stop).await
     });
-    ended(outcome, &args.file)
+    let (code, said) = outcome.ending(&args.file)?;
+    if let Some(said) = said {
+        eprintln!("{said}");
+    }
+    Ok(ExitCode::from(code))
 }
 
 /// Why process `p` would refuse its flags (the first line of clap's message) or, an agent,
@@ -86,39 +89,4 @@ fn check(p: &Planned) -> std::result::Result<(), String> {
     let agent = AgentArgs::from_arg_matches(agent).map_err(|e| e.to_string())?;
     let row = graspopt_runner::agents::agent_row(agent.kind);
     (row.check)(&agent.standalone()).map_err(|e| graspopt_runner::error::chain(&e))
-}
-
-/// The exit status of a launch that ended with `outcome`, its cause said on stderr.
-fn ended(outcome: Outcome, file: &Path) -> Result<ExitCode> {
-    match outcome {
-        Outcome::Coordinator(Some(0), _) => Ok(ExitCode::SUCCESS),
-        Outcome::Coordinator(code, log) => {
-            let log = log.unwrap_or_default();
-            let what = if code == Some(i32::from(NO_TRIAL_COMPLETED)) {
-                "no trial of the run completed"
-            } else {
-                "the coordinator failed"
-            };
-            eprintln!(
-                "graspopt launch: {what}; the coordinator's log ({}):\n{}",
-                log.display(),
-                tail(&log, 20)
-            );
-            // Its exit status is launch's (1 if it was killed by a signal).
-            let code = code.and_then(|c| u8::try_from(c).ok()).unwrap_or(1);
-            Ok(ExitCode::from(code))
-        }
-        Outcome::Died(name, status, log) => bail!(
-            "{name} stopped ({status}) before the run finished; everything was stopped. Its log ({}):\n{}",
-            log.display(),
-            tail(&log, 20)
-        ),
-        Outcome::Interrupted => {
-            eprintln!(
-                "graspopt launch: interrupted, every process stopped; continue the run with graspopt launch --resume {}",
-                file.display()
-            );
-            Ok(ExitCode::from(130))
-        }
-    }
 }
