@@ -1,6 +1,6 @@
 //! Recordings for the replay hand (`graspopt record`): a grid of simulated grasps written as
-//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --set replay=FILE` and the Python
-//! hands answer trials from, standing in for a robot's logged data.
+//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --set replay=FILE` and the
+//! Python hands answer trials from, standing in for a robot's logged data.
 //!
 //! With [`Sensing::Clouds`] each line holds the grasp's raw contact clouds and its score.
 //! With [`Sensing::Ft`] it holds what force/torque sensors under the fingertips read

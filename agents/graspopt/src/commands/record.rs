@@ -1,17 +1,8 @@
 //! `graspopt record --object mug --axes x,y --steps 9,9 --out mug.jsonl`: executes a grid of
-//! simulated grasps and writes their raw contact clouds as a recording (JSON lines), the
-//! format `graspopt agent hand --set replay=FILE` and `examples/python/hand_agent.py` answer trials
-//! from, standing in for a robot's logged fingertip data.
-//!
-//! `--sensing ft` (with `--hand barrett_ft`) records what force/torque sensors under the
-//! fingertips read instead: each line holds the grasp's fingertip readings (as in a
-//! `FingertipWrenches` message, with the sensor noise of `--force-resolution` and
-//! `--torque-resolution`, drawn from a generator seeded with the grid point's index), the score
-//! the metric agent gives those readings (`score`) and the score of the true, noise-free
-//! fingertip contacts they were simulated from (`true_score`).
-//! `examples/python/ft_hand_agent.py` and `agent hand --set replay=FILE` answer trials from it.
-//!
-//! The recording itself is `graspopt_runner::record`; this module reads the flags.
+//! simulated grasps and writes their raw contact clouds (or, with `--sensing ft` and
+//! `--hand barrett_ft`, their fingertip force/torque readings) as a recording, which
+//! `graspopt agent hand --set replay=FILE` and the Python hands answer trials from. The
+//! format and the recording: [`graspopt_runner::record`]; this module reads the flags.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
