@@ -1,10 +1,10 @@
 //! The registry of agent kinds ([`AGENTS`], one row each) and how one agent runs as its
 //! own process ([`Standalone`]: `graspopt agent <kind>`, each process of a launch file).
 //!
-//! To add an agent kind: its [`AgentKind`] variant, its crate with `impl Agent`, and its
-//! row here. `graspopt agent` makes a subcommand of every row and launch files accept its
-//! kind; its settings come from `--config FILE` and `--set key=value` with no code of its
-//! own (docs/agent-config.md documents them).
+//! To add an agent kind: its row in protocol's `agent_kinds!` (its [`AgentKind`]), its crate
+//! with `impl Agent`, and its row here; then its section in docs/agent-config.md.
+//! `graspopt agent` makes a subcommand of every row and launch files accept its kind; its
+//! settings come from `--config FILE` and `--set key=value` with no code of its own.
 
 use std::future::Future;
 use std::path::PathBuf;
@@ -174,6 +174,8 @@ mod tests {
         assert_eq!(kinds, AgentKind::ALL);
         for kind in AgentKind::ALL {
             assert_eq!(agent_row(kind).kind, kind);
+            // Its name in keys and its serde name are one.
+            assert_eq!(serde_json::to_value(kind).unwrap(), kind.as_str());
         }
     }
 

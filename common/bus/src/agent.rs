@@ -1,9 +1,9 @@
 //! What an agent is: one [`Agent`] trait that the runner (`graspopt run`'s embedded agents),
 //! `graspopt launch` and `graspopt agent <kind>` are written against once.
 //!
-//! To add an agent kind: a variant of [`AgentKind`] (its name on the bus), the crate of the
-//! agent with its `impl Agent`, and one row in the runner's registry
-//! (`graspopt_runner::agents`), which `graspopt agent` and launch files read.
+//! To add an agent kind: its row in protocol's `agent_kinds!` (its [`AgentKind`], its name
+//! on the bus), the crate of the agent with its `impl Agent`, and its row in the runner's
+//! registry (`graspopt_runner::agents::AGENTS`), which `graspopt agent` and launch files read.
 
 use std::future::Future;
 
