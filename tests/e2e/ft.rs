@@ -1,5 +1,5 @@
 //! Hands with force/torque sensors in their fingertips (issue 20): the simulated one
-//! (`agent hand --hand barrett_ft --sensing ft`), the replay hand and the Python hand
+//! (`agent hand --set hand=barrett_ft --set sensing=ft`), the replay hand and the Python hand
 //! (`examples/python/ft_hand_agent.py`) answering from a recording of fingertip readings
 //! (`graspopt record --sensing ft`), and bad readings. Each run's scores are checked against
 //! the score of the same trial's true contacts, recomputed here with the libraries.
@@ -237,7 +237,7 @@ pub(crate) fn check_replayed(rows: &[TrialRow], grasps: &[Recorded]) -> (f64, f6
     largest_differences(&pairs)
 }
 
-/// `agent hand --replay` of a recording of fingertip readings sends them as
+/// `agent hand --set replay=FILE` of a recording of fingertip readings sends them as
 /// `FingertipWrenches`: the metric agent scores them as recorded. A recording with a bad
 /// reading is refused by file and line.
 #[test]

@@ -1,4 +1,4 @@
-//! Hands that answer from recorded contact data: `graspopt agent hand --replay` and the
+//! Hands that answer from recorded contact data: `graspopt agent hand --set replay=FILE` and the
 //! Python hand agent (`examples/python/hand_agent.py`, JSON on the wire). A recording of a
 //! grid of grasps is made with `graspopt record`; an optimization then runs with the replaying
 //! hand as its only worker, and every trial's score must be the recorded score of the grasp
