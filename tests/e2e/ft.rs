@@ -401,7 +401,14 @@ fn bad_fingertip_readings_fail_their_trial_and_the_run_goes_on() {
         OBJECT,
         "6",
         "2",
-        &["--hand", HAND, "--method", "random", "--set", "lease_ms=60000"],
+        &[
+            "--hand",
+            HAND,
+            "--method",
+            "random",
+            "--set",
+            "lease_ms=60000",
+        ],
     );
     let started = Instant::now();
     let status = c.final_status(coordinator, Duration::from_secs(60));

@@ -313,7 +313,10 @@ fn launch(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
         );
     }
     let mut coordinator = run_flags(hand);
-    coordinator.extend(["--set".into(), format!("journal=results/{run}/journal.sqlite")]);
+    coordinator.extend([
+        "--set".into(),
+        format!("journal=results/{run}/journal.sqlite"),
+    ]);
     file += &format!(
         "[[agent]]\nkind = \"coordinator\"\nargs = [{}]\n",
         quoted(&coordinator)

@@ -311,7 +311,8 @@ fn a_run_across_three_network_namespaces_survives_a_router_restart() {
         ]);
         net.start(ns, id, &v, &dir)
     };
-    let hand = |ns: &str, m: &str, id: &str| agent(ns, m, id, &["hand", "--set", "trial_cost_ms=250"]);
+    let hand =
+        |ns: &str, m: &str, id: &str| agent(ns, m, id, &["hand", "--set", "trial_cost_ms=250"]);
     let _agents = [
         agent(a, "a", "perception", &["perception", "--set", "object=mug"]),
         agent(a, "a", "planner", &["planner"]),

@@ -256,7 +256,10 @@ fn the_run_survives_a_router_restart() {
     // Clients, and clouds over Zenoh as well: every message goes through the router.
     let client = ["--mode", "client", "--no-shm"];
     let with = |args: &[&'static str]| [args, &client[..]].concat();
-    let _perception = c.agent("perception", &with(&["perception", "--set", "object=cylinder"]));
+    let _perception = c.agent(
+        "perception",
+        &with(&["perception", "--set", "object=cylinder"]),
+    );
     let _planner = c.agent("planner", &with(&["planner"]));
     let _metric = c.agent("metric", &with(&["metric"]));
     let _hands = c.hands(2, &with(&["--set", "trial_cost_ms=200"]));

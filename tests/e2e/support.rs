@@ -214,7 +214,10 @@ impl Cluster {
     /// every run needs besides its hands and coordinator.
     pub fn support(&self, object: &str) -> Vec<Proc> {
         vec![
-            self.agent("perception", &["perception", "--set", &format!("object={object}")]),
+            self.agent(
+                "perception",
+                &["perception", "--set", &format!("object={object}")],
+            ),
             self.agent("planner", &["planner"]),
             self.agent("metric", &["metric"]),
         ]

@@ -114,7 +114,9 @@ impl graspopt_bus::Agent for CoordinatorAgent {
     }
 
     fn validate(config: &CoordinatorConfig) -> Result<(), Self::Error> {
-        config.validate().map_err(|e| CoordinatorAgentError(e.into()))
+        config
+            .validate()
+            .map_err(|e| CoordinatorAgentError(e.into()))
     }
 
     async fn run(

@@ -234,7 +234,10 @@ mod tests {
                 .unwrap()
                 .push(format!("trial {}", command.trial_id));
             if command.trial_id.is_multiple_of(2) {
-                return Err(HandError::Fault(format!("fault on trial {}", command.trial_id)));
+                return Err(HandError::Fault(format!(
+                    "fault on trial {}",
+                    command.trial_id
+                )));
             }
             Ok(HandReading {
                 palm_pose: Pose::IDENTITY,

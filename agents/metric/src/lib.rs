@@ -312,7 +312,9 @@ impl Scorer<'_> {
                         Err(err) => {
                             self.bad += 1;
                             let bad = self.bad;
-                            tracing::warn!("metric {id}: unusable object estimate ({bad} bad messages): {err}");
+                            tracing::warn!(
+                                "metric {id}: unusable object estimate ({bad} bad messages): {err}"
+                            );
                         }
                     }
                 }
@@ -320,12 +322,18 @@ impl Scorer<'_> {
             Ok(e) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: object estimate of run {:?} ignored ({bad} bad messages)", e.run_id);
+                tracing::warn!(
+                    "metric {id}: object estimate of run {:?} ignored ({bad} bad messages)",
+                    e.run_id
+                );
             }
             Err(e) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: bad object estimate on {} ({bad} bad messages): {e}", r.key);
+                tracing::warn!(
+                    "metric {id}: bad object estimate on {} ({bad} bad messages): {e}",
+                    r.key
+                );
             }
         }
     }
@@ -333,20 +341,29 @@ impl Scorer<'_> {
     async fn on_clouds(&mut self, r: ReceivedClouds) {
         let id = self.config.id.clone();
         match r.message {
-            Ok(c) if c.run_id == *self.run => self.waiting.push_back(Measured::Clouds(c, r.path.as_str())),
+            Ok(c) if c.run_id == *self.run => {
+                self.waiting.push_back(Measured::Clouds(c, r.path.as_str()))
+            }
             Ok(c) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: clouds of run {:?} ignored ({bad} bad messages)", c.run_id);
+                tracing::warn!(
+                    "metric {id}: clouds of run {:?} ignored ({bad} bad messages)",
+                    c.run_id
+                );
             }
             Err(e) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: bad clouds via {} ({bad} bad messages): {e}", r.path.as_str());
+                tracing::warn!(
+                    "metric {id}: bad clouds via {} ({bad} bad messages): {e}",
+                    r.path.as_str()
+                );
                 // Clouds that name an attempt of this run fail it with the reason, so the
                 // trial does not wait for its lease (the coordinator accepts it only from
                 // the worker the attempt was issued to).
-                self.fail_invalid(&e, "contact clouds", r.path.as_str()).await;
+                self.fail_invalid(&e, "contact clouds", r.path.as_str())
+                    .await;
             }
         }
     }
@@ -358,12 +375,18 @@ impl Scorer<'_> {
             Ok(w) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: fingertip readings of run {:?} ignored ({bad} bad messages)", w.run_id);
+                tracing::warn!(
+                    "metric {id}: fingertip readings of run {:?} ignored ({bad} bad messages)",
+                    w.run_id
+                );
             }
             Err(e) => {
                 self.bad += 1;
                 let bad = self.bad;
-                tracing::warn!("metric {id}: bad fingertip readings on {} ({bad} bad messages): {e}", r.key);
+                tracing::warn!(
+                    "metric {id}: bad fingertip readings on {} ({bad} bad messages): {e}",
+                    r.key
+                );
                 self.fail_invalid(&e, "fingertip readings", "zenoh").await;
             }
         }
@@ -382,7 +405,10 @@ impl Scorer<'_> {
             let id = &self.config.id;
             let failed = invalid_measurement_result(a, what, detail, id, transport);
             if let Err(e) = self.bus.put(&self.key, &failed, Encoding::Bincode).await {
-                tracing::warn!("metric {id}: cannot publish the failure of trial {}: {e}", a.trial_id);
+                tracing::warn!(
+                    "metric {id}: cannot publish the failure of trial {}: {e}",
+                    a.trial_id
+                );
             }
         }
     }

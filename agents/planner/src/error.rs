@@ -27,4 +27,3 @@ pub enum PlannerError {
     #[error(transparent)]
     Bus(#[from] graspopt_bus::BusError),
 }
-

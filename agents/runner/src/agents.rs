@@ -93,10 +93,7 @@ pub const AGENTS: [AgentRow; 5] = [
 
 /// The row of `kind`.
 pub fn agent_row(kind: AgentKind) -> &'static AgentRow {
-    AGENTS
-        .iter()
-        .find(|r| r.kind == kind)
-        .unwrap_or(&AGENTS[0])
+    AGENTS.iter().find(|r| r.kind == kind).unwrap_or(&AGENTS[0])
 }
 
 /// The settings of agent `A` as `s` gives them: its file, the `--set` overrides, the id.
@@ -211,7 +208,10 @@ mod tests {
             "{e}"
         );
         let e = err("fingertips.noise.force=1");
-        assert!(e.contains("unknown key `force` in [fingertips.noise]"), "{e}");
+        assert!(
+            e.contains("unknown key `force` in [fingertips.noise]"),
+            "{e}"
+        );
         assert!(err("sensing=sonar").contains("--set sensing=sonar: unknown variant"));
         assert!(err("trial_cost_ms").contains("write it as key=value"));
     }

@@ -64,7 +64,6 @@ pub enum BenchError {
     Io(#[from] std::io::Error),
 }
 
-
 pub mod coordinator;
 pub mod functions;
 

@@ -110,7 +110,9 @@ fn apply_set<T: DeserializeOwned>(
             }
         }
     }
-    Err(refused(first_error.map_or_else(String::new, |e| e.to_string())))
+    Err(refused(
+        first_error.map_or_else(String::new, |e| e.to_string()),
+    ))
 }
 
 /// `text` read as a TOML value (`None` when it is not one: a bare word, say).

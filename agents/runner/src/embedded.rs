@@ -62,8 +62,20 @@ pub async fn run_embedded(
     })?;
     let bus = Bus::open(&e.bus).await?;
     let mut tasks = JoinSet::new();
-    spawn(&mut tasks, PerceptionAgent, &bus, &e.run, e.perception.clone());
-    spawn(&mut tasks, PlannerAgent, &bus, &e.run, PlannerConfig::default());
+    spawn(
+        &mut tasks,
+        PerceptionAgent,
+        &bus,
+        &e.run,
+        e.perception.clone(),
+    );
+    spawn(
+        &mut tasks,
+        PlannerAgent,
+        &bus,
+        &e.run,
+        PlannerConfig::default(),
+    );
     spawn(&mut tasks, MetricAgent, &bus, &e.run, e.metric.clone());
     for i in 1..=e.workers {
         let hand = HandConfig {

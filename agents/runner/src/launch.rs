@@ -177,7 +177,13 @@ impl LaunchFile {
             }
         }
         let coordinator = AgentKind::Coordinator.as_str();
-        if launch.agents.iter().filter(|a| a.kind == coordinator).count() > 1 {
+        if launch
+            .agents
+            .iter()
+            .filter(|a| a.kind == coordinator)
+            .count()
+            > 1
+        {
             return Err(refused("a run has one coordinator".into()));
         }
         Ok(launch)

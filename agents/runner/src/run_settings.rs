@@ -221,8 +221,8 @@ impl RecordedSettings {
         };
         s.trial.contacts = ContactModel::parse(&self.contacts)
             .map_err(|e| recorded("contact model".into(), Some(e.into())))?;
-        s.trial.metric = Metric::parse(&self.metric)
-            .map_err(|e| recorded("metric".into(), Some(e.into())))?;
+        s.trial.metric =
+            Metric::parse(&self.metric).map_err(|e| recorded("metric".into(), Some(e.into())))?;
         s.trial.frame = ReferenceFrame::parse(&self.frame)
             .map_err(|e| recorded("frame".into(), Some(e.into())))?;
         s.trial.torque_scale = self.torque_scale;
@@ -376,8 +376,7 @@ impl RunSettings {
         let recorded =
             graspopt_coordinator::recorded_spec(&journal, run).map_err(RunnerError::agent)?;
         let Some(recorded) = recorded else {
-            let runs =
-                graspopt_coordinator::recorded_runs(&journal).map_err(RunnerError::agent)?;
+            let runs = graspopt_coordinator::recorded_runs(&journal).map_err(RunnerError::agent)?;
             let run = run.clone();
             if runs.is_empty() {
                 return Err(RunnerError::NotRecorded { run, journal });

@@ -19,18 +19,18 @@
 
 pub mod agent;
 pub mod alive;
-pub mod config;
 pub mod clouds;
+pub mod config;
 pub mod error;
 pub mod inbox;
 mod reach;
 pub mod session;
 mod task;
 
-pub use alive::{AliveEvent, AliveWatch, Claim};
 pub use agent::Agent;
-pub use config::{BusConfig, BusMode};
+pub use alive::{AliveEvent, AliveWatch, Claim};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
+pub use config::{BusConfig, BusMode};
 pub use error::BusError;
 pub use inbox::Inbox;
 pub use reach::{REACH_GRACE, REACH_REMINDER};

@@ -74,7 +74,8 @@ impl FromArgMatches for AgentArgs {
             AgentKind::Coordinator => Some(SpecArgs::from_arg_matches(sub)?),
             _ => None,
         };
-        let given = |id: &&clap::Id| sub.value_source(id.as_str()) == Some(ValueSource::CommandLine);
+        let given =
+            |id: &&clap::Id| sub.value_source(id.as_str()) == Some(ValueSource::CommandLine);
         Ok(AgentArgs {
             kind,
             common: Common::from_arg_matches(sub)?,

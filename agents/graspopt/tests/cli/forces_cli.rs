@@ -139,6 +139,9 @@ fn a_hand_without_spherical_fingertips_cannot_sense_forces() {
     let o = graspopt(&["agent", "hand", "--set", "sensing=sonar"]);
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("--set sensing=sonar: unknown variant `sonar`"), "{err}");
+    assert!(
+        err.contains("--set sensing=sonar: unknown variant `sonar`"),
+        "{err}"
+    );
     assert!(err.contains("clouds") && err.contains("ft"), "{err}");
 }
