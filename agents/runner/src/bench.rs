@@ -29,6 +29,12 @@ use crate::{Embedded, RunSettings, placeholder, run_embedded};
 
 type Result<T> = std::result::Result<T, BenchError>;
 
+impl From<RunnerError> for BenchError {
+    fn from(e: RunnerError) -> Self {
+        BenchError::Runner(Box::new(e))
+    }
+}
+
 /// Why a benchmark could not measure.
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
@@ -44,7 +50,7 @@ pub enum BenchError {
     #[error("{0}")]
     Changed(&'static str),
     #[error(transparent)]
-    Runner(#[from] RunnerError),
+    Runner(Box<RunnerError>),
     #[error(transparent)]
     Bus(#[from] graspopt_bus::BusError),
     #[error(transparent)]
