@@ -91,7 +91,7 @@ pub const AGENTS: [AgentRow; 5] = [
     row::<CoordinatorAgent>(|s| Box::pin(coordinate(s))),
 ];
 
-/// The row of `kind`.
+/// The row of `kind` (every kind has one: a test checks).
 pub fn agent_row(kind: AgentKind) -> &'static AgentRow {
     AGENTS.iter().find(|r| r.kind == kind).unwrap_or(&AGENTS[0])
 }

@@ -82,15 +82,16 @@ fn apply_set<T: DeserializeOwned>(
             return Err(refused(format!("{} is not a table", path[..i].join("."))));
         };
         let Some(inner) = keys.get(*part) else {
-            let names: Vec<&str> = keys.keys().map(String::as_str).collect();
-            let place = match i {
-                0 => "at the top level".to_string(),
-                _ => format!("in [{}]", path[..i].join(".")),
+            let unknown = RunnerError::UnknownKey {
+                key: part.to_string(),
+                place: place(&path[..i].join(".")),
+                keys: keys
+                    .keys()
+                    .map(String::as_str)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             };
-            return Err(refused(format!(
-                "unknown key `{part}` {place}; the keys there are {}",
-                names.join(", ")
-            )));
+            return Err(refused(unknown.to_string()));
         };
         table = inner;
     }
@@ -147,6 +148,15 @@ fn relative_to<T: DeserializeOwned + Serialize>(
     serde_json::from_value(value)
 }
 
+/// Where a key is, in a message: at the top level, or in the table at `path` (dotted).
+fn place(path: &str) -> String {
+    if path.is_empty() {
+        "at the top level".to_string()
+    } else {
+        format!("in [{path}]")
+    }
+}
+
 /// The first key of `table` (at `path`, a dotted table name, empty at the top) that
 /// `known` (the settings' defaults as JSON) does not have, naming the keys there; tables
 /// are checked recursively where the default is a table too.
@@ -157,14 +167,9 @@ fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Op
     for (key, value) in table {
         let Some(default) = keys.get(key) else {
             let names: Vec<&str> = keys.keys().map(String::as_str).collect();
-            let place = if path.is_empty() {
-                "at the top level".to_string()
-            } else {
-                format!("in [{path}]")
-            };
             return Some(RunnerError::UnknownKey {
                 key: key.clone(),
-                place,
+                place: place(path),
                 keys: names.join(", "),
             });
         };
