@@ -104,7 +104,7 @@ pub struct CoordinatorAgent {
 
 impl graspopt_bus::Agent for CoordinatorAgent {
     const KIND: graspopt_protocol::AgentKind = graspopt_protocol::AgentKind::Coordinator;
-    const ABOUT: &'static str = "Owns the run and its journal.";
+    const ABOUT: &'static str = "Owns the run and its journal";
     type Config = CoordinatorConfig;
     type Output = graspopt_protocol::RunStatus;
     type Error = CoordinatorAgentError;

@@ -157,7 +157,7 @@ pub struct HandAgent;
 
 impl Agent for HandAgent {
     const KIND: AgentKind = AgentKind::Hand;
-    const ABOUT: &'static str = "Executes trials on the simulated hand.";
+    const ABOUT: &'static str = "Executes trials on the simulated hand";
     type Config = HandConfig;
     type Output = ();
     type Error = HandAgentError;

@@ -440,7 +440,7 @@ pub struct MetricAgent;
 
 impl Agent for MetricAgent {
     const KIND: AgentKind = AgentKind::Metric;
-    const ABOUT: &'static str = "Scores contact clouds and fingertip force readings.";
+    const ABOUT: &'static str = "Scores contact clouds and fingertip force readings";
     type Config = MetricConfig;
     type Output = ();
     type Error = MetricError;

@@ -160,7 +160,7 @@ pub struct PerceptionAgent;
 
 impl Agent for PerceptionAgent {
     const KIND: AgentKind = AgentKind::Perception;
-    const ABOUT: &'static str = "Publishes the object estimate.";
+    const ABOUT: &'static str = "Publishes the object estimate";
     type Config = PerceptionConfig;
     type Output = ();
     type Error = PerceptionError;

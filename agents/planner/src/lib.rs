@@ -274,7 +274,7 @@ pub struct PlannerAgent;
 
 impl Agent for PlannerAgent {
     const KIND: AgentKind = AgentKind::Planner;
-    const ABOUT: &'static str = "Proposes trials.";
+    const ABOUT: &'static str = "Proposes trials";
     type Config = PlannerConfig;
     type Output = ();
     type Error = PlannerError;

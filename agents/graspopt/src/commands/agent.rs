@@ -51,11 +51,13 @@ pub struct Common {
 impl Args for AgentArgs {
     fn augment_args(cmd: Command) -> Command {
         let kinds = AGENTS.iter().map(|row| {
-            let sub = Common::augment_args(Command::new(row.kind.as_str()).about(row.about));
-            match row.kind {
+            let sub = Common::augment_args(Command::new(row.kind.as_str()));
+            let sub = match row.kind {
                 AgentKind::Coordinator => SpecArgs::augment_args(sub),
                 _ => sub,
-            }
+            };
+            // After the flags: a flattened struct's doc comment would be its description.
+            sub.about(row.about).long_about(None)
         });
         cmd.subcommands(kinds).subcommand_required(true)
     }
