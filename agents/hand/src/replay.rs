@@ -132,7 +132,7 @@ impl Recording {
                     &command, "check", None, reading,
                 )),
             }
-            .map_err(bad)?;
+            .map_err(|e| bad(e.to_string()))?;
             if t.params.iter().any(|v| !v.is_finite()) {
                 return Err(bad("a parameter is not finite".into()));
             }

@@ -403,7 +403,8 @@ impl Scorer<'_> {
             && a.run_id == *self.run
         {
             let id = &self.config.id;
-            let failed = invalid_measurement_result(a, what, detail, id, transport);
+            let detail = detail.to_string();
+            let failed = invalid_measurement_result(a, what, &detail, id, transport);
             if let Err(e) = self.bus.put(&self.key, &failed, Encoding::Bincode).await {
                 tracing::warn!(
                     "metric {id}: cannot publish the failure of trial {}: {e}",

@@ -612,7 +612,8 @@ pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<R
         check_finite(|| "metrics.bw".to_string(), m.bw)?;
     }
     if let Some(f) = &result.forces {
-        f.validate("forces").map_err(JournalError::Invalid)?;
+        f.validate("forces")
+            .map_err(|e| JournalError::Invalid(e.to_string()))?;
     }
     let Ok(id) = db_id(result.trial_id) else {
         return Ok(ResultOutcome::UnknownTrial);

@@ -12,6 +12,7 @@
 use serde_json::Value;
 
 use crate::WIRE_VERSION;
+pub use crate::error::{DecodeError, EncodeError};
 use crate::messages::Message;
 
 /// Largest payload accepted (64 MiB): a bound on what garbage can make a decoder allocate.
@@ -47,46 +48,6 @@ impl Encoding {
             _ => Encoding::Bincode,
         }
     }
-}
-
-/// Why a payload was refused.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum DecodeError {
-    #[error("empty {message_type} payload")]
-    Empty { message_type: &'static str },
-    #[error("{message_type} payload of {size} bytes is larger than the {MAX_PAYLOAD}-byte limit")]
-    TooLarge {
-        message_type: &'static str,
-        size: usize,
-    },
-    #[error("{message_type} has wire version {found}, this agent speaks version {expected}")]
-    WrongVersion {
-        message_type: &'static str,
-        found: u64,
-        expected: u16,
-    },
-    #[error("malformed {message_type} ({format}): {detail}")]
-    Malformed {
-        message_type: &'static str,
-        format: &'static str,
-        detail: String,
-    },
-    #[error("invalid {message_type}: {detail}")]
-    Invalid {
-        message_type: &'static str,
-        detail: String,
-        /// The attempt the message reports on, when it names one.
-        about: Option<Box<crate::messages::AttemptRef>>,
-    },
-}
-
-/// Encoding failed (a message that cannot be represented, e.g. a non-finite float in JSON).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("cannot encode {message_type} as {format}: {detail}")]
-pub struct EncodeError {
-    pub message_type: &'static str,
-    pub format: &'static str,
-    pub detail: String,
 }
 
 fn bincode_config() -> impl bincode::config::Config {
@@ -245,24 +206,18 @@ pub fn decode_topic(
     bytes: &[u8],
     encoding: Encoding,
 ) -> Result<Value, DecodeError> {
-    use crate::Topic;
-    use crate::messages::{
-        ContactClouds, FingertipWrenches, ObjectEstimate, RunStatus, TrialCommand, TrialResult,
-    };
-    fn json<T: Message>(bytes: &[u8], encoding: Encoding) -> Result<Value, DecodeError> {
-        let msg = decode::<T>(bytes, encoding)?;
-        serde_json::to_value(&msg).map_err(|e| DecodeError::Malformed {
-            message_type: T::TYPE,
-            format: "json",
-            detail: e.to_string(),
-        })
-    }
-    match topic {
-        Topic::Object => json::<ObjectEstimate>(bytes, encoding),
-        Topic::Command => json::<TrialCommand>(bytes, encoding),
-        Topic::Clouds => json::<ContactClouds>(bytes, encoding),
-        Topic::Wrenches => json::<FingertipWrenches>(bytes, encoding),
-        Topic::Result => json::<TrialResult>(bytes, encoding),
-        Topic::Status => json::<RunStatus>(bytes, encoding),
-    }
+    (topic.decode_json())(bytes, encoding)
+}
+
+/// Decodes (and validates) a `T`, as JSON: a topic's decoder for [`decode_topic`].
+pub(crate) fn decode_json<T: Message>(
+    bytes: &[u8],
+    encoding: Encoding,
+) -> Result<Value, DecodeError> {
+    let msg = decode::<T>(bytes, encoding)?;
+    serde_json::to_value(&msg).map_err(|e| DecodeError::Malformed {
+        message_type: T::TYPE,
+        format: "json",
+        detail: e.to_string(),
+    })
 }

@@ -28,6 +28,7 @@
 
 use crate::WIRE_VERSION;
 use crate::codec::{DecodeError, EncodeError, MAX_PAYLOAD};
+use crate::error::ValidationError;
 use crate::keys::RunId;
 use crate::messages::{CloudPoint, ContactClouds, FingerCloud, Message, Pose};
 use zerocopy::{FromBytes, IntoBytes};
@@ -260,8 +261,42 @@ impl<'a> Reader<'a> {
 }
 
 /// Reads and validates clouds written by [`write_clouds`]; the same checks, with the same
-/// messages, as [`crate::decode`] runs.
+/// messages, as [`crate::decode`] runs. In the layout's order: the fixed header, the finger
+/// table, the texts, the links, then the points.
 pub fn read_clouds(bytes: &[u8]) -> Result<ContactClouds, DecodeError> {
+    check_size(bytes)?;
+    let mut r = Reader { bytes, at: 0 };
+    let header = read_header(&mut r)?;
+    let shape = read_finger_table(&mut r, header.finger_count)?;
+    let [run_len, worker_len, hand_len, error_len] = header.lens;
+    let run_id = r.text(run_len, || "run_id".into())?;
+    let run_id = RunId::new(&run_id).map_err(|e| malformed(format!("run_id: {e}")))?;
+    let worker = r.text(worker_len, || "worker".into())?;
+    let hand = r.text(hand_len, || "hand".into())?;
+    let error = r.text(error_len, || "error".into())?;
+    let fingers = read_links(&mut r, &shape)?;
+    let points_at = points_start(&mut r, &shape)?;
+    let pose = header.pose;
+    let msg = ContactClouds {
+        run_id,
+        trial_id: header.trial_id,
+        attempt: header.attempt,
+        worker,
+        hand,
+        palm_pose: Pose {
+            translation: [pose[0], pose[1], pose[2]],
+            rotation: [pose[3], pose[4], pose[5], pose[6]],
+        },
+        fingers: Vec::new(),
+        min_gap: (header.flags & HAS_MIN_GAP != 0).then_some(header.min_gap),
+        error: (header.flags & HAS_ERROR != 0).then_some(error),
+        executed_ms: header.executed_ms,
+    };
+    read_points(msg, fingers, &shape, &bytes[points_at..])
+}
+
+/// A payload that is empty or over [`MAX_PAYLOAD`] is refused before it is read.
+fn check_size(bytes: &[u8]) -> Result<(), DecodeError> {
     let message_type = ContactClouds::TYPE;
     if bytes.is_empty() {
         return Err(DecodeError::Empty { message_type });
@@ -272,7 +307,24 @@ pub fn read_clouds(bytes: &[u8]) -> Result<ContactClouds, DecodeError> {
             size: bytes.len(),
         });
     }
-    let mut r = Reader { bytes, at: 0 };
+    Ok(())
+}
+
+/// The fixed part of the header, as read.
+struct Header {
+    flags: u16,
+    trial_id: u64,
+    attempt: u32,
+    finger_count: usize,
+    executed_ms: i64,
+    min_gap: f64,
+    pose: [f64; 7],
+    /// The byte lengths of run_id, worker, hand and error.
+    lens: [u32; 4],
+}
+
+/// Reads the fixed header, checking the magic, the wire version and the flags.
+fn read_header(r: &mut Reader) -> Result<Header, DecodeError> {
     let magic = r.array::<4>("magic")?;
     if magic != MAGIC {
         return Err(malformed(format!(
@@ -282,7 +334,7 @@ pub fn read_clouds(bytes: &[u8]) -> Result<ContactClouds, DecodeError> {
     let version = r.u16("wire version")?;
     if version != WIRE_VERSION {
         return Err(DecodeError::WrongVersion {
-            message_type,
+            message_type: ContactClouds::TYPE,
             found: u64::from(version),
             expected: WIRE_VERSION,
         });
@@ -305,7 +357,28 @@ pub fn read_clouds(bytes: &[u8]) -> Result<ContactClouds, DecodeError> {
     for (len, name) in lens.iter_mut().zip(names) {
         *len = r.u32(&format!("{name} length"))?;
     }
-    // Checked before anything is allocated for it.
+    Ok(Header {
+        flags,
+        trial_id,
+        attempt,
+        finger_count,
+        executed_ms,
+        min_gap,
+        pose,
+        lens,
+    })
+}
+
+/// One finger's entry of the finger table.
+struct FingerShape {
+    finger: Option<u32>,
+    links: usize,
+    points: usize,
+}
+
+/// Reads the finger table; its size is checked against the payload before anything is
+/// allocated for it.
+fn read_finger_table(r: &mut Reader, finger_count: usize) -> Result<Vec<FingerShape>, DecodeError> {
     let table = r.take(finger_count.saturating_mul(FINGER_ENTRY), || {
         format!("the finger table ({finger_count} fingers)")
     })?;
@@ -322,65 +395,70 @@ pub fn read_clouds(bytes: &[u8]) -> Result<ContactClouds, DecodeError> {
                 )));
             }
         };
-        shape.push((finger, word(8) as usize, word(12) as usize));
+        shape.push(FingerShape {
+            finger,
+            links: word(8) as usize,
+            points: word(12) as usize,
+        });
     }
-    let [run_len, worker_len, hand_len, error_len] = lens;
-    let run_id = r.text(run_len, || "run_id".into())?;
-    let run_id = RunId::new(&run_id).map_err(|e| malformed(format!("run_id: {e}")))?;
-    let worker = r.text(worker_len, || "worker".into())?;
-    let hand = r.text(hand_len, || "hand".into())?;
-    let error = r.text(error_len, || "error".into())?;
-    let mut fingers = Vec::with_capacity(finger_count);
-    for (f, &(finger, links, _)) in shape.iter().enumerate() {
+    Ok(shape)
+}
+
+/// Reads each finger's links: the fingers, without their points yet.
+fn read_links(r: &mut Reader, shape: &[FingerShape]) -> Result<Vec<FingerCloud>, DecodeError> {
+    let mut fingers = Vec::with_capacity(shape.len());
+    for (f, s) in shape.iter().enumerate() {
         // Each link takes at least 4 bytes: no more is reserved than the payload can hold,
         // and a count too large ends in a truncation error naming the link.
-        let mut names = Vec::with_capacity(links.min((bytes.len() - r.at) / 4));
-        for l in 0..links {
+        let mut names = Vec::with_capacity(s.links.min((r.bytes.len() - r.at) / 4));
+        for l in 0..s.links {
             let len = r.u32(&format!("fingers[{f}].links[{l}] length"))?;
             names.push(r.text(len, || format!("fingers[{f}].links[{l}]"))?);
         }
         fingers.push(FingerCloud {
-            finger,
+            finger: s.finger,
             links: names,
             points: Vec::new(),
         });
     }
+    Ok(fingers)
+}
+
+/// Skips the padding before the points and returns where they start, once the rest of the
+/// payload is exactly the points the finger table declares.
+fn points_start(r: &mut Reader, shape: &[FingerShape]) -> Result<usize, DecodeError> {
     let padding = r.at.next_multiple_of(8) - r.at;
     r.take(padding, || "padding before the points".into())?;
-    let points_len = bytes.len() - r.at;
-    let declared: usize = shape.iter().map(|&(_, _, n)| n).sum();
+    let points_len = r.bytes.len() - r.at;
+    let declared: usize = shape.iter().map(|s| s.points).sum();
     if declared.checked_mul(POINT_BYTES) != Some(points_len) {
         return Err(malformed(format!(
             "points: the finger table declares {declared} points ({} bytes), the payload has {points_len} bytes for them",
             declared.saturating_mul(POINT_BYTES)
         )));
     }
-    let mut msg = ContactClouds {
-        run_id,
-        trial_id,
-        attempt,
-        worker,
-        hand,
-        palm_pose: Pose {
-            translation: [pose[0], pose[1], pose[2]],
-            rotation: [pose[3], pose[4], pose[5], pose[6]],
-        },
-        fingers: Vec::new(),
-        min_gap: (flags & HAS_MIN_GAP != 0).then_some(min_gap),
-        error: (flags & HAS_ERROR != 0).then_some(error),
-        executed_ms,
-    };
-    let invalid = |msg: &ContactClouds, detail: String| DecodeError::Invalid {
-        message_type,
+    Ok(r.at)
+}
+
+/// Validates `msg`'s header, then reads each finger's points from `points` (every point of
+/// the payload, finger after finger) and checks them; `msg` with its fingers.
+fn read_points(
+    mut msg: ContactClouds,
+    mut fingers: Vec<FingerCloud>,
+    shape: &[FingerShape],
+    points: &[u8],
+) -> Result<ContactClouds, DecodeError> {
+    let invalid = |msg: &ContactClouds, detail: ValidationError| DecodeError::Invalid {
+        message_type: ContactClouds::TYPE,
         detail,
         about: msg.attempt_ref().map(Box::new),
     };
     if let Err(detail) = msg.validate_header() {
         return Err(invalid(&msg, detail));
     }
-    let mut at = r.at;
-    for (f, (finger, &(_, _, count))) in fingers.iter_mut().zip(&shape).enumerate() {
-        let block = &bytes[at..at + count * POINT_BYTES];
+    let mut at = 0;
+    for (f, (finger, s)) in fingers.iter_mut().zip(shape).enumerate() {
+        let block = &points[at..at + s.points * POINT_BYTES];
         at += block.len();
         // Copied first, then checked in one branch-free sweep; the error is formatted only
         // for the first point that fails (`graspopt bench clouds`: 88 µs to 43 µs for 10,000

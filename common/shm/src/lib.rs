@@ -108,9 +108,12 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFac
 /// iceoryx2 service variant whose ports may move between threads.
 type Ipc = ipc_threadsafe::Service;
 
+mod error;
 mod probe;
 mod subscriber;
 
+use error::service_err;
+pub use error::{Result, ShmError};
 pub use probe::{available, clean_stale, clean_stale_prefixes};
 pub use subscriber::ShmSubscriber;
 
@@ -154,58 +157,6 @@ const STALE_SCAN_INTERVAL: Duration = Duration::from_secs(1);
 /// How long [`clean_stale`] waits for another process that is already cleaning
 /// up the same dead node.
 const CLEANUP_WAIT: Duration = Duration::from_millis(200);
-
-/// Errors of this crate. Each names the service (or prefix) and the operation
-/// that failed.
-#[derive(Debug, thiserror::Error)]
-pub enum ShmError {
-    /// The [`ShmConfig`] cannot be used (bad prefix, zero capacity).
-    #[error("invalid shared-memory config: {0}")]
-    InvalidConfig(String),
-    /// The service name is not a valid iceoryx2 service name.
-    #[error("invalid shared-memory service name {service:?}: {reason}")]
-    InvalidServiceName {
-        /// The name that was refused.
-        service: String,
-        /// Why.
-        reason: String,
-    },
-    /// An operation on one service failed.
-    #[error("shared-memory service {service:?}: {operation} failed: {detail}")]
-    Service {
-        /// The service name.
-        service: String,
-        /// What was being done.
-        operation: &'static str,
-        /// The underlying error.
-        detail: String,
-    },
-    /// An operation over all services of a prefix failed.
-    #[error("shared memory (prefix {prefix:?}): {operation} failed: {detail}")]
-    Host {
-        /// The iceoryx2 prefix.
-        prefix: String,
-        /// What was being done.
-        operation: &'static str,
-        /// The underlying error.
-        detail: String,
-    },
-}
-
-/// Result type of this crate.
-pub type Result<T, E = ShmError> = std::result::Result<T, E>;
-
-/// Maps an iceoryx2 error to [`ShmError::Service`].
-fn service_err<'a, E: Display>(
-    service: &'a str,
-    operation: &'static str,
-) -> impl FnOnce(E) -> ShmError + 'a {
-    move |e| ShmError::Service {
-        service: service.to_owned(),
-        operation,
-        detail: e.to_string(),
-    }
-}
 
 /// Settings shared by every process that uses the same services: processes
 /// that open one service must agree on all of them except `delivery_timeout`.

@@ -1,30 +1,20 @@
 //! The key-expression scheme. Every key is `graspopt/<run>/...`:
 //!
-//! | key                                   | message            | published by        |
-//! |---------------------------------------|--------------------|---------------------|
-//! | `graspopt/<run>/object`               | [`ObjectEstimate`] | perception          |
-//! | `graspopt/<run>/hand/<worker>/command`| [`TrialCommand`]   | coordinator         |
-//! | `graspopt/<run>/clouds`               | [`ContactClouds`]  | hand                |
-//! | `graspopt/<run>/result`               | [`TrialResult`]    | metric              |
-//! | `graspopt/<run>/status`               | [`RunStatus`]      | coordinator         |
-//! | `graspopt/<run>/planner/suggest`      | [`SuggestRequest`] -> [`SuggestReply`] (query) | planner answers |
-//! | `graspopt/<run>/coordinator/state`    | [`RunStatus`] (query) | coordinator answers |
-//! | `graspopt/<run>/alive/<kind>/<host>/<id>[/json][/<topic>]` | liveliness token (`/json`: send me JSON; `/<topic>`: the topic it publishes, `clouds` or `wrenches` for a hand) | every agent |
+//! - a topic or a query per row of the key table ([`TABLE`]): `object`, `hand/<worker>/command`,
+//!   `clouds`, `wrenches`, `result`, `status`, `planner/suggest`, `coordinator/state`
+//!   (docs/protocol.md says who publishes each and what it carries);
+//! - `alive/<kind>/<host>/<id>[/json][/<topic>]`: an agent's liveliness token (`/json`: send
+//!   me JSON; `/<topic>`: the topic it publishes, `clouds` or `wrenches` for a hand);
+//! - `claim/<kind>/<slot>/<nonce>/<phase>`: an agent taking its place ([`claim_token`]).
 //!
-//! One table ([`TABLE`], in `table.rs`) binds each key to the type of its messages: a
-//! [`Key<M>`] comes only from its row ([`RESULT`]`.key(run)`), and the bus sends and awaits
-//! only `M`s on it. The liveliness and claim keys are built beside it. Nothing else writes a
-//! key chunk.
+//! The key table (`table.rs`) binds each key to the type of its messages: a [`Key<M>`] comes
+//! only from its row ([`RESULT`]`.key(run)`), and the bus sends and awaits only `M`s on it.
+//! Its topics are one list, the `topics!` invocation, from which each topic's key constant,
+//! its [`Topic`] and its decoder for [`crate::decode_topic`] follow; that list says how to
+//! add a topic. The liveliness and claim keys are built beside it. Nothing else writes a key
+//! chunk.
 //!
 //! Run ids, hosts and agent ids are single key chunks: ASCII letters, digits, `-`, `_` and `.`.
-//!
-//! [`ObjectEstimate`]: crate::ObjectEstimate
-//! [`TrialCommand`]: crate::TrialCommand
-//! [`ContactClouds`]: crate::ContactClouds
-//! [`TrialResult`]: crate::TrialResult
-//! [`RunStatus`]: crate::RunStatus
-//! [`SuggestRequest`]: crate::SuggestRequest
-//! [`SuggestReply`]: crate::SuggestReply
 
 use std::fmt;
 
@@ -38,15 +28,7 @@ pub use table::*;
 /// The first chunk of every key.
 pub const ROOT: &str = "graspopt";
 
-/// A key chunk that is not valid (empty, too long or with a character outside the allowed set).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "invalid {what} {value:?}: use 1 to 64 ASCII letters, digits, '-', '_' or '.' (not starting with '.')"
-)]
-pub struct KeyError {
-    pub what: &'static str,
-    pub value: String,
-}
+pub use crate::error::KeyError;
 
 fn check_chunk(what: &'static str, value: &str) -> Result<(), KeyError> {
     let ok = !value.is_empty()

@@ -4,6 +4,7 @@ use std::fmt;
 use std::marker::PhantomData;
 
 use super::{AgentKind, Claim, ROOT, RunId, check_agent_id};
+use crate::codec::{DecodeError, Encoding};
 use crate::messages::{
     ContactClouds, FingertipWrenches, Message, ObjectEstimate, RunStatus, SuggestReply,
     SuggestRequest, TrialCommand, TrialResult,
@@ -291,39 +292,119 @@ macro_rules! plain_keys {
 }
 plain_keys!(str, String);
 
-/// perception -> coordinator, hands, metric: the object estimate.
-pub const OBJECT: TopicDef<ObjectEstimate> =
-    TopicDef::new("object", "object", AgentKind::Perception);
-/// coordinator -> one hand: a trial to carry out.
-pub const COMMAND: TopicDef<TrialCommand> =
-    TopicDef::new("command", "hand/*/command", AgentKind::Coordinator);
-/// hand -> metric: the contact clouds of a trial (when not through shared memory).
-pub const CLOUDS: TopicDef<ContactClouds> = TopicDef::new("clouds", "clouds", AgentKind::Hand);
-/// hand -> metric: the fingertip force/torque readings of a trial (hands that sense forces).
-pub const WRENCHES: TopicDef<FingertipWrenches> =
-    TopicDef::new("wrenches", "wrenches", AgentKind::Hand);
-/// metric -> coordinator: a trial's score.
-pub const RESULT: TopicDef<TrialResult> = TopicDef::new("result", "result", AgentKind::Metric);
-/// coordinator -> monitors: the run's state.
-pub const STATUS: TopicDef<RunStatus> = TopicDef::new("status", "status", AgentKind::Coordinator);
+/// Declares the topics from one row each: the row's `TopicDef` constant, its [`Topic`]
+/// variant, [`Topic::ALL`], [`Topic::entry`], the topic rows of [`TABLE`] and the decoder
+/// that [`crate::decode_topic`] runs. The rows, and how to add one, are below.
+macro_rules! topics {
+    (
+        topics {
+            $(
+                $(#[$doc:meta])*
+                $def:ident: $variant:ident = $place:literal
+                    => $message:ident, $name:literal, $path:literal, $by:ident;
+            )+
+        }
+        queries { $($query:ident),+ $(,)? }
+    ) => {
+        $(
+            $(#[$doc])*
+            pub const $def: TopicDef<$message> = TopicDef::new($name, $path, AgentKind::$by);
+        )+
+
+        /// The key table: every topic, then every query (their rows are the `topics!`
+        /// invocation in `keys/table.rs`, which says how to add one).
+        pub const TABLE: [Entry; TOPIC_COUNT + [$(stringify!($query)),+].len()] =
+            [$($def.entry,)+ $($query.entry,)+];
+
+        const TOPIC_COUNT: usize = [$(stringify!($def)),+].len();
+
+        /// The published topics, for tools that list and decode them: the topic rows of
+        /// [`TABLE`].
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Topic {
+            $(
+                #[doc = concat!("`", $name, "`: [`", stringify!($def), "`].")]
+                $variant = $place,
+            )+
+        }
+
+        impl Topic {
+            /// Every topic, each at its place (the number in its row): a new topic takes the
+            /// next place, so the others keep theirs (fuzz seeds name topics by place).
+            pub const ALL: [Topic; TOPIC_COUNT] = places([$(Topic::$variant),+]);
+
+            /// Its row of the table.
+            pub const fn entry(self) -> Entry {
+                match self {
+                    $(Topic::$variant => $def.entry,)+
+                }
+            }
+
+            /// Decodes (and validates) a message of this topic, as JSON.
+            pub(crate) fn decode_json(self) -> DecodeJson {
+                match self {
+                    $(Topic::$variant => crate::codec::decode_json::<$message>,)+
+                }
+            }
+        }
+    };
+}
+
+/// How a topic's messages are decoded for display ([`crate::decode_topic`]).
+type DecodeJson = fn(&[u8], Encoding) -> Result<serde_json::Value, DecodeError>;
+
+/// The topics in the order of their places; fails the build unless the places are 0, 1, ...
+/// each taken once.
+const fn places(rows: [Topic; TOPIC_COUNT]) -> [Topic; TOPIC_COUNT] {
+    let mut all = rows;
+    let mut i = 0;
+    while i < rows.len() {
+        all[rows[i] as usize] = rows[i];
+        i += 1;
+    }
+    let mut place = 0;
+    while place < all.len() {
+        assert!(all[place] as usize == place, "two topics take one place");
+        place += 1;
+    }
+    all
+}
+
+// The key table. A topic's row: `CONSTANT: Variant = place => Message, "name", "path",
+// publisher`.
+//
+// To add a topic: (1) write its message (a struct that implements `Message`, in the
+// `messages` module of its concept); (2) add its row to `topics` here, with the next
+// place; (3) add its row to the key table of docs/protocol.md (a test compares the two).
+// Its key constant, `Topic` variant, place in `Topic::ALL`, row of `TABLE` and decoder for
+// `graspopt topic echo` follow from the row. (Tests that must cover every topic fail until
+// they do: the e2e fuzz test wants a stream of malformed messages for it.)
+//
+// A query is a `QueryDef` constant below, named in `queries`.
+topics! {
+    topics {
+        /// perception -> coordinator, hands, metric: the object estimate.
+        OBJECT: Object = 0 => ObjectEstimate, "object", "object", Perception;
+        /// coordinator -> one hand: a trial to carry out.
+        COMMAND: Command = 1 => TrialCommand, "command", "hand/*/command", Coordinator;
+        /// hand -> metric: the contact clouds of a trial (when not through shared memory).
+        CLOUDS: Clouds = 2 => ContactClouds, "clouds", "clouds", Hand;
+        /// hand -> metric: the fingertip force/torque readings of a trial (hands that sense forces).
+        WRENCHES: Wrenches = 5 => FingertipWrenches, "wrenches", "wrenches", Hand;
+        /// metric -> coordinator: a trial's score.
+        RESULT: Result = 3 => TrialResult, "result", "result", Metric;
+        /// coordinator -> monitors: the run's state.
+        STATUS: Status = 4 => RunStatus, "status", "status", Coordinator;
+    }
+    queries { SUGGEST, STATE }
+}
+
 /// coordinator asks the planner for points.
 pub const SUGGEST: QueryDef<SuggestRequest, SuggestReply> =
     QueryDef::new("suggest", "planner/suggest", AgentKind::Planner);
 /// anyone asks the coordinator for the run's state.
 pub const STATE: QueryDef<(), RunStatus> =
     QueryDef::without_request("state", "coordinator/state", AgentKind::Coordinator);
-
-/// The key table: every topic, then every query.
-pub const TABLE: [Entry; 8] = [
-    OBJECT.entry,
-    COMMAND.entry,
-    CLOUDS.entry,
-    WRENCHES.entry,
-    RESULT.entry,
-    STATUS.entry,
-    SUGGEST.entry,
-    STATE.entry,
-];
 
 /// `graspopt/<run>/alive/<kind>/<host>/<id>`: an agent's liveliness token; with the topic
 /// it publishes when it says (`.../<id>/wrenches`: see [`AliveKey::publishes`]).
@@ -396,40 +477,7 @@ pub fn shm_probe_service() -> String {
     format!("{ROOT}/shm-probe")
 }
 
-/// The published topics, for tools that list and decode them: the topic rows of [`TABLE`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Topic {
-    Object,
-    Command,
-    Clouds,
-    Wrenches,
-    Result,
-    Status,
-}
-
 impl Topic {
-    /// Every topic (`Wrenches`, added last, keeps the others' positions).
-    pub const ALL: [Topic; 6] = [
-        Topic::Object,
-        Topic::Command,
-        Topic::Clouds,
-        Topic::Result,
-        Topic::Status,
-        Topic::Wrenches,
-    ];
-
-    /// Its row of the table.
-    pub const fn entry(self) -> Entry {
-        match self {
-            Topic::Object => OBJECT.entry,
-            Topic::Command => COMMAND.entry,
-            Topic::Clouds => CLOUDS.entry,
-            Topic::Wrenches => WRENCHES.entry,
-            Topic::Result => RESULT.entry,
-            Topic::Status => STATUS.entry,
-        }
-    }
-
     /// The message type carried.
     pub fn message_type(self) -> &'static str {
         self.entry().message

@@ -270,3 +270,23 @@ fn sanitize_makes_valid_chunks() {
     }
     assert_eq!(sanitize_chunk("a b/c"), "a_b_c");
 }
+
+/// Fuzz seeds name a topic by its place in `Topic::ALL` (fuzz/examples/gen_seeds.rs): the
+/// places of the topics there never move, and a topic's row says its place.
+#[test]
+fn topics_keep_their_places() {
+    assert_eq!(
+        Topic::ALL,
+        [
+            Topic::Object,
+            Topic::Command,
+            Topic::Clouds,
+            Topic::Result,
+            Topic::Status,
+            Topic::Wrenches
+        ]
+    );
+    for (place, topic) in Topic::ALL.into_iter().enumerate() {
+        assert_eq!(topic as usize, place);
+    }
+}

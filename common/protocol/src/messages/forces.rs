@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::finite;
+use crate::error::{Problem, ValidationError};
 
 /// The contact-force analysis of a trial (the thesis's "contact force analysis"), reported
 /// beside its metrics. Wrenches are `[fx, fy, fz, tx, ty, tz]` in newtons and newton-metres,
@@ -86,9 +87,23 @@ impl ForceAnalysis {
         text
     }
 
-    /// Checks that every number is finite and the norms are >= 0; the error names the field.
-    pub fn validate(&self, field: &str) -> Result<(), String> {
-        finite(&format!("{field}.external"), &self.external)?;
+    /// Checks that every number is finite and the norms are >= 0; the error names the field
+    /// (`field` of a `ForceAnalysis`).
+    pub fn validate(&self, field: &str) -> Result<(), ValidationError> {
+        self.validate_in("ForceAnalysis", field)
+    }
+
+    /// [`ForceAnalysis::validate`] for the analysis at `field` of a message of type
+    /// `message_type`.
+    pub(crate) fn validate_in(
+        &self,
+        message_type: &'static str,
+        field: &str,
+    ) -> Result<(), ValidationError> {
+        let invalid = |name: &str, problem| {
+            ValidationError::new(message_type, format!("{field}.{name}"), problem)
+        };
+        finite(message_type, &format!("{field}.external"), &self.external)?;
         for (name, v) in [
             ("resisting_norm", self.resisting_norm),
             ("resisting_max", self.resisting_max),
@@ -96,18 +111,25 @@ impl ForceAnalysis {
             if let Some(v) = v
                 && !(v.is_finite() && v >= 0.0)
             {
-                return Err(format!("{field}.{name} must be finite and >= 0, got {v}"));
+                let problem = Problem::OutOfRange {
+                    requirement: "finite and >= 0",
+                    value: v,
+                };
+                return Err(invalid(name, problem));
             }
         }
         if let Some(w) = &self.net_wrench {
-            finite(&format!("{field}.net_wrench"), w)?;
+            finite(message_type, &format!("{field}.net_wrench"), w)?;
         }
         if self.unavailable.is_some() && self.resisting_norm.is_some() {
-            return Err(format!(
-                "{field}.unavailable says the least forces are unknown, yet {field}.resisting_norm is set"
-            ));
+            let problem = Problem::Contradicts(format!("{field}.resisting_norm"));
+            return Err(invalid("unavailable", problem));
         }
-        finite(&format!("{field}.slip_margins"), &self.slip_margins)
+        finite(
+            message_type,
+            &format!("{field}.slip_margins"),
+            &self.slip_margins,
+        )
     }
 }
 
