@@ -88,7 +88,13 @@ fn one_worker_gives_the_same_trials_embedded_multi_process_and_over_either_cloud
     let journal = c.journal();
     let _perception = c.agent(
         "perception",
-        &["perception", "--object", "mug", "--seed", SEED],
+        &[
+            "perception",
+            "--set",
+            "object=mug",
+            "--set",
+            &format!("seed={SEED}"),
+        ],
     );
     let _planner = c.agent("planner", &["planner"]);
     let _metric = c.agent("metric", &["metric"]);

@@ -44,8 +44,8 @@ fn a_trial_survives_its_killed_worker() {
     let c = Cluster::start("killed", "killed");
     let journal = c.journal();
     let _support = c.support("cuboid");
-    let mut hands = c.hands(2, &["--trial-cost-ms", "400"]);
-    let coordinator = c.coordinator("cuboid", "8", "3", &["--lease-ms", "120000"]);
+    let mut hands = c.hands(2, &["--set", "trial_cost_ms=400"]);
+    let coordinator = c.coordinator("cuboid", "8", "3", &["--set", "lease_ms=120000"]);
     // hand-1 has completed a trial and holds another one: kill it.
     wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
         t.worker == "hand-1" && t.state == TrialState::Completed
@@ -89,8 +89,8 @@ fn a_hung_worker_loses_its_trial_when_the_lease_expires() {
     let c = Cluster::start("hung", "hung");
     let journal = c.journal();
     let _support = c.support("sphere");
-    let hands = c.hands(2, &["--trial-cost-ms", "300"]);
-    let coordinator = c.coordinator("sphere", "14", "1", &["--lease-ms", "1500"]);
+    let hands = c.hands(2, &["--set", "trial_cost_ms=300"]);
+    let coordinator = c.coordinator("sphere", "14", "1", &["--set", "lease_ms=1500"]);
     let held = wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
         t.worker == "hand-1" && t.state == TrialState::Running
     });
@@ -159,7 +159,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
     let c = Cluster::start("badinput", "bad");
     let journal = c.journal();
     let _support = c.support("cylinder");
-    let _hands = c.hands(2, &["--trial-cost-ms", "300"]);
+    let _hands = c.hands(2, &["--set", "trial_cost_ms=300"]);
     let coordinator = c.coordinator("cylinder", "10", "6", &[]);
     let run = RunId::new("bad").unwrap();
     let runtime = tokio::runtime::Runtime::new().unwrap();
@@ -324,7 +324,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
 #[ignore = "slow suite: .ci/run runs it (tests/e2e/main.rs)"]
 fn trials_wait_for_a_metric_agent() {
     let c = Cluster::start("latemetric", "late");
-    let _perception = c.agent("perception", &["perception", "--object", "cuboid"]);
+    let _perception = c.agent("perception", &["perception", "--set", "object=cuboid"]);
     let _planner = c.agent("planner", &["planner"]);
     let _hands = c.hands(1, &[]);
     let coordinator = c.coordinator("cuboid", "6", "2", &[]);

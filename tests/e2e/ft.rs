@@ -1,5 +1,5 @@
 //! Hands with force/torque sensors in their fingertips (issue 20): the simulated one
-//! (`agent hand --hand barrett_ft --sensing ft`), the replay hand and the Python hand
+//! (`agent hand --set hand=barrett_ft --set sensing=ft`), the replay hand and the Python hand
 //! (`examples/python/ft_hand_agent.py`) answering from a recording of fingertip readings
 //! (`graspopt record --sensing ft`), and bad readings. Each run's scores are checked against
 //! the score of the same trial's true contacts, recomputed here with the libraries.
@@ -103,7 +103,15 @@ fn a_run_with_a_force_sensing_hand_scores_like_its_true_contacts() {
     let c = Cluster::start("ftsim", "ftsim");
     let hand = c.agent(
         "ft-hand",
-        &["hand", "--id", "ft-hand", "--hand", HAND, "--sensing", "ft"],
+        &[
+            "hand",
+            "--id",
+            "ft-hand",
+            "--set",
+            &format!("hand={HAND}"),
+            "--set",
+            "sensing=ft",
+        ],
     );
     let rows = optimize_with(&c, hand, "ft-hand", 30);
     let ev = evaluator();
@@ -229,7 +237,7 @@ pub(crate) fn check_replayed(rows: &[TrialRow], grasps: &[Recorded]) -> (f64, f6
     largest_differences(&pairs)
 }
 
-/// `agent hand --replay` of a recording of fingertip readings sends them as
+/// `agent hand --set replay=FILE` of a recording of fingertip readings sends them as
 /// `FingertipWrenches`: the metric agent scores them as recorded. A recording with a bad
 /// reading is refused by file and line.
 #[test]
@@ -242,8 +250,8 @@ fn replay_hand_answers_with_recorded_fingertip_readings() {
             "hand",
             "--id",
             "replay-ft-hand",
-            "--replay",
-            rec.to_str().unwrap(),
+            "--set",
+            &format!("replay={}", rec.display()),
         ],
     );
     let rows = optimize_with(&c, hand, "replay-ft-hand", 10);
@@ -266,8 +274,8 @@ fn replay_hand_answers_with_recorded_fingertip_readings() {
     let o = graspopt(&[
         "agent",
         "hand",
-        "--replay",
-        bad.to_str().unwrap(),
+        "--set",
+        &format!("replay={}", bad.display()),
         "--connect",
         &c.endpoint,
         "--no-multicast-scouting",
@@ -393,7 +401,14 @@ fn bad_fingertip_readings_fail_their_trial_and_the_run_goes_on() {
         OBJECT,
         "6",
         "2",
-        &["--hand", HAND, "--method", "random", "--lease-ms", "60000"],
+        &[
+            "--hand",
+            HAND,
+            "--method",
+            "random",
+            "--set",
+            "lease_ms=60000",
+        ],
     );
     let started = Instant::now();
     let status = c.final_status(coordinator, Duration::from_secs(60));

@@ -395,7 +395,7 @@ fn run(name: &str, fuzz: bool) -> (Vec<TrialRow>, serde_json::Value, Option<(Clu
     let c = Cluster::start(name, RUN);
     let mut agents = c.support("sphere");
     // Slow enough trials that the run outlasts the noise.
-    agents.extend(c.hands(1, &["--trial-cost-ms", "900"]));
+    agents.extend(c.hands(1, &["--set", "trial_cost_ms=900"]));
     let coordinator = c.coordinator("sphere", &TRIALS.to_string(), SEED, &[]);
     let sent = fuzz.then(|| send_noise(&c));
     if sent.is_some() {

@@ -150,10 +150,14 @@ impl Hand {
         hand
     }
 
-    /// The flags of a simulated hand agent: `--hand`, and what it senses.
+    /// The settings of a simulated hand agent: its hand, and what it senses (`--sensing ft`
+    /// becomes `--set sensing=ft`).
     fn agent_flags(&self) -> Vec<String> {
-        let mut v = vec!["--hand".to_string(), self.hand.clone()];
-        v.extend(self.sensing.iter().map(|s| s.to_string()));
+        let mut v = vec!["--set".to_string(), format!("hand={}", self.hand)];
+        for pair in self.sensing.chunks(2) {
+            let key = pair[0].trim_start_matches("--");
+            v.extend(["--set".to_string(), format!("{key}={}", pair[1])]);
+        }
         v
     }
 
@@ -298,7 +302,7 @@ fn launch(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
     };
     let mut file = format!(
         "run = {run:?}\nendpoint = {endpoint:?}\n\n[router]\n\n\
-         [[agent]]\nkind = \"perception\"\nargs = [\"--object\", {:?}]\n\n\
+         [[agent]]\nkind = \"perception\"\nargs = [\"--set\", \"object={}\"]\n\n\
          [[agent]]\nkind = \"planner\"\n\n[[agent]]\nkind = \"metric\"\n\n",
         hand.object
     );
@@ -309,7 +313,10 @@ fn launch(hand: &Hand, dir: &Path, run: &str) -> PathBuf {
         );
     }
     let mut coordinator = run_flags(hand);
-    coordinator.extend(["--journal".into(), format!("results/{run}/journal.sqlite")]);
+    coordinator.extend([
+        "--set".into(),
+        format!("journal=results/{run}/journal.sqlite"),
+    ]);
     file += &format!(
         "[[agent]]\nkind = \"coordinator\"\nargs = [{}]\n",
         quoted(&coordinator)
@@ -364,7 +371,7 @@ fn processes(hand: &Hand, c: &Cluster, secure_roles: bool) -> PathBuf {
     let _support = [
         agent(
             "perception",
-            &["perception", "--object", hand.object],
+            &["perception", "--set", &format!("object={}", hand.object)],
             "perception",
         ),
         agent("planner", &["planner"], "planner"),

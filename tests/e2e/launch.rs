@@ -81,17 +81,17 @@ endpoint = "tcp/127.0.0.1:{port}"
 [router]
 [[agent]]
 kind = "perception"
-args = ["--object", "cylinder"]
+args = ["--set", "object=cylinder"]
 [[agent]]
 kind = "planner"
 [[agent]]
 kind = "metric"
 [[agent]]
 kind = "hand"
-args = ["--trial-cost-ms", "100"]
+args = ["--set", "trial_cost_ms=100"]
 [[agent]]
 kind = "coordinator"
-args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--journal", "results/lr/journal.sqlite"]
+args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--set", "journal=results/lr/journal.sqlite"]
 "#
         ),
     )

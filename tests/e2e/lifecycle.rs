@@ -216,7 +216,7 @@ fn a_second_hand_with_an_id_in_use_and_a_second_coordinator_are_refused() {
     let _support = c.support("mug");
     // Long enough (30 trials of 500 ms) for the refusals, which wait 5 s for the holder
     // to vanish, to happen while the run goes on.
-    let _hands = c.hands(1, &["--trial-cost-ms", "500"]);
+    let _hands = c.hands(1, &["--set", "trial_cost_ms=500"]);
     let coordinator = c.coordinator("mug", "30", "1", &[]);
     let journal = c.journal();
     wait_until("a first trial", Duration::from_secs(60), || {

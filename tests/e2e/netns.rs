@@ -311,9 +311,10 @@ fn a_run_across_three_network_namespaces_survives_a_router_restart() {
         ]);
         net.start(ns, id, &v, &dir)
     };
-    let hand = |ns: &str, m: &str, id: &str| agent(ns, m, id, &["hand", "--trial-cost-ms", "250"]);
+    let hand =
+        |ns: &str, m: &str, id: &str| agent(ns, m, id, &["hand", "--set", "trial_cost_ms=250"]);
     let _agents = [
-        agent(a, "a", "perception", &["perception", "--object", "mug"]),
+        agent(a, "a", "perception", &["perception", "--set", "object=mug"]),
         agent(a, "a", "planner", &["planner"]),
         hand(a, "a", "a-1"),
         agent(b, "b", "metric", &["metric"]),
@@ -339,10 +340,10 @@ fn a_run_across_three_network_namespaces_survives_a_router_restart() {
             "4",
             "--method",
             "random",
-            "--journal",
-            journal_arg,
-            "--lease-ms",
-            "60000",
+            "--set",
+            &format!("journal={journal_arg}"),
+            "--set",
+            "lease_ms=60000",
         ],
     );
     let on_c = |w: &str| w.starts_with("c-");

@@ -73,9 +73,9 @@ fn a_coordinator_killed_three_times_loses_nothing() {
     let c = Cluster::start("coordkill", "ck");
     let journal = c.journal();
     let _support = c.support("sphere");
-    let _hands = c.hands(2, &["--trial-cost-ms", "150"]);
+    let _hands = c.hands(2, &["--set", "trial_cost_ms=150"]);
     let (n, seed) = ("24", "5");
-    let flags = ["--lease-ms", "20000"];
+    let flags = ["--set", "lease_ms=20000"];
     let mut coordinator = c.coordinator("sphere", n, seed, &flags);
     let mut kept = BTreeMap::new();
     for k in 1..=3 {
@@ -115,8 +115,8 @@ fn the_journal_survives_kill_9_at_any_point() {
     let c = Cluster::start("journalkill", "jk");
     let journal = c.journal();
     let _support = c.support("cuboid");
-    let _hands = c.hands(2, &["--trial-cost-ms", "250"]);
-    let flags = ["--lease-ms", "20000", "--resume", "--method", "random"];
+    let _hands = c.hands(2, &["--set", "trial_cost_ms=250"]);
+    let flags = ["--set", "lease_ms=20000", "--resume", "--method", "random"];
     let mut kept = BTreeMap::new();
     // Delays after each start, scattered: the first kill likely before the journal exists
     // (a coordinator first checks for about 1.7 s that no other one holds the run), the
@@ -159,11 +159,11 @@ fn the_journal_survives_kill_9_at_any_point() {
 fn metric_and_planner_restarts_stall_the_run_only_while_they_are_away() {
     let c = Cluster::start("restarts", "rs");
     let journal = c.journal();
-    let _perception = c.agent("perception", &["perception", "--object", "mug"]);
+    let _perception = c.agent("perception", &["perception", "--set", "object=mug"]);
     let mut planner = c.agent("planner", &["planner"]);
     let mut metric = c.agent("metric", &["metric"]);
-    let _hands = c.hands(2, &["--trial-cost-ms", "200"]);
-    let coordinator = c.coordinator("mug", "20", "8", &["--lease-ms", "60000"]);
+    let _hands = c.hands(2, &["--set", "trial_cost_ms=200"]);
+    let coordinator = c.coordinator("mug", "20", "8", &["--set", "lease_ms=60000"]);
 
     wait_until("4 trials", Duration::from_secs(90), || {
         completed_now(&journal, "rs") >= 4
@@ -256,11 +256,14 @@ fn the_run_survives_a_router_restart() {
     // Clients, and clouds over Zenoh as well: every message goes through the router.
     let client = ["--mode", "client", "--no-shm"];
     let with = |args: &[&'static str]| [args, &client[..]].concat();
-    let _perception = c.agent("perception", &with(&["perception", "--object", "cylinder"]));
+    let _perception = c.agent(
+        "perception",
+        &with(&["perception", "--set", "object=cylinder"]),
+    );
     let _planner = c.agent("planner", &with(&["planner"]));
     let _metric = c.agent("metric", &with(&["metric"]));
-    let _hands = c.hands(2, &with(&["--trial-cost-ms", "200"]));
-    let coordinator = c.coordinator("cylinder", "16", "2", &with(&["--lease-ms", "8000"]));
+    let _hands = c.hands(2, &with(&["--set", "trial_cost_ms=200"]));
+    let coordinator = c.coordinator("cylinder", "16", "2", &with(&["--set", "lease_ms=8000"]));
     // Cut while a worker holds a trial (between trials both may be waiting for proposals).
     wait_until("4 trials, and one running", Duration::from_secs(90), || {
         completed_now(&journal, "rr") >= 4 && running_now(&journal, "rr") >= 1
@@ -364,7 +367,7 @@ fn degenerate_contacts_never_leave_a_trial_stuck() {
         "sphere",
         "12",
         "1",
-        &["--lease-ms", "60000", "--method", "random"],
+        &["--set", "lease_ms=60000", "--method", "random"],
     );
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let started = Instant::now();

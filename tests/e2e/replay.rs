@@ -1,4 +1,4 @@
-//! Hands that answer from recorded contact data: `graspopt agent hand --replay` and the
+//! Hands that answer from recorded contact data: `graspopt agent hand --set replay=FILE` and the
 //! Python hand agent (`examples/python/hand_agent.py`, JSON on the wire). A recording of a
 //! grid of grasps is made with `graspopt record`; an optimization then runs with the replaying
 //! hand as its only worker, and every trial's score must be the recorded score of the grasp
@@ -116,8 +116,8 @@ fn replay_hand_answers_trials_from_a_recording() {
             "hand",
             "--id",
             "replay-hand",
-            "--replay",
-            rec.to_str().unwrap(),
+            "--set",
+            &format!("replay={}", rec.display()),
         ],
     );
     optimize_with(&c, hand, "replay-hand", &grasps);
@@ -127,8 +127,8 @@ fn replay_hand_answers_trials_from_a_recording() {
     let o = graspopt(&[
         "agent",
         "hand",
-        "--replay",
-        bad.to_str().unwrap(),
+        "--set",
+        &format!("replay={}", bad.display()),
         "--connect",
         &c.endpoint,
         "--no-multicast-scouting",
@@ -301,7 +301,13 @@ fn a_coordinator_whose_every_trial_failed_says_why_and_exits_3() {
     let (rec, _) = record(&c.dir);
     let _hand = c.agent(
         "replay-hand",
-        &["hand", "--id", "hand-1", "--replay", rec.to_str().unwrap()],
+        &[
+            "hand",
+            "--id",
+            "hand-1",
+            "--set",
+            &format!("replay={}", rec.display()),
+        ],
     );
     let _support = c.support("cuboid");
     let coordinator = c.coordinator("cuboid", "6", "0", &["--params", "x,y,rz"]);

@@ -65,14 +65,14 @@ fn only_authenticated_agents_in_their_roles_reach_the_journal() {
     let _perception = agent(
         "perception",
         "perception",
-        &["perception", "--object", "cuboid"],
+        &["perception", "--set", "object=cuboid"],
     );
     let _planner = agent("planner", "planner", &["planner"]);
     let _metric = agent("metric", "metric", &["metric"]);
     let _hand = agent(
         "hand-1",
         "hand",
-        &["hand", "--id", "hand-1", "--trial-cost-ms", "300"],
+        &["hand", "--id", "hand-1", "--set", "trial_cost_ms=300"],
     );
     let config = role("coordinator");
     let coordinator = c.coordinator(

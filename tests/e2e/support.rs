@@ -214,7 +214,10 @@ impl Cluster {
     /// every run needs besides its hands and coordinator.
     pub fn support(&self, object: &str) -> Vec<Proc> {
         vec![
-            self.agent("perception", &["perception", "--object", object]),
+            self.agent(
+                "perception",
+                &["perception", "--set", &format!("object={object}")],
+            ),
             self.agent("planner", &["planner"]),
             self.agent("metric", &["metric"]),
         ]
@@ -252,7 +255,7 @@ impl Cluster {
         seed: &str,
         extra: &[&str],
     ) -> Proc {
-        let journal = self.journal();
+        let journal = format!("journal={}", self.journal().display());
         let mut args = vec![
             "coordinator",
             "--object",
@@ -261,8 +264,8 @@ impl Cluster {
             trials,
             "--seed",
             seed,
-            "--journal",
-            journal.to_str().unwrap(),
+            "--set",
+            &journal,
         ];
         args.extend_from_slice(extra);
         self.agent(name, &args)
@@ -282,8 +285,8 @@ impl Cluster {
 
     /// Flags of an in-test client of this cluster's router (no shared memory, no
     /// scouting), with a Zenoh configuration file if given.
-    pub fn client_args(&self, zenoh_config: Option<PathBuf>) -> graspopt_bus::BusArgs {
-        graspopt_bus::BusArgs {
+    pub fn client_args(&self, zenoh_config: Option<PathBuf>) -> graspopt_bus::BusConfig {
+        graspopt_bus::BusConfig {
             connect: vec![self.endpoint.clone()],
             mode: Some(graspopt_bus::BusMode::Client),
             zenoh_config,

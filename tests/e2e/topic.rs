@@ -154,10 +154,10 @@ fn topic_list_names_each_hand_under_the_topic_it_publishes() {
             "hand",
             "--id",
             "ft-hand",
-            "--hand",
-            "barrett_ft",
-            "--sensing",
-            "ft",
+            "--set",
+            "hand=barrett_ft",
+            "--set",
+            "sensing=ft",
         ],
     );
     let runtime = tokio::runtime::Runtime::new().unwrap();

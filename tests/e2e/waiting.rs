@@ -55,7 +55,7 @@ fn the_coordinator_says_what_it_waits_for_in_its_log_status_and_monitor() {
     );
 
     // Everything but the planner: the wait changes to the planner's answer.
-    let _perception = c.agent("perception", &["perception", "--object", "sphere"]);
+    let _perception = c.agent("perception", &["perception", "--set", "object=sphere"]);
     let _metric = c.agent("metric", &["metric"]);
     let _hands = c.hands(1, &[]);
     wait_until(

@@ -93,6 +93,62 @@ impl CoordinatorConfig {
     }
 }
 
+/// The coordinator as an [`graspopt_bus::Agent`] (`graspopt agent coordinator`, the embedded
+/// run's): it serves the run `spec` describes (with `resume`, the one in its journal) and
+/// gives every status it publishes to `progress`.
+pub struct CoordinatorAgent {
+    pub spec: RunSpec,
+    pub resume: bool,
+    pub progress: Option<tokio::sync::watch::Sender<graspopt_protocol::RunStatus>>,
+}
+
+impl graspopt_bus::Agent for CoordinatorAgent {
+    const KIND: graspopt_protocol::AgentKind = graspopt_protocol::AgentKind::Coordinator;
+    const ABOUT: &'static str = "Owns the run and its journal";
+    type Config = CoordinatorConfig;
+    type Output = graspopt_protocol::RunStatus;
+    type Error = CoordinatorAgentError;
+
+    fn id(config: &mut CoordinatorConfig) -> &mut String {
+        &mut config.id
+    }
+
+    fn validate(config: &CoordinatorConfig) -> Result<(), Self::Error> {
+        config
+            .validate()
+            .map_err(|e| CoordinatorAgentError(e.into()))
+    }
+
+    async fn run(
+        &self,
+        bus: &graspopt_bus::Bus,
+        run: &RunId,
+        config: &CoordinatorConfig,
+        stop: impl Future<Output = ()> + Send,
+    ) -> Result<Self::Output, Self::Error> {
+        let progress = self.progress.clone();
+        run_until(bus, run, &self.spec, config, self.resume, progress, stop)
+            .await
+            .map_err(|e| CoordinatorAgentError(e.into()))
+    }
+}
+
+/// Why the coordinator agent stopped: its message and causes, as the coordinator gives them.
+#[derive(Debug)]
+pub struct CoordinatorAgentError(pub Box<dyn std::error::Error + Send + Sync>);
+
+impl std::fmt::Display for CoordinatorAgentError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for CoordinatorAgentError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

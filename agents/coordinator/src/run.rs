@@ -264,7 +264,7 @@ impl<'a> Io<'a> {
     }
 
     /// The run finished: recorded, its final status published.
-    async fn finished(self, core: &Coordinator) -> anyhow::Result<RunStatus> {
+    async fn finished(mut self, core: &Coordinator) -> anyhow::Result<RunStatus> {
         let run = self.run.as_str();
         self.journal
             .set_run_status(run, RunLifecycle::Finished, now_ms())?;
@@ -274,7 +274,7 @@ impl<'a> Io<'a> {
     }
 
     /// Publishes the run's last status, and gives it to the progress watcher.
-    async fn last_status(&self, s: &RunStatus) {
+    async fn last_status(&mut self, s: &RunStatus) {
         let _ = self
             .bus
             .put(&STATUS.key(self.run.into()), s, Encoding::Bincode)
@@ -287,7 +287,7 @@ impl<'a> Io<'a> {
     /// The run was stopped: recorded (its status, published, says so), and said how to go
     /// on.
     async fn stopped(
-        self,
+        mut self,
         core: &Coordinator,
         path: &std::path::Path,
     ) -> anyhow::Result<RunStatus> {

@@ -34,7 +34,7 @@ enum Command {
     /// Grid-scan a metric over trial parameters (CSV; SVG and PNG images for one or two).
     Scan(commands::scan::ScanArgs),
     /// Record a grid of simulated grasps' contact clouds, or fingertip readings with
-    /// `--sensing ft` (for `agent hand --replay`).
+    /// `--sensing ft` (for `agent hand --set replay=FILE`).
     Record(commands::record::RecordArgs),
     /// Regenerate the thesis's experiments (`metrics`: figures 4.3-4.15; `bo`: figures
     /// 4.16-4.27 and Table 4.1).
@@ -120,9 +120,6 @@ fn main() -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let run_matches = matches.subcommand_matches("run");
-    let coordinator_matches = matches
-        .subcommand_matches("agent")
-        .and_then(|m| m.subcommand_matches("coordinator"));
     // Logs go to stderr; RUST_LOG overrides the default filter.
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -142,9 +139,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => commands::experiment::run(args),
         Command::OptimizeFunction(args) => commands::optimize_function::run(args),
         Command::Run(args) => commands::run::run(args, &|name| given(run_matches, name)),
-        Command::Agent(args) => {
-            commands::agent::run(args, &|name| given(coordinator_matches, name))
-        }
+        Command::Agent(args) => commands::agent::run(args),
         Command::Router(args) => commands::router::run(args),
         Command::Launch(args) => commands::launch::run(args),
         Command::Topic(args) => commands::topic::run(args),
@@ -203,11 +198,7 @@ mod tests {
         // The walk sees nested subcommands and flattened flag sets.
         let agent = cmd.find_subcommand("agent").unwrap();
         let coordinator = agent.find_subcommand("coordinator").unwrap();
-        assert!(
-            coordinator
-                .get_arguments()
-                .any(|a| a.get_id() == "lease_ms")
-        );
+        assert!(coordinator.get_arguments().any(|a| a.get_id() == "trials"));
         assert!(coordinator.get_arguments().any(|a| a.get_id() == "connect"));
     }
 

@@ -56,10 +56,7 @@ pub struct HandReading {
     pub min_gap: Option<f64>,
 }
 
-/// Why a hand could not execute a trial: the trial fails with this reason, the agent goes on.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct HandError(pub String);
+pub use crate::error::HandError;
 
 /// A hand that executes trial commands. [`crate::serve`] does everything else: the bus,
 /// filtering commands, padding each trial to its cost, tagging and sending the clouds.

@@ -12,7 +12,7 @@
 //! Two drivers come with it: [`SimulatedHand`] (the grasp simulator; its world holds the
 //! object perception names at its true pose, or the configured one) and [`ReplayHand`]
 //! (each trial gets the recorded grasp nearest to its parameters, see [`replay`]). [`run`]
-//! picks one from the [`HandConfig`] and serves it.
+//! picks one from the [`HandConfig`] and serves it; [`HandAgent`] is that as an [`Agent`].
 //!
 //! # A real hand
 //!
@@ -33,7 +33,7 @@
 //!     }
 //!     fn execute(&mut self, command: &TrialCommand) -> Result<HandReading, HandError> {
 //!         if !command.trial_id.is_multiple_of(2) {
-//!             return Err(HandError("gripper fault".into()));
+//!             return Err(HandError::Fault("gripper fault".into()));
 //!         }
 //!         // Move the arm to command.palm_pose, close, read the tactile sensors...
 //!         let finger = |i: u32, side: f64| FingerCloud {
@@ -50,15 +50,17 @@
 //!     }
 //! }
 //!
-//! # async fn example() -> anyhow::Result<()> {
-//! let bus = graspopt_bus::Bus::open(&graspopt_bus::BusArgs::default()).await?;
+//! # async fn example() -> Result<(), Box<dyn std::error::Error>> {
+//! let bus = graspopt_bus::Bus::open(&graspopt_bus::BusConfig::default()).await?;
 //! let run = RunId::new("lab-1")?;
-//! serve(&bus, &run, "gripper-1", Duration::ZERO, MyGripper).await
+//! serve(&bus, &run, "gripper-1", Duration::ZERO, MyGripper).await?;
+//! # Ok(())
 //! # }
 //! ```
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod driver;
+mod error;
 pub mod replay;
 pub mod serve;
 pub mod simulated;
@@ -66,13 +68,14 @@ pub mod simulated;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use graspopt_bus::Bus;
-use graspopt_protocol::RunId;
+use graspopt_bus::{Agent, Bus};
+use graspopt_protocol::{AgentKind, RunId};
 use graspopt_trial::fingertips::FingertipSettings;
 use graspopt_trial::forces::ForceSettings;
 use serde::{Deserialize, Serialize};
 
 pub use driver::{HandDriver, HandError, HandReading, Sensing};
+pub use error::HandAgentError;
 pub use replay::ReplayHand;
 pub use serve::{UNIQUE_WAIT, serve};
 pub use simulated::{SimulatedHand, world_object};
@@ -123,7 +126,7 @@ impl Default for HandConfig {
 /// Checks what `config` asks for before anything joins the bus: the hand exists, and with
 /// `sensing = "ft"` it has spherical fingertips and the sensor settings are valid (a replay
 /// hand's recording is checked when it loads).
-pub fn check(config: &HandConfig) -> anyhow::Result<()> {
+pub fn check(config: &HandConfig) -> Result<(), HandAgentError> {
     if config.replay.is_none() {
         SimulatedHand::new(config)?;
     }
@@ -133,7 +136,7 @@ pub fn check(config: &HandConfig) -> anyhow::Result<()> {
 /// Serves trial commands with the hand `config` describes (the replay hand when `replay`
 /// is set, else the simulated one, measuring clouds or fingertip forces per `sensing`) until
 /// the task is cancelled.
-pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<()> {
+pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> Result<(), HandAgentError> {
     let cost = Duration::from_millis(config.trial_cost_ms);
     if let Some(path) = &config.replay {
         let recording = replay::Recording::load(path)?;
@@ -147,4 +150,33 @@ pub async fn run(bus: &Bus, run: &RunId, config: &HandConfig) -> anyhow::Result<
     }
     let hand = SimulatedHand::new(config)?;
     serve(bus, run, &config.id, cost, hand).await
+}
+
+/// The hand agent (`graspopt agent hand`).
+pub struct HandAgent;
+
+impl Agent for HandAgent {
+    const KIND: AgentKind = AgentKind::Hand;
+    const ABOUT: &'static str = "Executes trials on the simulated hand";
+    type Config = HandConfig;
+    type Output = ();
+    type Error = HandAgentError;
+
+    fn id(config: &mut HandConfig) -> &mut String {
+        &mut config.id
+    }
+
+    fn validate(config: &HandConfig) -> Result<(), HandAgentError> {
+        check(config)
+    }
+
+    async fn run(
+        &self,
+        bus: &Bus,
+        run_id: &RunId,
+        config: &HandConfig,
+        stop: impl Future<Output = ()> + Send,
+    ) -> Result<(), HandAgentError> {
+        graspopt_bus::agent::until(run(bus, run_id, config), stop).await
+    }
 }

@@ -163,18 +163,16 @@ impl Recording {
     pub fn answer(&self, command: &TrialCommand) -> Result<HandReading, HandError> {
         match self.nearest(&command.params) {
             Some(t) if t.hand == command.hand => Ok(t.reading()),
-            Some(t) => Err(HandError(format!(
-                "the recording {} was made with a {} hand, the trial asks for {}",
-                self.path.display(),
-                t.hand,
-                command.hand
-            ))),
-            None => Err(HandError(format!(
-                "the recording {} has {} parameters per grasp, the trial has {}",
-                self.path.display(),
-                self.trials[0].params.len(),
-                command.params.len()
-            ))),
+            Some(t) => Err(HandError::RecordedHand {
+                path: self.path.clone(),
+                recorded: t.hand.clone(),
+                asked: command.hand.clone(),
+            }),
+            None => Err(HandError::RecordedParams {
+                path: self.path.clone(),
+                recorded: self.trials[0].params.len(),
+                asked: command.params.len(),
+            }),
         }
     }
 }
@@ -341,7 +339,7 @@ mod tests {
         assert_eq!(c.fingers, grasp(vec![], 0.0).fingers);
         // Wrong parameter count: a refusal, not a panic.
         let e = rec.answer(&command(vec![1.0])).unwrap_err();
-        assert!(e.0.contains("2 parameters per grasp"), "{e}");
+        assert!(e.to_string().contains("2 parameters per grasp"), "{e}");
 
         // Bad recordings name the line and the problem.
         let mut nan = grasp(vec![0.0, 0.0], 0.0);

@@ -2,7 +2,6 @@
 
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
 use graspopt_bus::{Bus, CloudSender, Inbox, Subscription, now_ms};
 use graspopt_protocol::keys::{COMMAND, OBJECT, WRENCHES};
 use graspopt_protocol::{
@@ -10,6 +9,7 @@ use graspopt_protocol::{
 };
 
 use crate::driver::{HandDriver, HandError, HandReading, Sensing};
+use crate::error::HandAgentError;
 
 /// How long a starting hand waits for a predecessor with its id to vanish (a worker killed
 /// and restarted at once) before refusing to start.
@@ -33,7 +33,7 @@ pub async fn serve(
     id: &str,
     cost: Duration,
     mut driver: impl HandDriver,
-) -> anyhow::Result<()> {
+) -> Result<(), HandAgentError> {
     // Two hands with one id would both execute every trial sent to that id.
     let place = bus
         .wait_until_unique(run, AgentKind::Hand, Some(id), UNIQUE_WAIT)
@@ -128,15 +128,16 @@ async fn execute<D: HandDriver>(
     mut driver: D,
     command: &TrialCommand,
     id: &str,
-) -> anyhow::Result<(D, Result<HandReading, HandError>)> {
+) -> Result<(D, Result<HandReading, HandError>), HandAgentError> {
     if let Some(hand) = driver.hand()
         && !graspopt_sim::same_hand(hand, &command.hand)
     {
-        let why = format!(
-            "worker {id} has a {hand} hand, the trial asks for {}",
-            command.hand
-        );
-        return Ok((driver, Err(HandError(why))));
+        let why = HandError::OtherHand {
+            worker: id.to_string(),
+            has: hand.to_string(),
+            asked: command.hand.clone(),
+        };
+        return Ok((driver, Err(why)));
     }
     let command = command.clone();
     tokio::task::spawn_blocking(move || {
@@ -144,7 +145,7 @@ async fn execute<D: HandDriver>(
         (driver, outcome)
     })
     .await
-    .context("hand: trial thread panicked")
+    .map_err(HandAgentError::Panicked)
 }
 
 /// The clouds message answering `command`, sent by worker `id` now: the reading, or no
@@ -157,7 +158,7 @@ pub fn tag(
 ) -> ContactClouds {
     let (palm_pose, fingers, min_gap, error) = match outcome {
         Ok(r) => (r.palm_pose, r.fingers, r.min_gap, None),
-        Err(e) => (command.palm_pose, Vec::new(), None, Some(e.0)),
+        Err(e) => (command.palm_pose, Vec::new(), None, Some(e.to_string())),
     };
     ContactClouds {
         run_id: command.run_id.clone(),
@@ -183,7 +184,7 @@ pub fn tag_wrenches(
 ) -> FingertipWrenches {
     let (palm_pose, fingertips, min_gap, error) = match outcome {
         Ok(r) => (r.palm_pose, r.fingertips, r.min_gap, None),
-        Err(e) => (command.palm_pose, Vec::new(), None, Some(e.0)),
+        Err(e) => (command.palm_pose, Vec::new(), None, Some(e.to_string())),
     };
     FingertipWrenches {
         run_id: command.run_id.clone(),
@@ -233,7 +234,10 @@ mod tests {
                 .unwrap()
                 .push(format!("trial {}", command.trial_id));
             if command.trial_id.is_multiple_of(2) {
-                return Err(HandError(format!("fault on trial {}", command.trial_id)));
+                return Err(HandError::Fault(format!(
+                    "fault on trial {}",
+                    command.trial_id
+                )));
             }
             Ok(HandReading {
                 palm_pose: Pose::IDENTITY,

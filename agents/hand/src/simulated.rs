@@ -3,7 +3,6 @@
 //! (`graspopt_trial::fingertips`), with sensor noise drawn from a generator seeded by the
 //! trial and attempt, so a trial reads the same each time it is executed.
 
-use anyhow::Context;
 use graspopt_convert::{TrialTag, clouds_from_outcome, fingertip_wrench, isometry};
 use graspopt_protocol::{ObjectEstimate, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
@@ -14,6 +13,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::HandConfig;
 use crate::driver::{HandDriver, HandError, HandReading, Sensing};
+use crate::error::HandAgentError;
 
 /// A simulated hand in a simulated world: the world holds the configured object, or the one
 /// perception names at its true pose.
@@ -31,16 +31,25 @@ impl SimulatedHand {
     /// The hand `config.hand` in the world of `config` (empty until an object estimate
     /// arrives when no object is configured). Sensing forces needs a hand with spherical
     /// fingertips.
-    pub fn new(config: &HandConfig) -> anyhow::Result<SimulatedHand> {
-        let hand = hand_by_name(&config.hand).context("hand agent")?;
+    pub fn new(config: &HandConfig) -> Result<SimulatedHand, HandAgentError> {
+        let hand = hand_by_name(&config.hand).map_err(|source| HandAgentError::Hand {
+            context: "hand agent",
+            source,
+        })?;
         if config.sensing == Sensing::Ft {
-            fingertips(hand.as_ref()).context("hand agent with --sensing ft")?;
-            config
-                .fingertips
-                .noise
+            let sensing = |context, source: Box<dyn std::error::Error + Send + Sync>| {
+                HandAgentError::Sensing { context, source }
+            };
+            fingertips(hand.as_ref())
+                .map_err(|e| sensing("hand agent with --sensing ft", e.into()))?;
+            let noise = &config.fingertips.noise;
+            noise
                 .validate()
-                .context("hand agent: fingertip sensor noise")?;
-            config.forces.validate().context("hand agent")?;
+                .map_err(|e| sensing("hand agent: fingertip sensor noise", e.into()))?;
+            config
+                .forces
+                .validate()
+                .map_err(|e| sensing("hand agent", e.into()))?;
         }
         Ok(SimulatedHand {
             hand,
@@ -59,7 +68,7 @@ impl SimulatedHand {
     ) -> Result<HandReading, HandError> {
         let palm = isometry(&command.palm_pose);
         let outcome = run_trial(world, self.hand.as_ref(), &palm, &self.settings)
-            .map_err(|e| HandError(format!("hand could not execute the trial: {e}")))?;
+            .map_err(|e| HandError::Simulation(e.to_string()))?;
         let tag = TrialTag {
             run_id: command.run_id.clone(),
             trial_id: command.trial_id,
@@ -86,7 +95,7 @@ impl SimulatedHand {
             &self.config.fingertips,
             &mut rng,
         )
-        .map_err(|e| HandError(format!("fingertip sensors: {e}")))?;
+        .map_err(|e| HandError::Fingertips(e.to_string()))?;
         let stamp_ms = graspopt_bus::now_ms();
         Ok(HandReading {
             palm_pose: clouds.palm_pose,
@@ -127,7 +136,7 @@ impl HandDriver for SimulatedHand {
     fn execute(&mut self, command: &TrialCommand) -> Result<HandReading, HandError> {
         match &self.world {
             Some(world) => self.execute_on(world, command),
-            None => Err(HandError("the hand's world holds no object".into())),
+            None => Err(HandError::NoObject),
         }
     }
 }

@@ -15,22 +15,24 @@
 //! slip margins (`graspopt_trial::forces`).
 //!
 //! [`score_clouds`] and [`score_wrenches`] are the logic (no network); [`run`] wires them to
-//! the bus.
+//! the bus, and [`MetricAgent`] is it as an [`Agent`].
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+mod error;
 
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use anyhow::Context;
-use graspopt_bus::{Bus, CloudReceiver};
+pub use error::MetricError;
+use graspopt_bus::{Agent, Bus, CloudReceiver, Received, ReceivedClouds};
 use graspopt_convert::{
     force_analysis, isometry, measured_from_clouds, metric_values, object_from_estimate,
     sensor_reading,
 };
-use graspopt_protocol::keys::{OBJECT, RESULT, WRENCHES};
+use graspopt_protocol::keys::{Key, OBJECT, RESULT, WRENCHES};
 use graspopt_protocol::{
     AgentKind, AttemptRef, ContactClouds, DecodeError, Encoding, FingertipWrenches, ForceAnalysis,
-    RunId, TrialResult,
+    ObjectEstimate, RunId, TrialResult,
 };
 use graspopt_quality::forces::ContactForces;
 use graspopt_sensing::SensingSettings;
@@ -242,105 +244,224 @@ pub fn invalid_measurement_result(
 }
 
 /// Scores clouds until the task is cancelled.
-pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> anyhow::Result<()> {
-    config
-        .contacts
-        .validate()
-        .context("metric agent settings")?;
-    config.forces.validate().context("metric agent settings")?;
+pub async fn run(bus: &Bus, run: &RunId, config: &MetricConfig) -> Result<(), MetricError> {
+    validate(config)?;
     let mut clouds = CloudReceiver::open(bus, run).await?;
     let wrenches = bus.subscribe(&WRENCHES.key(run.into())).await?;
     let objects = bus.subscribe(&OBJECT.key(run.into())).await?;
     let _token = bus
         .declare_alive(run, AgentKind::Metric, &config.id)
         .await?;
-    let config = Arc::new(config.clone());
-    let mut object: Option<(u64, String, Arc<Object>)> = None;
-    let mut waiting: VecDeque<Measured> = VecDeque::new();
-    let mut bad = 0u64;
-    let key = RESULT.key(run.into());
+    let mut scorer = Scorer {
+        bus,
+        run,
+        key: RESULT.key(run.into()),
+        config: Arc::new(config.clone()),
+        object: None,
+        waiting: VecDeque::new(),
+        bad: 0,
+    };
     loop {
         tokio::select! {
-            Some(r) = objects.recv() => match r.message {
-                Ok(e) if e.run_id == *run => {
-                    let same = object.as_ref().is_some_and(|(seq, name, _)| *seq == e.seq && *name == e.object);
-                    if !same {
-                        match object_from_estimate(&e) {
-                            Ok(o) => object = Some((e.seq, e.object.clone(), Arc::new(o))),
-                            Err(err) => {
-                                bad += 1;
-                                tracing::warn!("metric {}: unusable object estimate ({bad} bad messages): {err}", config.id);
-                            }
-                        }
-                    }
-                }
-                Ok(e) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: object estimate of run {:?} ignored ({bad} bad messages)", config.id, e.run_id);
-                }
-                Err(e) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: bad object estimate on {} ({bad} bad messages): {e}", config.id, r.key);
-                }
-            },
-            Some(r) = clouds.recv() => match r.message {
-                Ok(c) if c.run_id == *run => waiting.push_back(Measured::Clouds(c, r.path.as_str())),
-                Ok(c) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: clouds of run {:?} ignored ({bad} bad messages)", config.id, c.run_id);
-                }
-                Err(e) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: bad clouds via {} ({bad} bad messages): {e}", config.id, r.path.as_str());
-                    // Clouds that name an attempt of this run fail it with the reason, so
-                    // the trial does not wait for its lease (the coordinator accepts it only
-                    // from the worker the attempt was issued to).
-                    if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
-                        && a.run_id == *run
-                    {
-                        let failed = invalid_measurement_result(a, "contact clouds", &detail.to_string(), &config.id, r.path.as_str());
-                        if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
-                            tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
-                        }
-                    }
-                }
-            },
-            Some(r) = wrenches.recv() => match r.message {
-                Ok(w) if w.run_id == *run => waiting.push_back(Measured::Wrenches(w)),
-                Ok(w) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: fingertip readings of run {:?} ignored ({bad} bad messages)", config.id, w.run_id);
-                }
-                Err(e) => {
-                    bad += 1;
-                    tracing::warn!("metric {}: bad fingertip readings on {} ({bad} bad messages): {e}", config.id, r.key);
-                    if let DecodeError::Invalid { detail, about: Some(a), .. } = &e
-                        && a.run_id == *run
-                    {
-                        let failed = invalid_measurement_result(a, "fingertip readings", &detail.to_string(), &config.id, "zenoh");
-                        if let Err(e) = bus.put(&key, &failed, Encoding::Bincode).await {
-                            tracing::warn!("metric {}: cannot publish the failure of trial {}: {e}", config.id, a.trial_id);
-                        }
-                    }
-                }
-            },
+            Some(r) = objects.recv() => scorer.on_object(r),
+            Some(r) = clouds.recv() => scorer.on_clouds(r).await,
+            Some(r) = wrenches.recv() => scorer.on_wrenches(r).await,
             else => return Ok(()),
         }
-        if let Some((_, _, o)) = &object {
-            while let Some(measured) = waiting.pop_front() {
-                let (o, cfg) = (o.clone(), config.clone());
-                let result = tokio::task::spawn_blocking(move || measured.score(&o, &cfg))
-                    .await
-                    .context("metric: scoring thread panicked")?;
-                if let Err(e) = bus.put(&key, &result, Encoding::Bincode).await {
-                    tracing::warn!(
-                        "metric {}: cannot publish result of trial {}: {e}",
-                        config.id,
-                        result.trial_id
-                    );
+        scorer.score_waiting().await?;
+    }
+}
+
+/// Refuses settings the metric agent cannot score with, naming them.
+pub fn validate(config: &MetricConfig) -> Result<(), MetricError> {
+    config
+        .contacts
+        .validate()
+        .map_err(|e| MetricError::Settings(e.into()))?;
+    config
+        .forces
+        .validate()
+        .map_err(|e| MetricError::Settings(e.into()))
+}
+
+/// The metric agent's loop state: the run's object, the measurements waiting for it, and
+/// the count of bad messages.
+struct Scorer<'a> {
+    bus: &'a Bus,
+    run: &'a RunId,
+    key: Key<TrialResult>,
+    config: Arc<MetricConfig>,
+    /// The estimate's sequence number, object name and object.
+    object: Option<(u64, String, Arc<Object>)>,
+    waiting: VecDeque<Measured>,
+    bad: u64,
+}
+
+impl Scorer<'_> {
+    fn on_object(&mut self, r: Received<ObjectEstimate>) {
+        let id = &self.config.id;
+        match r.message {
+            Ok(e) if e.run_id == *self.run => {
+                let same = self
+                    .object
+                    .as_ref()
+                    .is_some_and(|(seq, name, _)| *seq == e.seq && *name == e.object);
+                if !same {
+                    match object_from_estimate(&e) {
+                        Ok(o) => self.object = Some((e.seq, e.object.clone(), Arc::new(o))),
+                        Err(err) => {
+                            self.bad += 1;
+                            let bad = self.bad;
+                            tracing::warn!(
+                                "metric {id}: unusable object estimate ({bad} bad messages): {err}"
+                            );
+                        }
+                    }
                 }
             }
+            Ok(e) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: object estimate of run {:?} ignored ({bad} bad messages)",
+                    e.run_id
+                );
+            }
+            Err(e) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: bad object estimate on {} ({bad} bad messages): {e}",
+                    r.key
+                );
+            }
         }
+    }
+
+    async fn on_clouds(&mut self, r: ReceivedClouds) {
+        let id = self.config.id.clone();
+        match r.message {
+            Ok(c) if c.run_id == *self.run => {
+                self.waiting.push_back(Measured::Clouds(c, r.path.as_str()))
+            }
+            Ok(c) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: clouds of run {:?} ignored ({bad} bad messages)",
+                    c.run_id
+                );
+            }
+            Err(e) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: bad clouds via {} ({bad} bad messages): {e}",
+                    r.path.as_str()
+                );
+                // Clouds that name an attempt of this run fail it with the reason, so the
+                // trial does not wait for its lease (the coordinator accepts it only from
+                // the worker the attempt was issued to).
+                self.fail_invalid(&e, "contact clouds", r.path.as_str())
+                    .await;
+            }
+        }
+    }
+
+    async fn on_wrenches(&mut self, r: Received<FingertipWrenches>) {
+        let id = self.config.id.clone();
+        match r.message {
+            Ok(w) if w.run_id == *self.run => self.waiting.push_back(Measured::Wrenches(w)),
+            Ok(w) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: fingertip readings of run {:?} ignored ({bad} bad messages)",
+                    w.run_id
+                );
+            }
+            Err(e) => {
+                self.bad += 1;
+                let bad = self.bad;
+                tracing::warn!(
+                    "metric {id}: bad fingertip readings on {} ({bad} bad messages): {e}",
+                    r.key
+                );
+                self.fail_invalid(&e, "fingertip readings", "zenoh").await;
+            }
+        }
+    }
+
+    /// Publishes the failure of the attempt an invalid measurement names, if it is of this
+    /// run.
+    async fn fail_invalid(&self, e: &DecodeError, what: &str, transport: &str) {
+        if let DecodeError::Invalid {
+            detail,
+            about: Some(a),
+            ..
+        } = e
+            && a.run_id == *self.run
+        {
+            let id = &self.config.id;
+            let detail = detail.to_string();
+            let failed = invalid_measurement_result(a, what, &detail, id, transport);
+            if let Err(e) = self.bus.put(&self.key, &failed, Encoding::Bincode).await {
+                tracing::warn!(
+                    "metric {id}: cannot publish the failure of trial {}: {e}",
+                    a.trial_id
+                );
+            }
+        }
+    }
+
+    /// Scores and publishes the waiting measurements, once the object is known.
+    async fn score_waiting(&mut self) -> Result<(), MetricError> {
+        let Some((_, _, o)) = &self.object else {
+            return Ok(());
+        };
+        while let Some(measured) = self.waiting.pop_front() {
+            let (o, cfg) = (o.clone(), self.config.clone());
+            let result = tokio::task::spawn_blocking(move || measured.score(&o, &cfg))
+                .await
+                .map_err(MetricError::Panicked)?;
+            if let Err(e) = self.bus.put(&self.key, &result, Encoding::Bincode).await {
+                tracing::warn!(
+                    "metric {}: cannot publish result of trial {}: {e}",
+                    self.config.id,
+                    result.trial_id
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The metric agent (`graspopt agent metric`).
+pub struct MetricAgent;
+
+impl Agent for MetricAgent {
+    const KIND: AgentKind = AgentKind::Metric;
+    const ABOUT: &'static str = "Scores contact clouds and fingertip force readings";
+    type Config = MetricConfig;
+    type Output = ();
+    type Error = MetricError;
+
+    fn id(config: &mut MetricConfig) -> &mut String {
+        &mut config.id
+    }
+
+    fn validate(config: &MetricConfig) -> Result<(), MetricError> {
+        validate(config)
+    }
+
+    async fn run(
+        &self,
+        bus: &Bus,
+        run_id: &RunId,
+        config: &MetricConfig,
+        stop: impl Future<Output = ()> + Send,
+    ) -> Result<(), MetricError> {
+        graspopt_bus::agent::until(run(bus, run_id, config), stop).await
     }
 }
 

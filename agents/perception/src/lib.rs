@@ -4,14 +4,17 @@
 //! Gaussian noise (a calibration error that stays for the whole run). It is published at
 //! start and then every `period_ms`, so agents that start later or restart learn it.
 //!
-//! [`estimate`] is the logic (no network); [`run`] wires it to the bus.
+//! [`estimate`] is the logic (no network); [`run`] wires it to the bus, and
+//! [`PerceptionAgent`] is it as an [`Agent`].
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
+mod error;
 
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::Context;
-use graspopt_bus::{Bus, now_ms};
+pub use error::PerceptionError;
+use graspopt_bus::{Agent, Bus, now_ms};
 use graspopt_protocol::keys::OBJECT;
 use graspopt_protocol::{AgentKind, Encoding, ObjectEstimate, RunId};
 use graspopt_sim::Object;
@@ -58,7 +61,7 @@ impl Default for PerceptionConfig {
 impl PerceptionConfig {
     /// Checks the settings: the noise levels must be finite and non-negative (an infinite
     /// one would put the object nowhere).
-    pub fn validate(&self) -> anyhow::Result<()> {
+    pub fn validate(&self) -> Result<(), PerceptionError> {
         // Beyond these an estimate means nothing (a rotation's standard deviation past a half
         // turn, a position's past a metre around objects of centimetres), and the pose of a
         // huge one is not even finite.
@@ -77,9 +80,12 @@ impl PerceptionConfig {
             ),
         ] {
             if !(v.is_finite() && (0.0..=max).contains(&v)) {
-                anyhow::bail!(
-                    "perception: {name} must be a standard deviation between 0 and {max} {unit}, got {v}"
-                );
+                return Err(PerceptionError::Noise {
+                    name,
+                    max,
+                    unit,
+                    value: v,
+                });
             }
         }
         Ok(())
@@ -92,11 +98,15 @@ pub const MAX_POSITION_NOISE: f64 = 1.0;
 pub const MAX_ROTATION_NOISE: f64 = std::f64::consts::PI;
 
 /// The scene's object (at its true pose).
-pub fn scene_object(config: &PerceptionConfig) -> anyhow::Result<Object> {
+pub fn scene_object(config: &PerceptionConfig) -> Result<Object, PerceptionError> {
     match &config.mesh {
-        Some(path) => Object::from_file_scaled(path, config.mesh_scale)
-            .with_context(|| format!("perception: cannot load mesh {}", path.display())),
-        None => Object::by_name(&config.object).context("perception"),
+        Some(path) => Object::from_file_scaled(path, config.mesh_scale).map_err(|source| {
+            PerceptionError::Mesh {
+                path: path.clone(),
+                source,
+            }
+        }),
+        None => Object::by_name(&config.object).map_err(PerceptionError::Object),
     }
 }
 
@@ -110,7 +120,7 @@ pub fn noisy_pose(truth: &Isometry3<f64>, config: &PerceptionConfig) -> Isometry
 }
 
 /// The estimate to publish.
-pub fn estimate(run: &RunId, config: &PerceptionConfig) -> anyhow::Result<ObjectEstimate> {
+pub fn estimate(run: &RunId, config: &PerceptionConfig) -> Result<ObjectEstimate, PerceptionError> {
     config.validate()?;
     let object = scene_object(config)?;
     let pose = noisy_pose(object.pose(), config);
@@ -129,7 +139,7 @@ pub fn estimate(run: &RunId, config: &PerceptionConfig) -> anyhow::Result<Object
 }
 
 /// Publishes the estimate until the task is cancelled.
-pub async fn run(bus: &Bus, run: &RunId, config: &PerceptionConfig) -> anyhow::Result<()> {
+pub async fn run(bus: &Bus, run: &RunId, config: &PerceptionConfig) -> Result<(), PerceptionError> {
     let mut estimate = estimate(run, config)?;
     let _token = bus
         .declare_alive(run, AgentKind::Perception, &config.id)
@@ -142,6 +152,35 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PerceptionConfig) -> anyhow::R
             tracing::warn!("perception: cannot publish the estimate: {e}");
         }
         tokio::time::sleep(period).await;
+    }
+}
+
+/// The perception agent (`graspopt agent perception`).
+pub struct PerceptionAgent;
+
+impl Agent for PerceptionAgent {
+    const KIND: AgentKind = AgentKind::Perception;
+    const ABOUT: &'static str = "Publishes the object estimate";
+    type Config = PerceptionConfig;
+    type Output = ();
+    type Error = PerceptionError;
+
+    fn id(config: &mut PerceptionConfig) -> &mut String {
+        &mut config.id
+    }
+
+    fn validate(config: &PerceptionConfig) -> Result<(), PerceptionError> {
+        config.validate()
+    }
+
+    async fn run(
+        &self,
+        bus: &Bus,
+        run_id: &RunId,
+        config: &PerceptionConfig,
+        stop: impl Future<Output = ()> + Send,
+    ) -> Result<(), PerceptionError> {
+        graspopt_bus::agent::until(run(bus, run_id, config), stop).await
     }
 }
 

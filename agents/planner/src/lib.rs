@@ -14,24 +14,25 @@
 //! history: the same design, the same data, but a model fitted afresh, whose proposals
 //! differ slightly from a warm engine's.
 //!
-//! [`Planner::answer`] is the logic (no network); [`run`] wires it to the bus.
+//! [`Planner::answer`] is the logic (no network); [`run`] wires it to the bus, and
+//! [`PlannerAgent`] is it as an [`Agent`].
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod bench;
 mod engine;
+mod error;
 
 use std::sync::{Arc, Mutex};
 
-use anyhow::Context;
 use graspopt_bayesopt::baseline::{AskTell, RandomSearch};
-use graspopt_bayesopt::error::BoError;
 use graspopt_bayesopt::optimizer::Optimizer;
-use graspopt_bus::Bus;
+use graspopt_bus::{Agent, Bus};
 use graspopt_protocol::keys::SUGGEST;
 use graspopt_protocol::{AgentKind, PlannerMethod, RunId, SuggestReply, SuggestRequest};
 use serde::{Deserialize, Serialize};
 
 use crate::engine::{Engine, Warm, bo_settings};
+pub use crate::error::PlannerError;
 
 /// Planner settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -46,27 +47,6 @@ impl Default for PlannerConfig {
             id: "planner".into(),
         }
     }
-}
-
-/// Why the planner cannot answer.
-#[derive(Debug, thiserror::Error)]
-pub enum PlannerError {
-    /// The engine refused (bounds, a proposal).
-    #[error(transparent)]
-    Bo(#[from] BoError),
-    #[error("observation rejected: {0}")]
-    Observation(BoError),
-    #[error("pending point rejected: {0}")]
-    Pending(BoError),
-    /// A saved engine state that cannot be used or written.
-    #[error("{0}")]
-    State(String),
-    #[error("this planner serves run {serving:?}, not {asked:?}")]
-    OtherRun { serving: RunId, asked: RunId },
-    #[error("planner state poisoned")]
-    Poisoned,
-    #[error("planner state missing")]
-    Missing,
 }
 
 /// The reply to `req` saying why there are no proposals.
@@ -245,7 +225,7 @@ impl Planner {
 }
 
 /// Answers proposal requests until the task is cancelled.
-pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Result<()> {
+pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> Result<(), PlannerError> {
     let server = bus.serve(&SUGGEST.key(run)).await?;
     let _token = bus
         .declare_alive(run, AgentKind::Planner, &config.id)
@@ -269,7 +249,7 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
             Err(_) => Ok(failed_reply(&req, &PlannerError::Poisoned)),
         })
         .await
-        .context("planner: proposal thread panicked")?;
+        .map_err(PlannerError::Panicked)?;
         let reply = match reply {
             Ok(reply) => reply,
             Err(e) => {
@@ -287,6 +267,35 @@ pub async fn run(bus: &Bus, run: &RunId, config: &PlannerConfig) -> anyhow::Resu
         }
     }
     Ok(())
+}
+
+/// The planner agent (`graspopt agent planner`).
+pub struct PlannerAgent;
+
+impl Agent for PlannerAgent {
+    const KIND: AgentKind = AgentKind::Planner;
+    const ABOUT: &'static str = "Proposes trials";
+    type Config = PlannerConfig;
+    type Output = ();
+    type Error = PlannerError;
+
+    fn id(config: &mut PlannerConfig) -> &mut String {
+        &mut config.id
+    }
+
+    fn validate(_: &PlannerConfig) -> Result<(), PlannerError> {
+        Ok(())
+    }
+
+    async fn run(
+        &self,
+        bus: &Bus,
+        run_id: &RunId,
+        config: &PlannerConfig,
+        stop: impl Future<Output = ()> + Send,
+    ) -> Result<(), PlannerError> {
+        graspopt_bus::agent::until(run(bus, run_id, config), stop).await
+    }
 }
 
 #[cfg(test)]

@@ -15,9 +15,8 @@ use std::fmt;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
 use graspopt_bayesopt::benchmark::median;
-use graspopt_bus::{Bus, BusArgs, CloudPath, CloudReceiver, CloudSender, free_loopback_port};
+use graspopt_bus::{Bus, BusConfig, CloudPath, CloudReceiver, CloudSender, free_loopback_port};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, PlannerMethod, Pose, RunId, RunStatus,
 };
@@ -25,9 +24,54 @@ use graspopt_sim::ParamKind;
 use graspopt_trial::TrialSettings;
 use tokio::sync::watch;
 
+use crate::error::{Boxed, RunnerError};
 use crate::{Embedded, RunSettings, placeholder, run_embedded};
 
+type Result<T> = std::result::Result<T, BenchError>;
+
+impl From<RunnerError> for BenchError {
+    fn from(e: RunnerError) -> Self {
+        BenchError::Runner(Box::new(e))
+    }
+}
+
+/// Why a benchmark could not measure.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    #[error("bench follower")]
+    Follower(#[source] tokio::task::JoinError),
+    #[error("no cloud within 5 s")]
+    NoCloud(#[source] tokio::time::error::Elapsed),
+    #[error("receiver closed")]
+    ReceiverClosed,
+    #[error("the clouds took the {0} path, not the one measured")]
+    OtherPath(&'static str),
+    /// What it measured is not what it sent: which check failed.
+    #[error("{0}")]
+    Changed(&'static str),
+    #[error(transparent)]
+    Runner(Box<RunnerError>),
+    #[error(transparent)]
+    Bus(#[from] graspopt_bus::BusError),
+    #[error(transparent)]
+    Journal(#[from] graspopt_journal::JournalError),
+    #[error(transparent)]
+    Trial(#[from] graspopt_trial::TrialError),
+    #[error(transparent)]
+    Key(#[from] graspopt_protocol::keys::KeyError),
+    #[error(transparent)]
+    Decode(#[from] graspopt_protocol::DecodeError),
+    #[error(transparent)]
+    Encode(#[from] graspopt_protocol::codec::EncodeError),
+    /// The shared-memory layout's error.
+    #[error(transparent)]
+    Layout(Boxed),
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
 pub mod coordinator;
+pub mod functions;
 
 /// What [`pipeline`] measures.
 #[derive(Debug, Clone)]
@@ -86,7 +130,7 @@ fn bench_run(
     cost: u64,
     method: PlannerMethod,
 ) -> Result<Embedded> {
-    RunSettings {
+    let settings = RunSettings {
         run: format!("bench-{tag}"),
         trial: bench_trial(),
         workers,
@@ -98,8 +142,8 @@ fn bench_run(
         trial_cost_ms: cost,
         lease_ms: 60_000,
         ..RunSettings::default()
-    }
-    .embedded()
+    };
+    Ok(settings.embedded()?)
 }
 
 /// Runs an embedded run and returns the instants at which each trial completed.
@@ -118,7 +162,7 @@ async fn timed_run(e: &Embedded) -> Result<(RunStatus, Vec<Instant>)> {
         times
     });
     let status = run_embedded(e, Some(tx)).await?;
-    let times = follow.await.context("bench follower")?;
+    let times = follow.await.map_err(BenchError::Follower)?;
     Ok((status, times))
 }
 
@@ -272,10 +316,10 @@ pub fn cloud_message(run: &RunId, trial: u64, points: usize) -> ContactClouds {
 async fn cloud_latency(shm: bool, points: usize, messages: usize) -> Result<(CloudPath, Vec<f64>)> {
     let port = free_loopback_port()?;
     let prefix = format!("graspopt_bench_{}_{}_", std::process::id(), u8::from(shm));
-    let mut a = BusArgs::loopback(vec![format!("tcp/127.0.0.1:{port}")], vec![]);
+    let mut a = BusConfig::loopback(vec![format!("tcp/127.0.0.1:{port}")], vec![]);
     a.shm_prefix = Some(prefix.clone());
     a.no_shm = !shm;
-    let mut b = BusArgs::loopback(vec![], vec![format!("tcp/127.0.0.1:{port}")]);
+    let mut b = BusConfig::loopback(vec![], vec![format!("tcp/127.0.0.1:{port}")]);
     b.shm_prefix = Some(prefix);
     b.no_shm = !shm;
     let hand_bus = Bus::open(&a).await?;
@@ -292,13 +336,12 @@ async fn cloud_latency(shm: bool, points: usize, messages: usize) -> Result<(Clo
         path = sender.send(&msg).await?;
         let got = tokio::time::timeout(Duration::from_secs(5), receiver.recv())
             .await
-            .context("no cloud within 5 s")?
-            .context("receiver closed")?;
+            .map_err(BenchError::NoCloud)?
+            .ok_or(BenchError::ReceiverClosed)?;
         let m = got.message?;
-        anyhow::ensure!(
-            m.trial_id == i as u64 && m.point_count() == points,
-            "wrong message"
-        );
+        if m.trial_id != i as u64 || m.point_count() != points {
+            return Err(BenchError::Changed("wrong message"));
+        }
         if i >= 10 {
             lat.push(t.elapsed().as_secs_f64() * 1e6);
         }
@@ -354,11 +397,9 @@ pub async fn clouds(points: usize, messages: usize) -> Result<CloudsReport> {
     let mut paths = Vec::new();
     for shm in [true, false] {
         let (path, mut lat) = cloud_latency(shm, points, messages).await?;
-        anyhow::ensure!(
-            (path == CloudPath::SharedMemory) == shm,
-            "the clouds took the {} path, not the one measured",
-            path.as_str()
-        );
+        if (path == CloudPath::SharedMemory) != shm {
+            return Err(BenchError::OtherPath(path.as_str()));
+        }
         lat.sort_by(f64::total_cmp);
         let p90 = lat
             .get((lat.len() * 9 / 10).min(lat.len().saturating_sub(1)))
@@ -371,7 +412,7 @@ pub async fn clouds(points: usize, messages: usize) -> Result<CloudsReport> {
         });
     }
     let encoded_bytes = graspopt_protocol::encode(&msg, Encoding::Bincode)?.len();
-    let layout_bytes = layout::clouds_len(&msg)?;
+    let layout_bytes = layout::clouds_len(&msg).map_err(|e| BenchError::Layout(e.into()))?;
     let (mut enc, mut dec, mut write, mut read) = (vec![], vec![], vec![], vec![]);
     let mut bytes = Vec::new();
     let mut buf = vec![0u8; layout_bytes];
@@ -382,16 +423,23 @@ pub async fn clouds(points: usize, messages: usize) -> Result<CloudsReport> {
         })?);
         dec.push(time_us(|| {
             let back: ContactClouds = graspopt_protocol::decode(&bytes, Encoding::Bincode)?;
-            anyhow::ensure!(back.point_count() == points, "decode lost points");
+            if back.point_count() != points {
+                return Err(BenchError::Changed("decode lost points"));
+            }
             Ok(())
         })?);
-        write.push(time_us(|| Ok(layout::write_clouds(&msg, &mut buf)?))?);
+        write.push(time_us(|| {
+            let written = layout::write_clouds(&msg, &mut buf);
+            written.map_err(|e| BenchError::Layout(e.into()))
+        })?);
         let mut back = None;
         read.push(time_us(|| {
-            back = Some(layout::read_clouds(&buf)?);
+            back = Some(layout::read_clouds(&buf).map_err(|e| BenchError::Layout(e.into()))?);
             Ok(())
         })?);
-        anyhow::ensure!(back.as_ref() == Some(&msg), "the layout changed the clouds");
+        if back.as_ref() != Some(&msg) {
+            return Err(BenchError::Changed("the layout changed the clouds"));
+        }
     }
     let m = |v: &[f64]| median(v).unwrap_or(f64::NAN);
     Ok(CloudsReport {

@@ -1,12 +1,15 @@
 //! An agent's settings file: TOML, the agent's settings struct (`HandConfig`, ...), keys left
 //! out keep their defaults and an unknown key is refused by name (the format:
-//! docs/agent-config.md). Flags given on the command line go on top (the binary's job).
+//! docs/agent-config.md); `--set key=value` overrides go on top ([`load_with`]).
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+
+use crate::error::{Boxed, RunnerError};
+
+type Result<T> = std::result::Result<T, RunnerError>;
 
 /// Reads a TOML settings file (defaults when none): keys left out keep their defaults, and a
 /// key the settings do not have is refused, naming the keys of its table (the settings'
@@ -15,20 +18,108 @@ pub fn load<T: DeserializeOwned + Serialize + Default>(path: Option<&Path>) -> R
     let Some(p) = path else {
         return Ok(T::default());
     };
-    let text = std::fs::read_to_string(p)
-        .with_context(|| format!("cannot read the settings file {}", p.display()))?;
-    let context = || format!("settings file {}", p.display());
-    let table: toml::Table = toml::from_str(&text).with_context(context)?;
+    let text = std::fs::read_to_string(p).map_err(|source| RunnerError::ReadSettings {
+        path: p.to_path_buf(),
+        source,
+    })?;
+    let in_file = |source: Boxed| RunnerError::SettingsFile {
+        path: p.to_path_buf(),
+        source,
+    };
+    let table: toml::Table = toml::from_str(&text).map_err(|e| in_file(e.into()))?;
     // Every key, with `null` for the settings that are none by default.
     let known = serde_json::to_value(T::default())?;
-    unknown_key(&table, &known, "")
-        .map_or(Ok(()), |e| Err(anyhow::anyhow!(e)))
-        .with_context(context)?;
-    let settings: T = toml::from_str(&text).with_context(context)?;
+    if let Some(e) = unknown_key(&table, &known, "") {
+        return Err(in_file(e.into()));
+    }
+    let settings: T = toml::from_str(&text).map_err(|e| in_file(e.into()))?;
     match p.parent().filter(|d| !d.as_os_str().is_empty()) {
-        Some(folder) => relative_to(settings, &table, folder).with_context(context),
+        Some(folder) => relative_to(settings, &table, folder).map_err(|e| in_file(e.into())),
         None => Ok(settings),
     }
+}
+
+/// [`load`], then each of `sets` (`key=value`, `--set` on the command line; a dotted key
+/// names a key of a table: `fingertips.noise.force_resolution=0`) on top. The value is read
+/// as TOML (`5`, `0.5`, `true`, `"text"`), or as text when it is not TOML or the setting
+/// is text; the error names the key.
+pub fn load_with<T: DeserializeOwned + Serialize + Default>(
+    path: Option<&Path>,
+    sets: &[String],
+) -> Result<T> {
+    let settings: T = load(path)?;
+    if sets.is_empty() {
+        return Ok(settings);
+    }
+    let known = serde_json::to_value(T::default())?;
+    let mut value = serde_json::to_value(settings)?;
+    for set in sets {
+        value = apply_set::<T>(value, &known, set)?;
+    }
+    Ok(serde_json::from_value(value)?)
+}
+
+/// `value` (the settings as JSON) with `set` (`key=value`) applied; checked against the
+/// settings' type.
+fn apply_set<T: DeserializeOwned>(
+    mut value: serde_json::Value,
+    known: &serde_json::Value,
+    set: &str,
+) -> Result<serde_json::Value> {
+    let (key, text) = set.split_once('=').unwrap_or((set, ""));
+    let refused = |why: String| RunnerError::Set {
+        key: key.to_string(),
+        value: text.to_string(),
+        why,
+    };
+    if !set.contains('=') {
+        return Err(refused("write it as key=value".into()));
+    }
+    let path: Vec<&str> = key.trim().split('.').collect();
+    let mut table = known;
+    for (i, part) in path.iter().enumerate() {
+        let serde_json::Value::Object(keys) = table else {
+            return Err(refused(format!("{} is not a table", path[..i].join("."))));
+        };
+        let Some(inner) = keys.get(*part) else {
+            let unknown = RunnerError::UnknownKey {
+                key: part.to_string(),
+                place: place(&path[..i].join(".")),
+                keys: keys
+                    .keys()
+                    .map(String::as_str)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            };
+            return Err(refused(unknown.to_string()));
+        };
+        table = inner;
+    }
+    let text_value = serde_json::Value::String(text.to_string());
+    let typed = toml_value(text).unwrap_or_else(|| text_value.clone());
+    let mut first_error = None;
+    for candidate in [typed, text_value] {
+        let mut slot = &mut value;
+        for part in &path {
+            slot = &mut slot[*part];
+        }
+        *slot = candidate;
+        match serde_json::from_value::<T>(value.clone()) {
+            Ok(_) => return Ok(value),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(refused(
+        first_error.map_or_else(String::new, |e| e.to_string()),
+    ))
+}
+
+/// `text` read as a TOML value (`None` when it is not one: a bare word, say).
+fn toml_value(text: &str) -> Option<serde_json::Value> {
+    let table: toml::Table = toml::from_str(&format!("v = {text}")).ok()?;
+    serde_json::to_value(table.get("v")?).ok()
 }
 
 /// The settings that name a file: with a relative path in a settings file, the file is
@@ -42,7 +133,7 @@ fn relative_to<T: DeserializeOwned + Serialize>(
     settings: T,
     table: &toml::Table,
     folder: &Path,
-) -> Result<T> {
+) -> std::result::Result<T, serde_json::Error> {
     let mut value = serde_json::to_value(settings)?;
     for key in FILE_KEYS {
         let Some(toml::Value::String(given)) = table.get(key) else {
@@ -54,28 +145,33 @@ fn relative_to<T: DeserializeOwned + Serialize>(
             value[key] = serde_json::Value::String(folder.join(path).display().to_string());
         }
     }
-    Ok(serde_json::from_value(value)?)
+    serde_json::from_value(value)
+}
+
+/// Where a key is, in a message: at the top level, or in the table at `path` (dotted).
+fn place(path: &str) -> String {
+    if path.is_empty() {
+        "at the top level".to_string()
+    } else {
+        format!("in [{path}]")
+    }
 }
 
 /// The first key of `table` (at `path`, a dotted table name, empty at the top) that
-/// `known` (the settings' defaults as JSON) does not have, as a message listing the keys
-/// there; tables are checked recursively where the default is a table too.
-fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Option<String> {
+/// `known` (the settings' defaults as JSON) does not have, naming the keys there; tables
+/// are checked recursively where the default is a table too.
+fn unknown_key(table: &toml::Table, known: &serde_json::Value, path: &str) -> Option<RunnerError> {
     let serde_json::Value::Object(keys) = known else {
         return None;
     };
     for (key, value) in table {
         let Some(default) = keys.get(key) else {
             let names: Vec<&str> = keys.keys().map(String::as_str).collect();
-            let place = if path.is_empty() {
-                "at the top level".to_string()
-            } else {
-                format!("in [{path}]")
-            };
-            return Some(format!(
-                "unknown key `{key}` {place}; the keys there are {}",
-                names.join(", ")
-            ));
+            return Some(RunnerError::UnknownKey {
+                key: key.clone(),
+                place: place(path),
+                keys: names.join(", "),
+            });
         };
         if let toml::Value::Table(inner) = value {
             let inner_path = if path.is_empty() {
@@ -118,7 +214,7 @@ mod tests {
             T: DeserializeOwned + Serialize + Default + PartialEq + std::fmt::Debug,
         {
             let loaded: T = load_text(&format!("{kind}.toml"), &documented(kind))
-                .unwrap_or_else(|e| panic!("{kind}: {e:#}"));
+                .unwrap_or_else(|e| panic!("{kind}: {}", crate::error::chain(&e)));
             assert_eq!(loaded, T::default(), "{kind}");
         }
         check::<graspopt_perception::PerceptionConfig>("perception");
@@ -131,7 +227,7 @@ mod tests {
     #[test]
     fn an_unknown_key_is_refused_with_the_keys_of_its_table() {
         let err = load_text::<graspopt_hand::HandConfig>("h.toml", "trial_cost = 5\n").unwrap_err();
-        let msg = format!("{err:#}");
+        let msg = crate::error::chain(&err);
         assert!(msg.contains("h.toml"), "{msg}");
         assert!(
             msg.contains("unknown key `trial_cost` at the top level"),
@@ -144,7 +240,7 @@ mod tests {
         // In a table, the table's own keys.
         let text = documented("metric").replace("include_palm = true", "include_palms = true");
         let err = load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err();
-        let msg = format!("{err:#}");
+        let msg = crate::error::chain(&err);
         assert!(
             msg.contains("unknown key `include_palms` in [score]"),
             "{msg}"
@@ -154,9 +250,8 @@ mod tests {
             "{msg}"
         );
         let text = documented("metric").replace("resolution = ", "resolutoin = ");
-        let msg = format!(
-            "{:#}",
-            load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err()
+        let msg = crate::error::chain(
+            &load_text::<graspopt_metric::MetricConfig>("m.toml", &text).unwrap_err(),
         );
         assert!(msg.contains("`resolutoin` in [contacts.cloud]"), "{msg}");
         // Keys left out keep their defaults; flags of other kinds are not keys.

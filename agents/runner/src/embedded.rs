@@ -2,11 +2,17 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use graspopt_bus::{Bus, BusArgs, free_loopback_port};
-use graspopt_coordinator::{CoordinatorConfig, RunSpec};
+use graspopt_bus::{Agent, Bus, BusConfig, free_loopback_port};
+use graspopt_coordinator::{CoordinatorAgent, CoordinatorConfig, RunSpec};
+use graspopt_hand::{HandAgent, HandConfig};
+use graspopt_metric::MetricAgent;
+use graspopt_perception::PerceptionAgent;
+use graspopt_planner::{PlannerAgent, PlannerConfig};
 use graspopt_protocol::{RunId, RunStatus};
 use tokio::sync::watch;
+use tokio::task::JoinSet;
+
+use crate::error::RunnerError;
 
 /// Everything one embedded run needs, resolved from flags (`graspopt run` builds it).
 pub struct Embedded {
@@ -17,9 +23,9 @@ pub struct Embedded {
     pub resume: bool,
     pub perception: graspopt_perception::PerceptionConfig,
     pub metric: graspopt_metric::MetricConfig,
-    pub hand: graspopt_hand::HandConfig,
+    pub hand: HandConfig,
     pub coordinator: CoordinatorConfig,
-    pub bus: BusArgs,
+    pub bus: BusConfig,
     /// The trials as simulated here (for the pictures of the results).
     pub evaluator: graspopt_trial::Evaluator,
 }
@@ -27,7 +33,7 @@ pub struct Embedded {
 /// The bus of an embedded run: unless `bus` names an endpoint or a Zenoh configuration, a free
 /// loopback port with multicast scouting off (no other run on the network hears it); unless
 /// it names a shared-memory prefix, one of this run and this process.
-pub fn own_bus(mut bus: BusArgs, run: &RunId) -> Result<BusArgs> {
+pub fn own_bus(mut bus: BusConfig, run: &RunId) -> Result<BusConfig, RunnerError> {
     if bus.listen.is_empty() && bus.connect.is_empty() && bus.zenoh_config.is_none() {
         bus.listen = vec![format!("tcp/127.0.0.1:{}", free_loopback_port()?)];
         bus.no_multicast_scouting = true;
@@ -47,53 +53,52 @@ pub fn own_bus(mut bus: BusArgs, run: &RunId) -> Result<BusArgs> {
 pub async fn run_embedded(
     e: &Embedded,
     progress: Option<watch::Sender<RunStatus>>,
-) -> Result<RunStatus> {
+) -> Result<RunStatus, RunnerError> {
     // Before anything is written: a run refused for its open-file limit leaves no trace.
     crate::open_files::ensure(e.workers)?;
-    std::fs::create_dir_all(&e.out)
-        .with_context(|| format!("cannot create the results folder {}", e.out.display()))?;
+    std::fs::create_dir_all(&e.out).map_err(|source| RunnerError::CreateFolder {
+        path: e.out.clone(),
+        source,
+    })?;
     let bus = Bus::open(&e.bus).await?;
-    let mut tasks = tokio::task::JoinSet::new();
-    {
-        let (b, r, c) = (bus.clone(), e.run.clone(), e.perception.clone());
-        tasks.spawn(async move { graspopt_perception::run(&b, &r, &c).await });
-    }
-    {
-        let (b, r) = (bus.clone(), e.run.clone());
-        tasks.spawn(async move {
-            graspopt_planner::run(&b, &r, &graspopt_planner::PlannerConfig::default()).await
-        });
-    }
-    {
-        let (b, r, c) = (bus.clone(), e.run.clone(), e.metric.clone());
-        tasks.spawn(async move { graspopt_metric::run(&b, &r, &c).await });
-    }
+    let mut tasks = JoinSet::new();
+    spawn(
+        &mut tasks,
+        PerceptionAgent,
+        &bus,
+        &e.run,
+        e.perception.clone(),
+    );
+    spawn(
+        &mut tasks,
+        PlannerAgent,
+        &bus,
+        &e.run,
+        PlannerConfig::default(),
+    );
+    spawn(&mut tasks, MetricAgent, &bus, &e.run, e.metric.clone());
     for i in 1..=e.workers {
-        let (b, r) = (bus.clone(), e.run.clone());
-        let c = graspopt_hand::HandConfig {
+        let hand = HandConfig {
             id: format!("hand-{i}"),
             ..e.hand.clone()
         };
-        tasks.spawn(async move { graspopt_hand::run(&b, &r, &c).await });
+        spawn(&mut tasks, HandAgent, &bus, &e.run, hand);
     }
-    // Ctrl-C (or SIGTERM) stops the run cleanly: the journal records it as stopped.
-    let coordinator = graspopt_coordinator::run_until(
-        &bus,
-        &e.run,
-        &e.spec,
-        &e.coordinator,
-        e.resume,
+    let coordinator = CoordinatorAgent {
+        spec: e.spec.clone(),
+        resume: e.resume,
         progress,
-        crate::signal::shutdown_signal(),
-    );
+    };
+    // Ctrl-C (or SIGTERM) stops the run cleanly: the journal records it as stopped.
+    let stop = crate::signal::shutdown_signal();
     let status = tokio::select! {
-        s = coordinator => s,
+        s = coordinator.run(&bus, &e.run, &e.coordinator, stop) => s.map_err(RunnerError::agent),
         Some(agent) = tasks.join_next() => {
             // An agent stopped before the run finished: that is an error.
             match agent {
-                Ok(Ok(())) => Err(anyhow::anyhow!("an agent stopped before the run finished")),
+                Ok(Ok(())) => Err(RunnerError::AgentStopped),
                 Ok(Err(err)) => Err(err),
-                Err(join) => Err(anyhow::anyhow!("an agent panicked: {join}")),
+                Err(join) => Err(RunnerError::AgentPanicked(join)),
             }
         }
     };
@@ -101,6 +106,21 @@ pub async fn run_embedded(
     while tasks.join_next().await.is_some() {}
     let _ = bus.close().await;
     status
+}
+
+/// Starts `agent` as a task of `tasks`, serving `run` on `bus` with `config` until aborted.
+fn spawn<A: Agent + 'static>(
+    tasks: &mut JoinSet<Result<(), RunnerError>>,
+    agent: A,
+    bus: &Bus,
+    run: &RunId,
+    config: A::Config,
+) {
+    let (bus, run) = (bus.clone(), run.clone());
+    tasks.spawn(async move {
+        let served = agent.run(&bus, &run, &config, std::future::pending());
+        served.await.map(drop).map_err(RunnerError::agent)
+    });
 }
 
 /// The status before the coordinator's first one.

@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
 use graspopt_journal::{FailureReason, Journal};
 use graspopt_protocol::text::rounded;
-use graspopt_protocol::{RunPhase, RunStatus, named_params};
+use graspopt_protocol::{BestTrial, RunPhase, RunStatus, named_params};
+
+use crate::error::RunnerError;
 
 /// Exit status of a run that spent its budget without completing a single trial (every
 /// trial failed): the lines printed say why.
@@ -30,14 +31,12 @@ pub struct RunEnd {
 impl RunEnd {
     /// The end of the run whose final status is `status`, with the failure reasons of the
     /// journal at `journal`.
-    pub fn read(status: RunStatus, journal: &Path) -> Result<RunEnd> {
+    pub fn read(status: RunStatus, journal: &Path) -> Result<RunEnd, RunnerError> {
         let failures = Journal::open_existing(journal)
             .and_then(|j| j.failure_reasons(status.run_id.as_str()))
-            .with_context(|| {
-                format!(
-                    "cannot read why trials failed from the journal {}",
-                    journal.display()
-                )
+            .map_err(|source| RunnerError::Failures {
+                journal: journal.to_path_buf(),
+                source,
             })?;
         Ok(RunEnd { status, failures })
     }
@@ -78,18 +77,28 @@ impl RunEnd {
                 b.trial_id,
                 rounded(b.score),
                 named_params(&s.param_names, &b.params, ","),
-                if b.force_closure == Some(true) {
-                    ", force closure"
-                } else {
-                    ""
-                }
+                closure(b)
             ));
         }
         out
     }
 
+    /// The lines of an embedded run whose results are in `out`: [`RunEnd::lines`], saying
+    /// how to go on when it was stopped, then where the results are.
+    pub fn embedded_lines(&self, out: &Path) -> Vec<String> {
+        let s = &self.status;
+        let then = if s.completed + s.failed + s.running == 0 {
+            " (stopped before its first trial: the same command starts it afresh)".to_string()
+        } else {
+            format!(" (stopped; continue with --resume --out {})", out.display())
+        };
+        let mut lines = self.lines(&then);
+        lines.push(format!("results: {}", out.display()));
+        lines
+    }
+
     /// The final status as JSON, with `failures`: `[{"reason": ..., "trials": n}, ...]`.
-    pub fn json(&self) -> Result<serde_json::Value> {
+    pub fn json(&self) -> Result<serde_json::Value, serde_json::Error> {
         let mut v = serde_json::to_value(&self.status)?;
         if let Some(map) = v.as_object_mut() {
             map.insert("failures".into(), serde_json::to_value(&self.failures)?);
@@ -100,6 +109,25 @@ impl RunEnd {
 
 /// `failed: N × reason` for one reason; `failed:` and a line per reason for several (the
 /// first [`SHOWN_REASONS`], then the others summed).
+/// The progress of a run's best trial so far: `best 0.5 (trial 3), force closure`.
+pub fn best_so_far(b: &BestTrial) -> String {
+    format!(
+        "best {} (trial {}){}",
+        rounded(b.score),
+        b.trial_id,
+        closure(b)
+    )
+}
+
+/// `, force closure` for a best trial in force closure.
+fn closure(b: &BestTrial) -> &'static str {
+    if b.force_closure == Some(true) {
+        ", force closure"
+    } else {
+        ""
+    }
+}
+
 fn failure_lines(failures: &[FailureReason]) -> Vec<String> {
     match failures {
         [] => Vec::new(),

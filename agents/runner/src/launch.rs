@@ -26,10 +26,14 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
+use graspopt_protocol::AgentKind;
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use serde::Deserialize;
+
+use crate::error::RunnerError;
+
+type Result<T> = std::result::Result<T, RunnerError>;
 
 /// A launch file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -88,6 +92,32 @@ fn one() -> u32 {
 }
 
 impl AgentEntry {
+    /// Why this entry cannot be launched: an unknown kind, or a count out of range.
+    fn check(&self) -> std::result::Result<(), String> {
+        if AgentKind::parse(&self.kind).is_none() {
+            let kinds: Vec<&str> = AgentKind::ALL.iter().map(|k| k.as_str()).collect();
+            return Err(format!(
+                "unknown agent kind {:?} (one of {})",
+                self.kind,
+                kinds.join(", ")
+            ));
+        }
+        if self.count == 0 {
+            return Err(format!("agent {:?} has count 0", self.kind));
+        }
+        // As many hands as one process may run (`graspopt run --workers`): the host's
+        // shared-memory service admits no more.
+        if self.count as usize > graspopt_shm::DEFAULT_MAX_PUBLISHERS {
+            return Err(format!(
+                "agent {:?} has count {}, more than the {} processes of one kind a machine runs",
+                self.kind,
+                self.count,
+                graspopt_shm::DEFAULT_MAX_PUBLISHERS
+            ));
+        }
+        Ok(())
+    }
+
     /// The ids of this entry's processes: the id (default: the kind), or `<id>-1` ...
     /// `<id>-<count>` for several.
     fn names(&self) -> Vec<String> {
@@ -99,8 +129,6 @@ impl AgentEntry {
         }
     }
 }
-
-const KINDS: [&str; 5] = ["perception", "hand", "metric", "planner", "coordinator"];
 
 /// One process to start.
 #[derive(Debug, Clone, PartialEq)]
@@ -116,71 +144,49 @@ pub struct Planned {
 
 impl LaunchFile {
     pub fn parse(text: &str, origin: &Path) -> Result<LaunchFile> {
-        let file: LaunchFile =
-            toml::from_str(text).with_context(|| format!("launch file {}", origin.display()))?;
-        graspopt_protocol::RunId::new(&file.run)
-            .with_context(|| format!("launch file {}: run", origin.display()))?;
-        graspopt_bus::args::check_endpoint(
-            &file.endpoint,
-            graspopt_bus::args::EndpointUse::Connect,
-        )
-        .with_context(|| format!("launch file {}", origin.display()))?;
-        for a in &file.agents {
-            if !KINDS.contains(&a.kind.as_str()) {
-                bail!(
-                    "launch file {}: unknown agent kind {:?} (one of {})",
-                    origin.display(),
-                    a.kind,
-                    KINDS.join(", ")
-                );
-            }
-            if a.count == 0 {
-                bail!(
-                    "launch file {}: agent {:?} has count 0",
-                    origin.display(),
-                    a.kind
-                );
-            }
-            // As many hands as one process may run (`graspopt run --workers`): the host's
-            // shared-memory service admits no more.
-            if a.count as usize > graspopt_shm::DEFAULT_MAX_PUBLISHERS {
-                bail!(
-                    "launch file {}: agent {:?} has count {}, more than the {} processes of \
-                     one kind a machine runs",
-                    origin.display(),
-                    a.kind,
-                    a.count,
-                    graspopt_shm::DEFAULT_MAX_PUBLISHERS
-                );
-            }
+        let file = origin.to_path_buf();
+        let invalid = |source: crate::error::Boxed| RunnerError::LaunchFileInvalid {
+            file: file.clone(),
+            source,
+        };
+        let refused = |why: String| RunnerError::LaunchFile {
+            file: file.clone(),
+            why,
+        };
+        let launch: LaunchFile = toml::from_str(text).map_err(|e| invalid(e.into()))?;
+        graspopt_protocol::RunId::new(&launch.run).map_err(|source| RunnerError::LaunchRun {
+            file: file.clone(),
+            source,
+        })?;
+        let connect = graspopt_bus::config::EndpointUse::Connect;
+        graspopt_bus::config::check_endpoint(&launch.endpoint, connect)
+            .map_err(|e| invalid(e.into()))?;
+        for a in &launch.agents {
+            a.check().map_err(refused)?;
         }
         let mut names = std::collections::HashSet::new();
-        for a in &file.agents {
+        for a in &launch.agents {
             for name in a.names() {
                 // The id names the agent on the bus and its log file.
-                graspopt_protocol::keys::check_agent_id(&name)
-                    .with_context(|| format!("launch file {}", origin.display()))?;
+                graspopt_protocol::keys::check_agent_id(&name).map_err(|e| invalid(e.into()))?;
                 if !names.insert(name.clone()) {
-                    bail!(
-                        "launch file {}: two agents named {name:?} (ids are unique in a run, across hosts)",
-                        origin.display()
-                    );
+                    return Err(refused(format!(
+                        "two agents named {name:?} (ids are unique in a run, across hosts)"
+                    )));
                 }
             }
         }
-        if file
+        let coordinator = AgentKind::Coordinator.as_str();
+        if launch
             .agents
             .iter()
-            .filter(|a| a.kind == "coordinator")
+            .filter(|a| a.kind == coordinator)
             .count()
             > 1
         {
-            bail!(
-                "launch file {}: a run has one coordinator",
-                origin.display()
-            );
+            return Err(refused("a run has one coordinator".into()));
         }
-        Ok(file)
+        Ok(launch)
     }
 
     /// The processes `host` runs, in start order. Paths are resolved against `base` (the
@@ -231,7 +237,7 @@ impl LaunchFile {
                 args.extend(a.args.iter().cloned());
                 out.push(Planned {
                     name,
-                    coordinator: a.kind == "coordinator",
+                    coordinator: a.kind == AgentKind::Coordinator.as_str(),
                     args,
                     wait_addr: None,
                 });
@@ -241,13 +247,47 @@ impl LaunchFile {
     }
 }
 
+/// The launch file at `path` and the processes this machine, `host`, runs of it, in start
+/// order; `endpoint` replaces the file's router endpoint (a router in the file then listens
+/// on it); with `resume`, the coordinator resumes its run. An error if nothing runs here.
+pub fn prepare(
+    path: &Path,
+    host: &str,
+    endpoint: Option<&str>,
+    resume: bool,
+) -> Result<(LaunchFile, Vec<Planned>)> {
+    let text = std::fs::read_to_string(path).map_err(|source| RunnerError::LaunchRead {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let mut file = LaunchFile::parse(&text, path)?;
+    if let Some(e) = endpoint {
+        file.endpoint = e.to_string();
+        if let Some(r) = &mut file.router {
+            r.listen = None;
+        }
+    }
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut plan = file.plan(host, &base)?;
+    if plan.is_empty() {
+        return Err(RunnerError::LaunchFile {
+            file: path.to_path_buf(),
+            why: format!("nothing runs on host {host:?} (use --host to pick an entry's host)"),
+        });
+    }
+    if resume {
+        resume_coordinator(&mut plan, host)?;
+    }
+    Ok((file, plan))
+}
+
 /// Makes the coordinator of `plan` resume its run (`--resume`, once). An error if `plan`
 /// has no coordinator: only the machine that runs it can resume the run.
 pub fn resume_coordinator(plan: &mut [Planned], host: &str) -> Result<()> {
     let Some(c) = plan.iter_mut().find(|p| p.coordinator) else {
-        bail!(
-            "--resume: no coordinator runs on host {host:?}; resume the run on the machine that runs the coordinator"
-        );
+        return Err(RunnerError::NoCoordinatorHere {
+            host: host.to_string(),
+        });
     };
     if !c.args.iter().any(|a| a == "--resume") {
         c.args.push("--resume".into());
@@ -298,6 +338,46 @@ pub enum Outcome {
     Interrupted,
 }
 
+impl Outcome {
+    /// How a launch of `file` that ended so ends: its exit status and what to say (the
+    /// coordinator's end, or a Ctrl-C), or the error of a process that stopped first.
+    pub fn ending(self, file: &Path) -> Result<(u8, Option<String>)> {
+        match self {
+            Outcome::Coordinator(Some(0), _) => Ok((0, None)),
+            Outcome::Coordinator(code, log) => {
+                let log = log.unwrap_or_default();
+                let no_trial = i32::from(crate::ending::NO_TRIAL_COMPLETED);
+                let what = if code == Some(no_trial) {
+                    "no trial of the run completed"
+                } else {
+                    "the coordinator failed"
+                };
+                let said = format!(
+                    "graspopt launch: {what}; the coordinator's log ({}):\n{}",
+                    log.display(),
+                    tail(&log, 20)
+                );
+                // Its exit status is launch's (1 if it was killed by a signal).
+                let code = code.and_then(|c| u8::try_from(c).ok()).unwrap_or(1);
+                Ok((code, Some(said)))
+            }
+            Outcome::Died(name, status, log) => Err(RunnerError::Died {
+                name,
+                status,
+                tail: tail(&log, 20),
+                log,
+            }),
+            Outcome::Interrupted => Ok((
+                130,
+                Some(format!(
+                    "graspopt launch: interrupted, every process stopped; continue the run with graspopt launch --resume {}",
+                    file.display()
+                )),
+            )),
+        }
+    }
+}
+
 impl Children {
     /// Starts `plan` in order: `exe` with each process's arguments, stderr to
     /// `<logs>/<name>.log`, stdout passed through; after the router, waits (at most 20 s)
@@ -308,20 +388,27 @@ impl Children {
         logs: &Path,
         mut started: impl FnMut(&str, &Path),
     ) -> Result<Children> {
-        std::fs::create_dir_all(logs)
-            .with_context(|| format!("cannot create the log folder {}", logs.display()))?;
+        std::fs::create_dir_all(logs).map_err(|source| RunnerError::LogFolder {
+            path: logs.to_path_buf(),
+            source,
+        })?;
         let mut children = Children(Vec::new());
         for p in plan {
             let log = logs.join(format!("{}.log", p.name));
-            let err = std::fs::File::create(&log)
-                .with_context(|| format!("cannot create {}", log.display()))?;
+            let err = std::fs::File::create(&log).map_err(|source| RunnerError::Create {
+                path: log.clone(),
+                source,
+            })?;
             let child = Command::new(exe)
                 .args(&p.args)
                 .stdin(Stdio::null())
                 .stderr(err)
                 .process_group(0)
                 .spawn()
-                .with_context(|| format!("cannot start {}", p.name))?;
+                .map_err(|source| RunnerError::Start {
+                    name: p.name.clone(),
+                    source,
+                })?;
             started(&p.name, &log);
             children.0.push(Running {
                 name: p.name.clone(),
@@ -334,7 +421,8 @@ impl Children {
                 let start = Instant::now();
                 while std::net::TcpStream::connect(addr.as_str()).is_err() {
                     if start.elapsed() > Duration::from_secs(20) {
-                        bail!("the router does not accept connections on {addr} after 20 s");
+                        let addr = addr.clone();
+                        return Err(RunnerError::RouterSilent { addr });
                     }
                     std::thread::sleep(Duration::from_millis(20));
                 }
@@ -518,7 +606,7 @@ mod tests {
             .chain(&file.plan("robot-pc", base).unwrap())
         {
             if let Some(w) = p.args.windows(2).find(|w| w[0] == "--zenoh-config") {
-                let bus = graspopt_bus::BusArgs {
+                let bus = graspopt_bus::BusConfig {
                     zenoh_config: Some(PathBuf::from(&w[1])),
                     ..Default::default()
                 };
@@ -551,7 +639,7 @@ mod tests {
     #[test]
     fn bad_launch_files_name_the_problem() {
         let origin = Path::new("x.toml");
-        let err = |t: &str| format!("{:#}", LaunchFile::parse(t, origin).unwrap_err());
+        let err = |t: &str| crate::error::chain(&LaunchFile::parse(t, origin).unwrap_err());
         assert!(err("run = \"a b\"\nendpoint = \"tcp/h:1\"").contains("run"));
         assert!(err("run = \"r\"\nendpoint = \"h:1\"").contains("no protocol"));
         let e = err("run = \"r\"\nendpoint = \"tcp/h:1\"\n[[agent]]\nkind = \"gripper\"");

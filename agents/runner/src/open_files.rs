@@ -8,7 +8,9 @@
 //! far from the cause. So a run raises its soft limit up to the hard one when it needs more,
 //! and refuses to start, naming both numbers, when even the hard limit is too low.
 
-use anyhow::{Result, bail};
+use crate::error::RunnerError;
+
+type Result<T> = std::result::Result<T, RunnerError>;
 use nix::sys::resource::{Resource, getrlimit, setrlimit};
 
 /// Descriptors of an embedded run apart from its hand workers (the Zenoh session, the
@@ -49,12 +51,13 @@ pub fn ensure(workers: usize) -> Result<Limit> {
 fn check(workers: usize, need: u64, soft: u64, hard: u64) -> Result<()> {
     if hard < need {
         let most = hard.saturating_sub(BASE) / PER_WORKER;
-        bail!(
-            "--workers {workers} needs about {need} open files, and this process may open at \
-             most {hard} (ulimit -Hn; soft limit {soft}): use at most {most} workers, raise \
-             the limit (ulimit -n {need}, or LimitNOFILE= in a systemd unit), or run the \
-             hands as separate processes (graspopt launch, graspopt agent hand)"
-        );
+        return Err(RunnerError::OpenFiles {
+            workers,
+            need,
+            hard,
+            soft,
+            most,
+        });
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! Recordings for the replay hand (`graspopt record`): a grid of simulated grasps written as
-//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --replay` and the Python
-//! hands answer trials from, standing in for a robot's logged data.
+//! JSON lines ([`RecordedTrial`]), the format `graspopt agent hand --set replay=FILE` and the
+//! Python hands answer trials from, standing in for a robot's logged data.
 //!
 //! With [`Sensing::Clouds`] each line holds the grasp's raw contact clouds and its score.
 //! With [`Sensing::Ft`] it holds what force/torque sensors under the fingertips read
@@ -11,14 +11,18 @@
 
 use std::io::Write;
 
-use anyhow::{Context, Result, bail};
+use crate::error::RunnerError;
+
+type Result<T> = std::result::Result<T, RunnerError>;
 use graspopt_convert::{TrialTag, clouds_from_outcome, fingertip_wrench, isometry};
 use graspopt_hand::Sensing;
 use graspopt_hand::replay::RecordedTrial;
 use graspopt_protocol::{FingertipWrenches, RunId};
 use graspopt_sim::{TrialOutcome, run_trial};
 use graspopt_trial::Evaluator;
-use graspopt_trial::fingertips::{FingertipSettings, fingertip_score, simulate_readings};
+use graspopt_trial::fingertips::{
+    FingertipSettings, fingertip_score, fingertips, simulate_readings,
+};
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
 use rand_chacha::ChaCha8Rng;
@@ -28,13 +32,61 @@ use rand_chacha::rand_core::SeedableRng;
 /// say): writing the recording would replace it.
 pub fn refuse_database(out: &std::path::Path) -> Result<()> {
     if graspopt_journal::output::holds_database(out) {
-        bail!(
-            "{} is an SQLite database (a run's journal?): a recording would replace it; \
-             write it elsewhere",
-            out.display()
-        );
+        return Err(RunnerError::Database {
+            path: out.to_path_buf(),
+        });
     }
     Ok(())
+}
+
+/// The fingertip sensors of a recording of `sensing` by `hand`: the default noise, or the
+/// resolutions given, which only [`Sensing::Ft`] takes.
+pub fn fingertip_settings(
+    sensing: Sensing,
+    hand: &str,
+    force_resolution: Option<f64>,
+    torque_resolution: Option<f64>,
+) -> Result<FingertipSettings> {
+    let mut tips = FingertipSettings::default();
+    if sensing != Sensing::Ft {
+        if force_resolution.is_some() || torque_resolution.is_some() {
+            return Err(RunnerError::NeedsFt);
+        }
+        return Ok(tips);
+    }
+    let noise = &mut tips.noise;
+    noise.force_resolution = force_resolution.unwrap_or(noise.force_resolution);
+    noise.torque_resolution = torque_resolution.unwrap_or(noise.torque_resolution);
+    noise.validate().map_err(|e| RunnerError::Flags {
+        flags: "--force-resolution / --torque-resolution",
+        source: e.into(),
+    })?;
+    let hand = graspopt_sim::hand_by_name(hand)?;
+    fingertips(hand.as_ref()).map_err(|e| RunnerError::Flags {
+        flags: "--sensing ft",
+        source: e.into(),
+    })?;
+    Ok(tips)
+}
+
+/// Records the grid `axes` (see [`record_grid`]) to the file `out`, its folder created;
+/// returns how many grasps.
+pub fn write_recording(
+    out: &std::path::Path,
+    ev: &Evaluator,
+    axes: &[Vec<f64>],
+    sensing: Sensing,
+    tips: &FingertipSettings,
+) -> Result<usize> {
+    let create = |path: &std::path::Path| {
+        let path = path.to_path_buf();
+        move |source| RunnerError::Create { path, source }
+    };
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(create(dir))?;
+    }
+    let file = std::fs::File::create(out).map_err(create(out))?;
+    record_grid(ev, axes, sensing, tips, &mut std::io::BufWriter::new(file))
 }
 
 /// The tag of every recorded grasp (a recording belongs to no run).
@@ -60,10 +112,13 @@ pub fn record_grid(
     let total: usize = axes.iter().map(Vec::len).product();
     for flat in 0..total {
         let params = graspopt_trial::scan::grid_point(axes, flat);
-        let at = || format!("grasp at {params:?}");
+        let at = |e: RunnerError| RunnerError::Grasp {
+            params: params.clone(),
+            source: Box::new(e),
+        };
         let trial = match sensing {
             Sensing::Clouds => {
-                let e = ev.evaluate(&params).with_context(at)?;
+                let e = ev.evaluate(&params).map_err(|e| at(e.into()))?;
                 let clouds = clouds_from_outcome(&tag, &e.outcome, 0);
                 RecordedTrial {
                     params,
@@ -78,7 +133,7 @@ pub fn record_grid(
             }
             Sensing::Ft => {
                 let mut rng = ChaCha8Rng::seed_from_u64(flat as u64);
-                fingertip_trial(ev, params.clone(), tips, &mut rng).with_context(at)?
+                fingertip_trial(ev, params.clone(), tips, &mut rng).map_err(at)?
             }
         };
         trial.write_line(out)?;
@@ -117,7 +172,7 @@ pub fn fingertip_trial(
     };
     let (scored, _) = graspopt_metric::score_wrenches(&readings, &ev.object, &config);
     if let Some(e) = scored.error {
-        bail!("the metric agent cannot score its fingertip readings: {e}");
+        return Err(RunnerError::FingertipScore(e));
     }
     let truth: Vec<_> = simulated
         .iter()

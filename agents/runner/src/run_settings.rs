@@ -4,8 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use graspopt_bus::BusArgs;
+use graspopt_bus::BusConfig;
 use graspopt_coordinator::{Conflicts, CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId};
 use graspopt_sim::{ContactModel, ParamKind};
@@ -13,6 +12,9 @@ use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 use serde::{Deserialize, Serialize};
 
 use crate::embedded::{Embedded, own_bus};
+use crate::error::RunnerError;
+
+type Result<T> = std::result::Result<T, RunnerError>;
 
 /// An embedded run's settings. `explicit(name)` in [`RunSettings::resolve`] names them by
 /// these field names (and the [`TrialSettings`] field names; `range` for its `ranges`).
@@ -47,7 +49,7 @@ pub struct RunSettings {
     pub position_noise: f64,
     /// Perception's orientation error, standard deviation per axis (radians).
     pub rotation_noise: f64,
-    pub bus: BusArgs,
+    pub bus: BusConfig,
 }
 
 impl Default for RunSettings {
@@ -68,7 +70,7 @@ impl Default for RunSettings {
             lease_ms: 30_000,
             position_noise: 0.0,
             rotation_noise: 0.0,
-            bus: BusArgs::default(),
+            bus: BusConfig::default(),
         }
     }
 }
@@ -199,24 +201,30 @@ impl RecordedSettings {
         s.trial.mesh = self.mesh.clone();
         s.trial.mesh_scale = self.mesh_scale;
         if let Some(file) = self.hand_file.as_ref().filter(|_| !explicit("hand")) {
-            anyhow::ensure!(
-                file.exists(),
-                "run {run:?}: its hand's file {} is gone: give --hand FILE where it is now",
-                file.display()
-            );
+            if !file.exists() {
+                return Err(RunnerError::HandFileGone {
+                    run: run.clone(),
+                    file: file.clone(),
+                });
+            }
             s.trial.hand = file.display().to_string();
         }
+        let recorded = |what: String, source: Option<crate::error::Boxed>| RunnerError::Recorded {
+            run: run.clone(),
+            what,
+            source,
+        };
         s.sensing = match &self.sensing {
             None => graspopt_hand::Sensing::Clouds,
             Some(name) => graspopt_hand::Sensing::parse(name)
-                .with_context(|| format!("run {run:?}: recorded sensing {name:?}"))?,
+                .ok_or_else(|| recorded(format!("sensing {name:?}"), None))?,
         };
         s.trial.contacts = ContactModel::parse(&self.contacts)
-            .with_context(|| format!("run {run:?}: recorded contact model"))?;
+            .map_err(|e| recorded("contact model".into(), Some(e.into())))?;
         s.trial.metric =
-            Metric::parse(&self.metric).with_context(|| format!("run {run:?}: recorded metric"))?;
+            Metric::parse(&self.metric).map_err(|e| recorded("metric".into(), Some(e.into())))?;
         s.trial.frame = ReferenceFrame::parse(&self.frame)
-            .with_context(|| format!("run {run:?}: recorded frame"))?;
+            .map_err(|e| recorded("frame".into(), Some(e.into())))?;
         s.trial.torque_scale = self.torque_scale;
         s.position_noise = self.position_noise;
         s.rotation_noise = self.rotation_noise;
@@ -267,7 +275,8 @@ impl RunSettings {
         // Resuming the run of a folder's journal: its id need not be given.
         if self.resume
             && !explicit("run")
-            && let Some(only) = graspopt_coordinator::sole_run(&out.join("journal.sqlite"))?
+            && let Some(only) = graspopt_coordinator::sole_run(&out.join("journal.sqlite"))
+                .map_err(RunnerError::agent)?
         {
             run = only;
         }
@@ -283,15 +292,13 @@ impl RunSettings {
     }
 
     fn assemble(&self, run: RunId, out: PathBuf) -> Result<Embedded> {
-        anyhow::ensure!(
-            self.workers <= graspopt_shm::DEFAULT_MAX_PUBLISHERS,
-            "--workers {} is more than the {} hand workers one process runs (the capacity of a \
-             host's shared-memory clouds service): run more hands as separate processes or on \
-             other hosts (graspopt launch, graspopt agent hand)",
-            self.workers,
-            graspopt_shm::DEFAULT_MAX_PUBLISHERS
-        );
-        graspopt_coordinator::check_trials(self.trials)?;
+        if self.workers > graspopt_shm::DEFAULT_MAX_PUBLISHERS {
+            return Err(RunnerError::TooManyWorkers {
+                workers: self.workers,
+                max: graspopt_shm::DEFAULT_MAX_PUBLISHERS,
+            });
+        }
+        graspopt_coordinator::check_trials(self.trials).map_err(RunnerError::agent)?;
         let evaluator = Evaluator::from_settings(&self.trial, &self.params)?;
         let object = evaluator.object.name().to_string();
         let bus = own_bus(self.bus.clone(), &run)?;
@@ -311,23 +318,20 @@ impl RunSettings {
             ..Default::default()
         };
         // Checked before anything is written, so a refused run leaves no trace.
-        anyhow::ensure!(
-            (1..=graspopt_coordinator::MAX_WAIT_MS).contains(&self.lease_ms),
-            "--lease-ms is {}: it must be between 1 and {} (a week)",
-            self.lease_ms,
-            graspopt_coordinator::MAX_WAIT_MS
-        );
+        if !(1..=graspopt_coordinator::MAX_WAIT_MS).contains(&self.lease_ms) {
+            return Err(RunnerError::Lease {
+                lease_ms: self.lease_ms,
+                max: graspopt_coordinator::MAX_WAIT_MS,
+            });
+        }
         // A trial that outlasts its lease is re-issued before it can end, again and again.
-        anyhow::ensure!(
-            self.trial_cost_ms < self.lease_ms,
-            "--trial-cost-ms {} is not shorter than the lease of a trial (--lease-ms {}): every \
-             trial would expire before it ends and be issued again forever; raise --lease-ms",
-            self.trial_cost_ms,
-            self.lease_ms
-        );
-        perception
-            .validate()
-            .map_err(|e| anyhow::anyhow!("{e:#}").context("--position-noise / --rotation-noise"))?;
+        if self.trial_cost_ms >= self.lease_ms {
+            return Err(RunnerError::TrialCost {
+                trial_cost_ms: self.trial_cost_ms,
+                lease_ms: self.lease_ms,
+            });
+        }
+        perception.validate().map_err(RunnerError::Noise)?;
         Ok(Embedded {
             // The run's ranges are recorded with it (a resumed run keeps them).
             spec: self.spec(
@@ -367,24 +371,18 @@ impl RunSettings {
     ) -> Result<RunSettings> {
         let journal = out.join("journal.sqlite");
         if !journal.exists() {
-            bail!(
-                "no journal at {}: there is nothing to resume (start the run without --resume)",
-                journal.display()
-            );
+            return Err(RunnerError::NoJournal { journal });
         }
-        let Some(recorded) = graspopt_coordinator::recorded_spec(&journal, run)? else {
-            let runs = graspopt_coordinator::recorded_runs(&journal)?;
+        let recorded =
+            graspopt_coordinator::recorded_spec(&journal, run).map_err(RunnerError::agent)?;
+        let Some(recorded) = recorded else {
+            let runs = graspopt_coordinator::recorded_runs(&journal).map_err(RunnerError::agent)?;
+            let run = run.clone();
             if runs.is_empty() {
-                bail!(
-                    "run {run:?} is not in {}: there is nothing to resume (start it without --resume)",
-                    journal.display()
-                );
+                return Err(RunnerError::NotRecorded { run, journal });
             }
-            bail!(
-                "run {run:?} is not in {}, which holds run {}: resume one of those (--run ID, or no --run if there is one), or start {run:?} without --resume",
-                journal.display(),
-                graspopt_coordinator::quoted_runs(&runs),
-            );
+            let runs = graspopt_coordinator::quoted_runs(&runs);
+            return Err(RunnerError::OtherRuns { run, journal, runs });
         };
         let hand = graspopt_sim::hand_name(&self.trial.hand)?;
         let mut given = self.spec(self.trial.object.clone(), hand, recorded.bounds.clone())?;
@@ -402,9 +400,10 @@ impl RunSettings {
             conflicts.0.extend(contrary);
         }
         if let Some(e) = conflicts.into_error(run) {
-            return Err(e);
+            return Err(RunnerError::agent(e));
         }
-        let spec = graspopt_coordinator::reconcile(run, &recorded, &given, explicit)?;
+        let spec = graspopt_coordinator::reconcile(run, &recorded, &given, explicit)
+            .map_err(RunnerError::agent)?;
         let mut s = self.clone();
         s.run = run.as_str().to_string();
         // The recorded name; a hand given again (a file moved, say) is taken as given: its
@@ -432,19 +431,18 @@ impl RunSettings {
 /// Refuses a new run in a results folder whose journal holds other runs: their
 /// `trials.csv`, `trials.json` and `best.svg` would be overwritten.
 fn check_folder_is_free(out: &Path, run: &RunId) -> Result<()> {
-    let others: Vec<String> = graspopt_coordinator::recorded_runs(&out.join("journal.sqlite"))?
+    let others: Vec<String> = graspopt_coordinator::recorded_runs(&out.join("journal.sqlite"))
+        .map_err(RunnerError::agent)?
         .into_iter()
         .filter(|id| id != run.as_str())
         .collect();
     if !others.is_empty() {
-        bail!(
-            "the results folder {} holds run {} already (its trials.csv, trials.json and best.svg would be overwritten): choose another --out, or resume {} with --resume --out {}{}",
-            out.display(),
-            graspopt_coordinator::quoted_runs(&others),
-            if others.len() == 1 { "it" } else { "one" },
-            out.display(),
-            if others.len() == 1 { "" } else { " --run ID" }
-        );
+        return Err(RunnerError::FolderTaken {
+            out: out.to_path_buf(),
+            runs: graspopt_coordinator::quoted_runs(&others),
+            it: if others.len() == 1 { "it" } else { "one" },
+            run_flag: if others.len() == 1 { "" } else { " --run ID" },
+        });
     }
     Ok(())
 }

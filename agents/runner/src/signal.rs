@@ -36,13 +36,3 @@ pub fn shutdown_signal() -> impl Future<Output = ()> + Send + 'static {
         }
     }
 }
-
-/// Runs `agent` until it ends or a shutdown signal comes (then `Ok`).
-pub async fn until_signal<F: std::future::Future<Output = anyhow::Result<()>>>(
-    agent: F,
-) -> anyhow::Result<()> {
-    tokio::select! {
-        r = agent => r,
-        _ = shutdown_signal() => Ok(()),
-    }
-}

@@ -1,6 +1,6 @@
 //! An embedded run, in-process: every agent on one loopback bus, no binary spawned.
 
-use graspopt_bus::BusArgs;
+use graspopt_bus::BusConfig;
 use graspopt_coordinator::{CoordinatorConfig, RunSpec};
 use graspopt_protocol::{PlannerMethod, RunId, RunPhase};
 use graspopt_runner::{Embedded, run_embedded};
@@ -13,7 +13,7 @@ fn mug_run(out: &std::path::Path, trials: u64) -> Embedded {
     let space = TrialSpace::approach_vertical_2d(&object);
     let evaluator = Evaluator::new(object, hand_by_name("barrett").unwrap(), space);
     let run = RunId::new("inproc").unwrap();
-    let bus = graspopt_runner::embedded::own_bus(BusArgs::default(), &run).unwrap();
+    let bus = graspopt_runner::embedded::own_bus(BusConfig::default(), &run).unwrap();
     Embedded {
         spec: RunSpec {
             object: "mug".into(),
@@ -124,7 +124,7 @@ async fn a_resumed_run_restores_its_recorded_settings_and_refuses_contrary_ones(
         .resolve(&|name| name == "contacts")
         .err()
         .expect("a contrary contact model must be refused");
-    let msg = format!("{err:#}");
+    let msg = graspopt_runner::error::chain(&err);
     assert!(
         msg.contains("--contacts mean") && msg.contains("patch"),
         "{msg}"
@@ -136,7 +136,7 @@ async fn a_resumed_run_restores_its_recorded_settings_and_refuses_contrary_ones(
         out: Some(dir.path().to_path_buf()),
         ..RunSettings::default()
     };
-    let msg = format!("{:#}", other.embedded().err().expect("the folder is taken"));
+    let msg = graspopt_runner::error::chain(&other.embedded().err().expect("the folder is taken"));
     assert!(msg.contains("holds run \"again\" already"), "{msg}");
 }
 
@@ -154,7 +154,7 @@ fn a_lease_out_of_range_is_refused_by_name() {
             out: Some(out.clone()),
             ..RunSettings::default()
         };
-        let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+        let msg = graspopt_runner::error::chain(&settings.embedded().err().expect("refused"));
         assert_eq!(
             msg,
             format!("--lease-ms is {lease_ms}: it must be between 1 and 604800000 (a week)")
@@ -174,7 +174,7 @@ fn a_lease_out_of_range_is_refused_by_name() {
             out: Some(tempfile::tempdir().unwrap().path().join("run")),
             ..RunSettings::default()
         };
-        let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+        let msg = graspopt_runner::error::chain(&settings.embedded().err().expect("refused"));
         assert_eq!(
             msg,
             format!("--trials is {trials}: it must be between 1 and 1000000000")
@@ -186,7 +186,7 @@ fn a_lease_out_of_range_is_refused_by_name() {
         out: Some(tempfile::tempdir().unwrap().path().join("run")),
         ..RunSettings::default()
     };
-    let msg = format!("{:#}", settings.embedded().err().expect("refused"));
+    let msg = graspopt_runner::error::chain(&settings.embedded().err().expect("refused"));
     assert!(
         msg.starts_with(
             "--trial-cost-ms 40000 is not shorter than the lease of a trial (--lease-ms 30000)"
@@ -253,12 +253,11 @@ async fn a_run_records_its_ranges_and_a_resumed_run_keeps_them() {
         },
         ..again.clone()
     };
-    let msg = format!(
-        "{:#}",
-        contrary
+    let msg = graspopt_runner::error::chain(
+        &contrary
             .resolve(&|name| name == "range")
             .err()
-            .expect("a contrary range must be refused")
+            .expect("a contrary range must be refused"),
     );
     assert!(
         msg.contains("--range rz=-2:2 (the run has rz=-3:3)"),

@@ -1,8 +1,10 @@
 //! graspopt on the network. This is the only common crate that knows there is a network
 //! (`graspopt-protocol` defines what is said, not how it travels):
 //!
-//! - [`args`]: one flag set for every tool and agent (`--connect`, `--listen`, `--mode`,
-//!   `--zenoh-config`, `--no-multicast-scouting`, `--shm-prefix`, `--no-shm`).
+//! - [`agent`]: the [`Agent`] trait every agent implements (its kind, settings, run).
+//! - [`config`]: how a process joins the bus, a plain [`BusConfig`] (the binary's bus flags
+//!   fill it: `--connect`, `--listen`, `--mode`, `--zenoh-config`, `--no-multicast-scouting`,
+//!   `--shm-prefix`, `--no-shm`).
 //! - [`session`]: a [`Bus`]: a Zenoh session plus typed put / subscribe / query / serve over the
 //!   protocol's codecs. Trial commands and results are put with `CongestionControl::Block`:
 //!   they are never dropped under congestion. Payloads that do not decode are handed to the
@@ -15,18 +17,20 @@
 //!   on the same host, Zenoh otherwise, chosen per message.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod agent;
 pub mod alive;
-pub mod args;
 pub mod clouds;
+pub mod config;
 pub mod error;
 pub mod inbox;
 mod reach;
 pub mod session;
 mod task;
 
+pub use agent::Agent;
 pub use alive::{AliveEvent, AliveWatch, Claim};
-pub use args::{BusArgs, BusMode};
 pub use clouds::{CloudPath, CloudReceiver, CloudSender, ReceivedClouds};
+pub use config::{BusConfig, BusMode};
 pub use error::BusError;
 pub use inbox::Inbox;
 pub use reach::{REACH_GRACE, REACH_REMINDER};

@@ -14,7 +14,7 @@ use zenoh::query::{Query, Queryable};
 use zenoh::sample::Sample;
 
 use crate::reach::{Target, linked, watch_reach};
-use crate::{BusArgs, BusError};
+use crate::{BusConfig, BusError};
 
 /// The protocol encoding as a Zenoh encoding.
 pub fn zenoh_encoding(encoding: Encoding) -> ZEncoding {
@@ -80,7 +80,7 @@ impl Bus {
         let port = crate::free_loopback_port()
             .map_err(|e| BusError::Config(format!("no free loopback port: {e}")))?;
         let endpoint = format!("tcp/127.0.0.1:{port}");
-        let mut args = BusArgs::loopback(vec![endpoint.clone()], Vec::new());
+        let mut args = BusConfig::loopback(vec![endpoint.clone()], Vec::new());
         args.no_shm = true;
         let hub = Bus::open(&args).await?;
         let mut connected = Vec::with_capacity(peers);
@@ -96,30 +96,30 @@ impl Bus {
 
     /// A session connected to `endpoint` (a [`Bus::loopback`] hub's), without shared memory.
     pub async fn loopback_peer(endpoint: &str) -> Result<Bus, BusError> {
-        let mut args = BusArgs::loopback(Vec::new(), vec![endpoint.to_string()]);
+        let mut args = BusConfig::loopback(Vec::new(), vec![endpoint.to_string()]);
         args.no_shm = true;
         Bus::open(&args).await
     }
 
-    /// Opens a session from the flags. A client refused by the router it connects to (a
+    /// Opens a session as `args` describes. A client refused by the router it connects to (a
     /// failed login: Zenoh says only "Unable to connect") is [`BusError::Unreached`], saying
     /// so.
-    pub async fn open(args: &BusArgs) -> Result<Bus, BusError> {
+    pub async fn open(args: &BusConfig) -> Result<Bus, BusError> {
         Bus::open_with(args, true).await
     }
 
     /// A session for a tool that watches the bus (`topic`, `monitor`): no shared memory and,
     /// when `quiet`, no warnings in the background about endpoints that do not answer: a
     /// command that ends soon says so itself ([`Bus::check_linked`]).
-    pub async fn open_watcher(args: &BusArgs, quiet: bool) -> Result<Bus, BusError> {
-        let args = BusArgs {
+    pub async fn open_watcher(args: &BusConfig, quiet: bool) -> Result<Bus, BusError> {
+        let args = BusConfig {
             no_shm: true,
             ..args.clone()
         };
         Bus::open_with(&args, !quiet).await
     }
 
-    async fn open_with(args: &BusArgs, warn_reach: bool) -> Result<Bus, BusError> {
+    async fn open_with(args: &BusConfig, warn_reach: bool) -> Result<Bus, BusError> {
         let config = args.zenoh_config()?;
         let target = Target::of(&config, args.zenoh_config.as_deref());
         let shm = if args.no_shm {

@@ -134,26 +134,24 @@ fn validate(what: &What) -> Result<()> {
 
 pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     validate(&args.what)?;
-    if let What::Planner {
-        observations,
-        pending,
-        rounds,
-        dims,
-    } = &args.what
-    {
-        // No async runtime: the rounds run in this thread alone.
-        let settings = PlannerBenchSettings {
-            dims: dims.clone(),
-            observations: *observations,
-            pending: *pending,
-            rounds: *rounds,
-            ..PlannerBenchSettings::default()
-        };
-        outln!("{}", planner_bench(&settings)?.to_string().trim_end())?;
-        return Ok(ExitCode::SUCCESS);
-    }
-    let runtime = tokio::runtime::Runtime::new()?;
-    match &args.what {
+    let runtime = || tokio::runtime::Runtime::new();
+    let report = match &args.what {
+        What::Planner {
+            observations,
+            pending,
+            rounds,
+            dims,
+        } => {
+            // No async runtime: the rounds run in this thread alone.
+            let settings = PlannerBenchSettings {
+                dims: dims.clone(),
+                observations: *observations,
+                pending: *pending,
+                rounds: *rounds,
+                ..PlannerBenchSettings::default()
+            };
+            planner_bench(&settings)?.to_string()
+        }
         What::Pipeline {
             trial_cost_ms,
             trials_per_worker,
@@ -168,13 +166,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 overhead_trials: *overhead_trials,
                 method: *method,
             };
-            outln!(
-                "{}",
-                runtime
-                    .block_on(bench::pipeline(&settings))?
-                    .to_string()
-                    .trim_end()
-            )?;
+            runtime()?.block_on(bench::pipeline(&settings))?.to_string()
         }
         What::Coordinator {
             workers,
@@ -186,24 +178,14 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 trials: *trials,
                 paths: paths.clone(),
             };
-            outln!(
-                "{}",
-                runtime
-                    .block_on(bench::coordinator::coordinator(&settings))?
-                    .to_string()
-                    .trim_end()
-            )?;
+            let report = bench::coordinator::coordinator(&settings);
+            runtime()?.block_on(report)?.to_string()
         }
-        What::Planner { .. } => {}
         What::Clouds { points, messages } => {
-            outln!(
-                "{}",
-                runtime
-                    .block_on(bench::clouds(*points, *messages))?
-                    .to_string()
-                    .trim_end()
-            )?;
+            let report = bench::clouds(*points, *messages);
+            runtime()?.block_on(report)?.to_string()
         }
-    }
+    };
+    outln!("{}", report.trim_end())?;
     Ok(ExitCode::SUCCESS)
 }

@@ -2,6 +2,7 @@
 
 pub mod agent;
 pub mod bench;
+pub mod bus;
 pub mod experiment;
 pub mod export;
 pub mod hands;

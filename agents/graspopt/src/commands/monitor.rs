@@ -6,10 +6,11 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Args;
-use graspopt_bus::{Bus, BusArgs};
+use graspopt_bus::Bus;
 use graspopt_protocol::RunId;
 use graspopt_watch::monitor;
 
+use super::bus::BusArgs;
 use crate::out::outln;
 
 #[derive(Args, Debug)]
@@ -28,7 +29,7 @@ pub fn run(args: &MonitorArgs) -> Result<ExitCode> {
     let only = args.run.as_deref().map(RunId::new).transpose()?;
     tokio::runtime::Runtime::new()?.block_on(async {
         // --once says itself when nothing answers where it connects.
-        let bus = Bus::open_watcher(&args.bus, args.once).await?;
+        let bus = Bus::open_watcher(&args.bus.config(), args.once).await?;
         let r = if args.once {
             match monitor::once(&bus, only.as_ref()).await {
                 Ok(lines) => lines

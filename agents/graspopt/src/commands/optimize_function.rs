@@ -4,9 +4,8 @@
 //! 0.1%, then medians over the seeds.
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use graspopt_bayesopt::benchmark::{Benchmark, REGRET_LEVELS};
-use graspopt_bayesopt::{Method, TestFunction};
-use serde_json::json;
+use graspopt_bayesopt::Method;
+use graspopt_runner::bench::functions;
 
 use super::setup::count;
 use crate::out::outln;
@@ -60,137 +59,21 @@ pub struct OptimizeFunctionArgs {
     pub format: FormatArg,
 }
 
-fn fmt_opt(v: Option<usize>) -> String {
-    v.map_or_else(|| "-".to_string(), |e| e.to_string())
-}
-
-fn fmt_med(v: Option<f64>) -> String {
-    v.map_or_else(|| "-".to_string(), |e| format!("{e}"))
-}
-
 /// Run the command.
 pub fn run(args: &OptimizeFunctionArgs) -> anyhow::Result<std::process::ExitCode> {
-    let function = TestFunction::from_name(&args.function)?;
-    let budget = args
-        .budget
-        .unwrap_or_else(|| Benchmark::default_budget(function));
-    let n_init = match args.init {
-        Some(n) => {
-            anyhow::ensure!(
-                n <= budget,
-                "--initial {n} is more than --budget {budget}: the initial design is part of the budget"
-            );
-            n
-        }
-        // The default design never exceeds a small explicit budget.
-        None => Benchmark::default_n_init(function, budget),
-    };
-    let method = args.method;
-    let q = args.batch;
-    let benchmark = Benchmark {
-        function,
-        method,
-        seeds: args.seeds,
-        budget,
-        n_init,
-        batch: q,
-    };
-    let agg = benchmark.run(|seed, trace, s| -> anyhow::Result<()> {
-        match args.format {
-            FormatArg::Json => {
-                let line = json!({
-                    "function": function.name(),
-                    "method": method.name(),
-                    "seed": seed,
-                    "budget": budget,
-                    "init": n_init,
-                    "batch": q,
-                    "best": trace,
-                    "regret_levels": REGRET_LEVELS,
-                    "evals_to": s.evals_to,
-                    "rounds_to": s.rounds_to,
-                    "final_regret": s.final_regret,
-                });
-                outln!("{line}")?;
-            }
-            FormatArg::Text => {
-                let best: Vec<String> = trace.iter().map(|v| format!("{v:.6}")).collect();
-                outln!(
-                    "seed {seed}: best after each evaluation: {}",
-                    best.join(" ")
-                )?;
-                let levels: Vec<String> = REGRET_LEVELS
-                    .iter()
-                    .enumerate()
-                    .map(|(k, l)| {
-                        format!(
-                            "{}%: {} evals / {} rounds",
-                            l * 100.0,
-                            fmt_opt(s.evals_to[k]),
-                            fmt_opt(s.rounds_to[k])
-                        )
-                    })
-                    .collect();
-                outln!(
-                    "seed {seed}: regret {} (final regret {:.3e})",
-                    levels.join(", "),
-                    s.final_regret
-                )?;
-            }
-        }
+    let b = functions::benchmark(
+        &args.function,
+        args.method,
+        args.seeds,
+        args.budget,
+        args.init,
+        args.batch,
+    )?;
+    let json = args.format == FormatArg::Json;
+    let levels = b.run(|seed, trace, s| -> anyhow::Result<()> {
+        outln!("{}", functions::seed_report(&b, json, seed, trace, s))?;
         Ok(())
     })?;
-    match args.format {
-        FormatArg::Json => {
-            let levels: Vec<serde_json::Value> = agg
-                .iter()
-                .map(|l| {
-                    json!({
-                        "level": l.level,
-                        "reached": l.reached,
-                        "seeds": l.seeds,
-                        "median_evals": l.median_evals,
-                        "median_rounds": l.median_rounds,
-                        "max_evals": l.max_evals,
-                    })
-                })
-                .collect();
-            outln!(
-                "{}",
-                json!({
-                    "summary": {
-                        "function": function.name(),
-                        "method": method.name(),
-                        "seeds": args.seeds,
-                        "budget": budget,
-                        "init": n_init,
-                        "batch": q,
-                        "levels": levels,
-                    }
-                })
-            )?;
-        }
-        FormatArg::Text => {
-            let parts: Vec<String> = agg
-                .iter()
-                .map(|l| {
-                    format!(
-                        "{}%: {}/{} seeds, median {} evals / {} rounds",
-                        l.level * 100.0,
-                        l.reached,
-                        l.seeds,
-                        fmt_med(l.median_evals),
-                        fmt_med(l.median_rounds)
-                    )
-                })
-                .collect();
-            outln!(
-                "summary {} ({}, budget {budget}, initial {n_init}, batch {q}): {}",
-                function.name(),
-                method.name(),
-                parts.join("; ")
-            )?;
-        }
-    }
+    outln!("{}", functions::summary_report(&b, json, &levels))?;
     Ok(std::process::ExitCode::SUCCESS)
 }

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use graspopt_bus::{Bus, BusArgs, BusMode};
+use graspopt_bus::{Bus, BusConfig, BusMode};
 
 /// Where the router listens when neither `--listen` nor `--zenoh-config` says.
 const DEFAULT_LISTEN: &str = "tcp/0.0.0.0:7447";
@@ -31,19 +31,19 @@ pub struct RouterArgs {
 
 impl RouterArgs {
     /// The bus flags of a router: router mode, never shared memory.
-    pub fn bus(&self) -> BusArgs {
+    pub fn bus(&self) -> BusConfig {
         let mut listen = self.listen.clone();
         if listen.is_empty() && self.zenoh_config.is_none() {
             listen = vec![DEFAULT_LISTEN.to_string()];
         }
-        BusArgs {
+        BusConfig {
             connect: self.connect.clone(),
             listen,
             mode: Some(BusMode::Router),
             zenoh_config: self.zenoh_config.clone(),
             no_multicast_scouting: self.no_multicast_scouting,
             no_shm: true,
-            ..BusArgs::default()
+            ..BusConfig::default()
         }
     }
 }

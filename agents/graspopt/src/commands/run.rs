@@ -9,23 +9,20 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Args;
-use graspopt_bus::BusArgs;
-use graspopt_protocol::PlannerMethod;
-use graspopt_protocol::text::rounded;
-use graspopt_sim::ParamKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use tokio::sync::watch;
 
-use super::setup::{SimArgs, count, planner_method, sensing, trial_param};
+use super::bus::BusArgs;
+use super::setup::{SpecArgs, count, sensing};
 use crate::out::outln;
-use graspopt_coordinator::{MAX_TRIALS, MAX_WAIT_MS};
-use graspopt_runner::ending::RunEnd;
+use graspopt_coordinator::MAX_WAIT_MS;
+use graspopt_runner::ending::{RunEnd, best_so_far};
 use graspopt_runner::{RunSettings, placeholder, run_embedded};
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
     #[command(flatten)]
-    pub sim: SimArgs,
+    pub spec: SpecArgs,
     /// Run id (one key chunk: letters, digits, '-', '_', '.').
     #[arg(long, default_value = "run")]
     pub run: String,
@@ -37,37 +34,9 @@ pub struct RunArgs {
     /// force/torque readings; a hand with sensing fingertips, barrett_ft).
     #[arg(long, default_value = "clouds", value_parser = sensing())]
     pub sensing: graspopt_hand::Sensing,
-    /// Number of trials.
-    #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
-    pub trials: u64,
-    /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
-    #[arg(
-        long,
-        visible_alias = "axes",
-        default_value = "x,y",
-        value_delimiter = ',',
-        value_parser = trial_param()
-    )]
-    pub params: Vec<ParamKind>,
-    /// How trials are proposed: bo (Bayesian optimization: GP, EI, DIRECT) or random
-    /// (uniform random search, a baseline).
-    #[arg(long, default_value = "bo", value_parser = planner_method())]
-    pub method: PlannerMethod,
-    /// Size of the initial design (space-filling, not model-based) (default: the engine's).
-    #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
-    pub initial: Option<u32>,
-    /// Seed of the planner's random choices and of perception's noise (the same seed
-    /// proposes the same trials).
-    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
-    pub seed: u64,
     /// Results folder (default: results/<run>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Continue the run recorded in the results folder's journal (its only run, unless
-    /// --run names one), with its recorded settings and workers (a larger --trials raises
-    /// its budget).
-    #[arg(long)]
-    pub resume: bool,
     /// Minimum duration of a simulated trial, to model a robot (milliseconds).
     #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
     pub trial_cost_ms: u64,
@@ -92,21 +61,21 @@ impl RunArgs {
     pub fn settings(&self) -> RunSettings {
         RunSettings {
             run: self.run.clone(),
-            trial: self.sim.settings(),
+            trial: self.spec.sim.settings(),
             workers: self.workers,
             sensing: self.sensing,
-            trials: self.trials,
-            params: self.params.clone(),
-            method: self.method,
-            initial: self.initial,
-            seed: self.seed,
+            trials: self.spec.trials,
+            params: self.spec.params.clone(),
+            method: self.spec.method,
+            initial: self.spec.initial,
+            seed: self.spec.seed,
             out: self.out.clone(),
-            resume: self.resume,
+            resume: self.spec.resume,
             trial_cost_ms: self.trial_cost_ms,
             lease_ms: self.lease_ms,
             position_noise: self.position_noise,
             rotation_noise: self.rotation_noise,
-            bus: self.bus.clone(),
+            bus: self.bus.config(),
         }
     }
 }
@@ -146,16 +115,7 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
                     let s = status_rx.borrow().clone();
                     bar.set_position(s.completed + s.failed);
                     if let Some(b) = &s.best {
-                        bar.set_message(format!(
-                            "best {} (trial {}){}",
-                            rounded(b.score),
-                            b.trial_id,
-                            if b.force_closure == Some(true) {
-                                ", force closure"
-                            } else {
-                                ""
-                            }
-                        ));
+                        bar.set_message(best_so_far(b));
                     }
                 }
             })
@@ -174,18 +134,8 @@ pub fn run(args: &RunArgs, explicit: &dyn Fn(&str) -> bool) -> Result<ExitCode> 
     };
     graspopt_report::run::write_results(&folder, &status.object)?;
     let end = RunEnd::read(status, &e.coordinator.journal)?;
-    let s = &end.status;
-    let then = if s.completed + s.failed + s.running == 0 {
-        " (stopped before its first trial: the same command starts it afresh)".to_string()
-    } else {
-        format!(
-            " (stopped; continue with --resume --out {})",
-            e.out.display()
-        )
-    };
-    for line in end.lines(&then) {
+    for line in end.embedded_lines(&e.out) {
         outln!("{line}")?;
     }
-    outln!("results: {}", e.out.display())?;
     Ok(ExitCode::from(end.exit_code()))
 }

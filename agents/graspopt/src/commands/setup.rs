@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use graspopt_coordinator::MAX_TRIALS;
 use graspopt_protocol::PlannerMethod;
 use graspopt_protocol::text::grouped;
-use graspopt_sim::{ContactModel, Object, ParamKind, ParamSpec};
+use graspopt_sim::{ContactModel, ParamKind, ParamSpec};
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, TrialSettings};
 
 #[derive(Args, Debug, Clone)]
@@ -43,6 +44,38 @@ pub struct SimArgs {
     #[arg(long, value_name = "NAME=LO:HI", value_delimiter = ',', value_parser = param_range())]
     #[arg(help = graspopt_sim::pose::ranges_help())]
     pub range: Vec<ParamSpec>,
+}
+
+/// What a run is (`run`, `agent coordinator`): the trial flags, the budget, the
+/// parameters, how trials are proposed, and whether it resumes.
+#[derive(Args, Debug, Clone)]
+pub struct SpecArgs {
+    #[command(flatten)]
+    pub sim: SimArgs,
+    /// Number of trials (with --resume: raises the recorded budget).
+    #[arg(long, default_value_t = 60, value_parser = count::<u64>(1, MAX_TRIALS))]
+    pub trials: u64,
+    /// Trial parameters, comma-separated: x (approach), y (vertical), lateral, rx, ry, rz.
+    #[arg(long, visible_alias = "axes", default_value = "x,y", value_delimiter = ',',
+          value_parser = trial_param())]
+    pub params: Vec<ParamKind>,
+    /// How trials are proposed: bo (Bayesian optimization: GP, EI, DIRECT) or random
+    /// (uniform random search, a baseline).
+    #[arg(long, default_value = "bo", value_parser = planner_method())]
+    pub method: PlannerMethod,
+    /// Size of the initial design (space-filling, not model-based) (default: the engine's).
+    #[arg(long, value_parser = count::<u32>(0, u32::MAX.into()))]
+    pub initial: Option<u32>,
+    /// Seed of the planner's random choices (the same seed proposes the same trials) and,
+    /// in `graspopt run`, of perception's noise.
+    #[arg(long, default_value_t = 0, value_parser = count::<u64>(0, u64::MAX))]
+    pub seed: u64,
+    /// Continue the run recorded in the journal (its only run, unless --run names one),
+    /// with its recorded settings (`graspopt run`: its results folder's journal, and its
+    /// workers). Without --resume, a run recorded with no trial (a start that stopped
+    /// before its first) starts afresh.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 /// `--range`: `NAME=LO:HI` ([`ParamSpec::parse_range`]).
@@ -121,11 +154,6 @@ impl SimArgs {
             torque_scale: self.torque_scale,
             ranges: self.range.clone(),
         }
-    }
-
-    /// The object named by the flags.
-    pub fn object(&self) -> Result<Object> {
-        Ok(self.settings().object()?)
     }
 
     /// An evaluator over the trial space with the given parameters (default bounds, or

@@ -6,11 +6,12 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Subcommand};
-use graspopt_bus::{Bus, BusArgs};
+use graspopt_bus::Bus;
 use graspopt_protocol::RunId;
 use graspopt_runner::signal::shutdown_signal;
 use graspopt_watch::topic::{self, EchoSettings, Format, MIN_WINDOW, Measure, RateSettings};
 
+use super::bus::BusArgs;
 use super::setup::count;
 
 use crate::out::outln;
@@ -132,7 +133,7 @@ pub fn run(args: &TopicArgs) -> Result<ExitCode> {
     let plan = plan(&args.what)?;
     tokio::runtime::Runtime::new()?.block_on(async {
         // `list` says itself when nothing answers where it connects.
-        let bus = Bus::open_watcher(&args.bus, matches!(plan, Plan::List(..))).await?;
+        let bus = Bus::open_watcher(&args.bus.config(), matches!(plan, Plan::List(..))).await?;
         let mut out = std::io::stdout();
         let result = match &plan {
             Plan::List(run, format) => list(&bus, run.as_ref(), *format).await,

@@ -743,4 +743,27 @@ fn launch_checks_every_agent_s_flags_before_starting_any() {
         assert!(!logs.exists());
         assert!(out.stdout.is_empty());
     }
+    // A setting the agent does not have, or cannot take, likewise.
+    for (set, why) in [
+        ("trial_cost=5", "unknown key `trial_cost` at the top level"),
+        (
+            "trial_cost_ms=soon",
+            "invalid type: string \"soon\", expected u64",
+        ),
+    ] {
+        let text = format!(
+            "run = \"r\"\nendpoint = \"tcp/127.0.0.1:7449\"\n[[agent]]\nkind = \"hand\"\n\
+             args = [\"--set\", \"{set}\"]\n"
+        );
+        std::fs::write(&file, text).unwrap();
+        let args = [
+            "launch",
+            path,
+            "--dry-run",
+            "--logs",
+            logs.to_str().unwrap(),
+        ];
+        refused(&args, &["typo.toml: hand:", &format!("--set {set}: {why}")]);
+        assert!(!logs.exists());
+    }
 }

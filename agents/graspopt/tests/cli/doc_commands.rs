@@ -726,12 +726,12 @@ graspopt hands
     let placeholders = Placeholders::new(&repo_root(), Path::new("/h/g.urdf"));
     let applied = placeholders
         .apply(&words(
-            "agent hand --run R --connect tcp/ROUTER:7447 --hand my_gripper.urdf",
+            "agent hand --run R --connect tcp/ROUTER:7447 --set hand=my_gripper.urdf",
         ))
         .unwrap();
     assert_eq!(
         applied,
-        words("agent hand --run docs --connect tcp/127.0.0.1:7447 --hand /h/g.urdf")
+        words("agent hand --run docs --connect tcp/127.0.0.1:7447 --set hand=/h/g.urdf")
     );
     let launch = placeholders
         .apply(&words("launch deploy/local.toml"))

@@ -121,10 +121,10 @@ fn a_hand_without_spherical_fingertips_cannot_sense_forces() {
     let o = graspopt(&[
         "agent",
         "hand",
-        "--hand",
-        "barrett",
-        "--sensing",
-        "ft",
+        "--set",
+        "hand=barrett",
+        "--set",
+        "sensing=ft",
         "--connect",
         "tcp/127.0.0.1:9",
         "--no-multicast-scouting",
@@ -135,9 +135,13 @@ fn a_hand_without_spherical_fingertips_cannot_sense_forces() {
         err.contains("hand barrett has no spherical fingertips"),
         "{err}"
     );
-    // And a sensing kind that does not exist is a usage error listing the kinds.
-    let o = graspopt(&["agent", "hand", "--sensing", "sonar"]);
-    assert_eq!(o.status.code(), Some(2));
+    // And a sensing kind that does not exist is refused naming the setting and the kinds.
+    let o = graspopt(&["agent", "hand", "--set", "sensing=sonar"]);
+    assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--set sensing=sonar: unknown variant `sonar`"),
+        "{err}"
+    );
     assert!(err.contains("clouds") && err.contains("ft"), "{err}");
 }

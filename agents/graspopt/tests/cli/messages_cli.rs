@@ -137,6 +137,7 @@ fn a_negative_count_is_refused_naming_the_accepted_range() {
     let dir = tempdir("negative-counts");
     let out = dir.join("never");
     let o = out.to_str().unwrap();
+    let journal = format!("journal={o}");
     for (args, expected) in [
         (
             vec!["run", "--trials", "-5", "--out", o],
@@ -151,7 +152,7 @@ fn a_negative_count_is_refused_naming_the_accepted_range() {
             "--initial <INITIAL>': must be a whole number",
         ),
         (
-            vec!["agent", "coordinator", "--trials", "-5", "--journal", o],
+            vec!["agent", "coordinator", "--trials", "-5", "--set", &journal],
             "--trials <TRIALS>': must be a whole number from 1 to 1,000,000,000",
         ),
         (

@@ -29,7 +29,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail, ensure};
-use graspopt_bus::{Bus, BusArgs, now_ms};
+use graspopt_bus::{Bus, BusConfig, now_ms};
 use graspopt_coordinator::{Action, Coordinator, CoordinatorConfig, RunSpec, Write, open_run};
 use graspopt_journal::{Journal, TrialState, event_kind};
 use graspopt_protocol::keys::{AliveKey, COMMAND, OBJECT, RESULT, SUGGEST};
@@ -372,7 +372,7 @@ fn carry_out(
 /// The coordinator's loop on an in-process bus (see the module's doc).
 pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRow> {
     let run = RunId::new(&format!("bench-bus-{workers}"))?;
-    let mut args = own_bus(BusArgs::default(), &run)?;
+    let mut args = own_bus(BusConfig::default(), &run)?;
     args.no_shm = true;
     let bus = Bus::open(&args).await?;
     let mut tasks = tokio::task::JoinSet::new();

@@ -185,40 +185,40 @@ pub fn check_agent_id(id: &str) -> Result<(), KeyError> {
     check_chunk("agent id", id)
 }
 
-/// The kinds of agent.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum AgentKind {
-    Perception,
-    Hand,
-    Metric,
-    Planner,
-    Coordinator,
+/// Declares [`AgentKind`] from one row per kind: its variant and its name (in keys, in
+/// `graspopt agent <name>`, in launch files; serde writes it too).
+macro_rules! agent_kinds {
+    ($($kind:ident => $name:literal,)+) => {
+        /// The kinds of agent. To add one: its row in the `agent_kinds!` list below, its
+        /// crate's `impl graspopt_bus::Agent`, and its row in the runner's registry.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum AgentKind {
+            $($kind,)+
+        }
+
+        impl AgentKind {
+            pub const ALL: [AgentKind; [$($name),+].len()] = [$(AgentKind::$kind),+];
+
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $(AgentKind::$kind => $name,)+
+                }
+            }
+            /// Parses a kind name.
+            pub fn parse(name: &str) -> Option<AgentKind> {
+                AgentKind::ALL.into_iter().find(|k| k.as_str() == name)
+            }
+        }
+    };
 }
 
-impl AgentKind {
-    pub const ALL: [AgentKind; 5] = [
-        AgentKind::Perception,
-        AgentKind::Hand,
-        AgentKind::Metric,
-        AgentKind::Planner,
-        AgentKind::Coordinator,
-    ];
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            AgentKind::Perception => "perception",
-            AgentKind::Hand => "hand",
-            AgentKind::Metric => "metric",
-            AgentKind::Planner => "planner",
-            AgentKind::Coordinator => "coordinator",
-        }
-    }
-
-    /// Parses a kind name.
-    pub fn parse(name: &str) -> Option<AgentKind> {
-        AgentKind::ALL.into_iter().find(|k| k.as_str() == name)
-    }
+agent_kinds! {
+    Perception => "perception",
+    Hand => "hand",
+    Metric => "metric",
+    Planner => "planner",
+    Coordinator => "coordinator",
 }
 
 impl fmt::Display for AgentKind {

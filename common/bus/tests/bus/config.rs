@@ -1,6 +1,6 @@
 //! Flags refused before a session opens.
 
-use graspopt_bus::{Bus, BusArgs, BusError};
+use graspopt_bus::{Bus, BusConfig, BusError};
 
 /// A `--shm-prefix` that iceoryx2 cannot use is refused by name, not left to a warning and
 /// a silent fall-back to the network.
@@ -12,7 +12,7 @@ fn an_unusable_shm_prefix_is_refused_by_name() {
         ("a/b", "contains '/'"),
         (".hidden", "starts with '.'"),
     ] {
-        let mut args = BusArgs::loopback(Vec::new(), Vec::new());
+        let mut args = BusConfig::loopback(Vec::new(), Vec::new());
         args.shm_prefix = Some(prefix.to_string());
         match rt.block_on(Bus::open(&args)) {
             Err(e @ BusError::Config(_)) => {

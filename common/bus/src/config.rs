@@ -1,9 +1,11 @@
-//! The flag set every graspopt tool and agent shares, in the manner of Zenoh's examples.
+//! How a process joins the bus: a plain [`BusConfig`] (the `graspopt` binary fills it from
+//! its bus flags, `--connect`, `--listen`, `--mode`, ..., in the manner of Zenoh's
+//! examples; tests and the embedded run by hand), and the check of an endpoint.
 
 use std::path::PathBuf;
 
 /// How this process joins the bus.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BusMode {
     /// Talk directly to other peers (and to routers).
     Peer,
@@ -14,6 +16,9 @@ pub enum BusMode {
 }
 
 impl BusMode {
+    /// Every mode, in the order `--help` lists them.
+    pub const ALL: [BusMode; 3] = [BusMode::Peer, BusMode::Client, BusMode::Router];
+
     pub fn as_str(self) -> &'static str {
         match self {
             BusMode::Peer => "peer",
@@ -21,48 +26,40 @@ impl BusMode {
             BusMode::Router => "router",
         }
     }
+
+    /// A mode by its name.
+    pub fn parse(name: &str) -> Option<BusMode> {
+        Self::ALL.into_iter().find(|m| m.as_str() == name)
+    }
 }
 
-/// Bus flags.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct BusArgs {
-    /// Endpoint to connect to, e.g. `tcp/192.168.1.10:7447` (a router); repeatable. An
-    /// endpoint that does not parse is refused at once; one that does not answer is named in
-    /// a warning within a few seconds and tried again in the background. Turns multicast
-    /// scouting off (see `--scout`).
-    #[arg(short = 'e', long = "connect", value_name = "ENDPOINT", global = true)]
+/// How a session is opened: its endpoints, mode and Zenoh configuration, and the shared
+/// memory it may use. The error messages name the flags that set each field.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BusConfig {
+    /// Endpoints to connect to, e.g. `tcp/192.168.1.10:7447` (a router).
     pub connect: Vec<String>,
-    /// Endpoint to listen on, e.g. `tcp/0.0.0.0:7447`; repeatable.
-    #[arg(short = 'l', long = "listen", value_name = "ENDPOINT", global = true)]
+    /// Endpoints to listen on, e.g. `tcp/0.0.0.0:7447`.
     pub listen: Vec<String>,
-    /// Session mode (default: peer, or the Zenoh configuration file's).
-    #[arg(long, value_enum, global = true)]
+    /// Session mode (`None`: peer, or the Zenoh configuration file's).
     pub mode: Option<BusMode>,
-    /// A Zenoh configuration file (json5); the flags override it.
-    #[arg(long = "zenoh-config", value_name = "FILE", global = true)]
+    /// A Zenoh configuration file (json5); the fields above override it.
     pub zenoh_config: Option<PathBuf>,
-    /// Do not look for peers by UDP multicast; only the `--connect` endpoints are used (the
-    /// default whenever `--connect` is given).
-    #[arg(long, global = true)]
+    /// No UDP multicast scouting: only the `connect` endpoints.
     pub no_multicast_scouting: bool,
-    /// Also look for peers by UDP multicast when `--connect` is given. Without it, a process
-    /// given `--connect` meets only what it connects to, so a wrong address fails on one
-    /// machine as it would across two.
-    #[arg(long, global = true, conflicts_with = "no_multicast_scouting")]
+    /// Multicast scouting even when `connect` is given.
     pub scout: bool,
     /// Prefix of the shared-memory (iceoryx2) resources, to separate installations on a host.
-    #[arg(long, value_name = "PREFIX", global = true)]
     pub shm_prefix: Option<String>,
     /// Never use shared memory for contact clouds (always Zenoh).
-    #[arg(long, global = true)]
     pub no_shm: bool,
 }
 
-impl BusArgs {
-    /// Arguments for a process that talks only over loopback through `endpoint` (tests, the
+impl BusConfig {
+    /// The configuration of a process that talks only over loopback through `endpoint` (tests, the
     /// embedded run): no multicast scouting.
     pub fn loopback(listen: Vec<String>, connect: Vec<String>) -> Self {
-        BusArgs {
+        BusConfig {
             connect,
             listen,
             mode: Some(BusMode::Peer),
@@ -74,7 +71,7 @@ impl BusArgs {
         }
     }
 
-    /// The Zenoh configuration these flags describe.
+    /// The Zenoh configuration this describes.
     pub fn zenoh_config(&self) -> Result<zenoh::Config, crate::BusError> {
         use crate::BusError;
         use crate::error::without_source_locations;
@@ -130,7 +127,7 @@ impl BusArgs {
         Ok(config)
     }
 
-    /// Whether the flags leave UDP multicast scouting on: not with `--no-multicast-scouting`,
+    /// Whether this leaves UDP multicast scouting on: not with `--no-multicast-scouting`,
     /// and not with `--connect` unless `--scout` asks for it (a Zenoh configuration file
     /// decides when neither flag is given).
     pub fn multicast_scouting(&self) -> bool {
@@ -266,11 +263,11 @@ mod tests {
 
     #[test]
     fn connect_turns_multicast_scouting_off_unless_asked() {
-        let mut args = BusArgs::default();
+        let mut args = BusConfig::default();
         assert!(args.multicast_scouting());
         args.connect = vec!["tcp/127.0.0.1:7447".into()];
         assert!(!args.multicast_scouting());
-        let scouting = |a: &BusArgs| {
+        let scouting = |a: &BusConfig| {
             a.zenoh_config()
                 .unwrap()
                 .get_json("scouting/multicast/enabled")
