@@ -329,7 +329,7 @@ impl HandDriver for BadSensors {
         self.0.hand()
     }
     fn sensing(&self) -> Sensing {
-        Sensing::Ft
+        Sensing::Wrenches
     }
     fn needs_object(&self) -> bool {
         self.0.needs_object()
@@ -386,7 +386,7 @@ fn bad_fingertip_readings_fail_their_trial_and_the_run_goes_on() {
         id: "ft-bad".into(),
         hand: HAND.into(),
         object: Some(OBJECT.into()),
-        sensing: Sensing::Ft,
+        sensing: Sensing::Wrenches,
         ..Default::default()
     };
     let driver = BadSensors(SimulatedHand::new(&config).unwrap());

@@ -11,19 +11,20 @@ pub enum Sensing {
     #[default]
     Clouds,
     /// A six-axis force/torque sensor under each fingertip: the metric agent finds the
-    /// contacts from the readings.
-    Ft,
+    /// contacts from the readings. Users type `ft` (force/torque).
+    #[serde(rename = "ft")]
+    Wrenches,
 }
 
 impl Sensing {
     /// Every kind, in the order `--help` lists them.
-    pub const ALL: [Sensing; 2] = [Sensing::Clouds, Sensing::Ft];
+    pub const ALL: [Sensing; 2] = [Sensing::Clouds, Sensing::Wrenches];
 
     /// The name users type (the serde name): `clouds`, `ft`.
     pub fn name(self) -> &'static str {
         match self {
             Sensing::Clouds => "clouds",
-            Sensing::Ft => "ft",
+            Sensing::Wrenches => "ft",
         }
     }
 
@@ -36,7 +37,7 @@ impl Sensing {
     pub fn topic(self) -> Topic {
         match self {
             Sensing::Clouds => Topic::Clouds,
-            Sensing::Ft => Topic::Wrenches,
+            Sensing::Wrenches => Topic::Wrenches,
         }
     }
 }
@@ -49,7 +50,7 @@ pub struct HandReading {
     /// The raw contact cloud of each finger in finger order, then the palm's (hands that
     /// sense [`Sensing::Clouds`]).
     pub fingers: Vec<FingerCloud>,
-    /// The fingertip force/torque readings (hands that sense [`Sensing::Ft`]).
+    /// The fingertip force/torque readings (hands that sense [`Sensing::Wrenches`]).
     pub fingertips: Vec<FingertipWrench>,
     /// Smallest distance between a link and the object (metres) when nothing touches;
     /// `None` when unknown.

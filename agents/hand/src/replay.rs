@@ -128,7 +128,7 @@ impl Recording {
                 Sensing::Clouds => graspopt_protocol::Message::validate(&crate::serve::tag(
                     &command, "check", None, reading,
                 )),
-                Sensing::Ft => graspopt_protocol::Message::validate(&crate::serve::tag_wrenches(
+                Sensing::Wrenches => graspopt_protocol::Message::validate(&crate::serve::tag_wrenches(
                     &command, "check", None, reading,
                 )),
             }
@@ -204,7 +204,7 @@ impl RecordedTrial {
     /// What this grasp holds: fingertip readings when it has `fingertips`, else clouds.
     pub fn sensing(&self) -> Sensing {
         match self.fingertips {
-            Some(_) => Sensing::Ft,
+            Some(_) => Sensing::Wrenches,
             None => Sensing::Clouds,
         }
     }
@@ -244,7 +244,7 @@ fn probe_command(t: &RecordedTrial) -> TrialCommand {
 fn holds(sensing: Sensing) -> &'static str {
     match sensing {
         Sensing::Clouds => "contact clouds (fingers)",
-        Sensing::Ft => "fingertip readings (fingertips)",
+        Sensing::Wrenches => "fingertip readings (fingertips)",
     }
 }
 
@@ -384,9 +384,9 @@ mod tests {
             lines[0]
         );
         let rec = Recording::load(&write(&dir, "ft.jsonl", &lines)).unwrap();
-        assert_eq!(rec.sensing, Sensing::Ft);
+        assert_eq!(rec.sensing, Sensing::Wrenches);
         let mut hand = ReplayHand { recording: rec };
-        assert_eq!(hand.sensing(), Sensing::Ft);
+        assert_eq!(hand.sensing(), Sensing::Wrenches);
         let mut c = command(vec![0.9]);
         c.hand = "barrett_ft".into();
         let r = hand.execute(&c).unwrap();

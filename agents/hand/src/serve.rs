@@ -20,7 +20,7 @@ pub const UNIQUE_WAIT: Duration = Duration::from_secs(5);
 /// it is alive, see [`UNIQUE_WAIT`]), subscribes, declares itself alive, then for each
 /// command of this run and worker executes it on a thread of its own, pads the trial to at
 /// least `cost` (a robot's cycle time), and sends the clouds, tagged with the trial, to the
-/// metric agents (or, for a driver that senses [`Sensing::Ft`], the fingertip readings on
+/// metric agents (or, for a driver that senses [`Sensing::Wrenches`], the fingertip readings on
 /// the wrenches topic). A failed execution is sent as clouds (readings) with the reason in
 /// `error`. Messages of other runs or workers, and ones that do not decode, are counted and
 /// logged. Should another hand with the id turn out to hold the place too (both claimed
@@ -90,7 +90,7 @@ pub async fn serve(
                 .send(&tag(&command, id, driver.hand(), outcome))
                 .await
                 .map(|_| ()),
-            Sensing::Ft => {
+            Sensing::Wrenches => {
                 let readings = tag_wrenches(&command, id, driver.hand(), outcome);
                 bus.put(&WRENCHES.key(run.into()), &readings, Encoding::Bincode)
                     .await

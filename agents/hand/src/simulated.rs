@@ -1,5 +1,5 @@
 //! The simulated hand: a [`HandDriver`] on the grasp simulator. It measures contact clouds, or
-//! with [`Sensing::Ft`] the readings of force/torque sensors under its spherical fingertips
+//! with [`Sensing::Wrenches`] the readings of force/torque sensors under its spherical fingertips
 //! (`graspopt_trial::fingertips`), with sensor noise drawn from a generator seeded by the
 //! trial and attempt, so a trial reads the same each time it is executed.
 
@@ -36,7 +36,7 @@ impl SimulatedHand {
             context: "hand agent",
             source,
         })?;
-        if config.sensing == Sensing::Ft {
+        if config.sensing == Sensing::Wrenches {
             let sensing = |context, source: Box<dyn std::error::Error + Send + Sync>| {
                 HandAgentError::Sensing { context, source }
             };

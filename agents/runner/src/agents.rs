@@ -190,7 +190,7 @@ mod tests {
         ]))
         .unwrap();
         assert_eq!((c.trial_cost_ms, c.hand.as_str()), (200, "barrett_ft"));
-        assert_eq!(c.sensing, graspopt_hand::Sensing::Ft);
+        assert_eq!(c.sensing, graspopt_hand::Sensing::Wrenches);
         assert_eq!(c.fingertips.noise.force_resolution, 0.0);
         let c = settings::<PerceptionAgent>(&Standalone {
             id: Some("eye".into()),

@@ -3,7 +3,7 @@
 //! Python hands answer trials from, standing in for a robot's logged data.
 //!
 //! With [`Sensing::Clouds`] each line holds the grasp's raw contact clouds and its score.
-//! With [`Sensing::Ft`] it holds what force/torque sensors under the fingertips read
+//! With [`Sensing::Wrenches`] it holds what force/torque sensors under the fingertips read
 //! ([`fingertip_trial`]): the readings (as in a `FingertipWrenches` message, with the sensor
 //! noise of the [`FingertipSettings`], drawn from a generator seeded with the grid point's
 //! index), the score the metric agent gives them (`score`) and the score of the true,
@@ -40,7 +40,7 @@ pub fn refuse_database(out: &std::path::Path) -> Result<()> {
 }
 
 /// The fingertip sensors of a recording of `sensing` by `hand`: the default noise, or the
-/// resolutions given, which only [`Sensing::Ft`] takes.
+/// resolutions given, which only [`Sensing::Wrenches`] takes.
 pub fn fingertip_settings(
     sensing: Sensing,
     hand: &str,
@@ -48,7 +48,7 @@ pub fn fingertip_settings(
     torque_resolution: Option<f64>,
 ) -> Result<FingertipSettings> {
     let mut tips = FingertipSettings::default();
-    if sensing != Sensing::Ft {
+    if sensing != Sensing::Wrenches {
         if force_resolution.is_some() || torque_resolution.is_some() {
             return Err(RunnerError::NeedsFt);
         }
@@ -100,7 +100,7 @@ fn tag() -> Result<TrialTag> {
 }
 
 /// Records every point of the grid `axes` (the first axis varying slowest) to `out`, one
-/// line per grasp; returns how many. `tips` matters only for [`Sensing::Ft`].
+/// line per grasp; returns how many. `tips` matters only for [`Sensing::Wrenches`].
 pub fn record_grid(
     ev: &Evaluator,
     axes: &[Vec<f64>],
@@ -131,7 +131,7 @@ pub fn record_grid(
                     true_score: None,
                 }
             }
-            Sensing::Ft => {
+            Sensing::Wrenches => {
                 let mut rng = ChaCha8Rng::seed_from_u64(flat as u64);
                 fingertip_trial(ev, params.clone(), tips, &mut rng).map_err(at)?
             }

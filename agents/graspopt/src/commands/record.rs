@@ -51,7 +51,7 @@ pub fn run(args: &RecordArgs) -> Result<ExitCode> {
     let total = record::write_recording(&args.out, &ev, &axes, sensing, &tips)?;
     let what = match sensing {
         Sensing::Clouds => "grasps",
-        Sensing::Ft => "grasps' fingertip readings",
+        Sensing::Wrenches => "grasps' fingertip readings",
     };
     outln!(
         "{total} {what} of the {} written to {}",

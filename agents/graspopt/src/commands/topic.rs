@@ -83,7 +83,8 @@ pub enum TopicCommand {
         window: usize,
     },
     /// Bandwidth of a topic.
-    Bw {
+    #[command(name = "bw")]
+    Bandwidth {
         #[command(flatten)]
         watch: Watch,
         /// Messages in the sliding window (at least 3: a rate needs two intervals).
@@ -125,7 +126,7 @@ fn plan(what: &TopicCommand) -> Result<Plan> {
             duration: topic::check_duration(watch.duration)?,
         }),
         TopicCommand::Hz { watch, window } => rate(watch, *window, Measure::Rate)?,
-        TopicCommand::Bw { watch, window } => rate(watch, *window, Measure::Bandwidth)?,
+        TopicCommand::Bandwidth { watch, window } => rate(watch, *window, Measure::Bandwidth)?,
     })
 }
 
