@@ -4,13 +4,13 @@
 
 use std::collections::BTreeMap;
 
-use anyhow::{Context, bail};
 use graspopt_bus::now_ms;
 use graspopt_journal::{Journal, RunLifecycle, RunRecord, TrialState, event_kind};
 use graspopt_protocol::{ObjectEstimate, PlannerMethod, RunId};
 use graspopt_sim::{Object, ParamKind, ParamSpec, TrialSpace};
 use serde::{Deserialize, Serialize};
 
+use crate::error::CoordinatorError;
 use crate::state::{RunState, Trial, TrialPhase};
 
 /// What a run is: recorded in the journal when the run is created, and taken from there when
@@ -95,27 +95,44 @@ pub fn range_conflicts(recorded: &RunSpec, ranges: &[ParamSpec]) -> Vec<String> 
 }
 
 /// The run's recorded spec in the journal at `path`, if the file and the run exist.
-pub fn recorded_spec(path: &std::path::Path, run: &RunId) -> anyhow::Result<Option<RunSpec>> {
+pub fn recorded_spec(
+    path: &std::path::Path,
+    run: &RunId,
+) -> Result<Option<RunSpec>, CoordinatorError> {
     if !path.exists() {
         return Ok(None);
     }
-    let journal = Journal::open(path)
-        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    let journal = open_journal(path)?;
     let Some(record) = journal.run(run.as_str())? else {
         return Ok(None);
     };
-    let spec = serde_json::from_str::<RunSpec>(&record.config_json)
-        .with_context(|| format!("run {run:?}: journal holds an unreadable run spec"))?;
-    Ok(Some(spec))
+    Ok(Some(read_spec(run, &record)?))
+}
+
+/// Opens the journal at `path`, the error naming it.
+pub(crate) fn open_journal(path: &std::path::Path) -> Result<Journal, CoordinatorError> {
+    Journal::open(path).map_err(|source| CoordinatorError::OpenJournal {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// The spec recorded with the run of `record`.
+fn read_spec(run: &RunId, record: &RunRecord) -> Result<RunSpec, CoordinatorError> {
+    serde_json::from_str::<RunSpec>(&record.config_json).map_err(|source| {
+        CoordinatorError::UnreadableSpec {
+            run: run.clone(),
+            source,
+        }
+    })
 }
 
 /// The run ids the journal at `path` holds, oldest first (none if there is no such file).
-pub fn recorded_runs(path: &std::path::Path) -> anyhow::Result<Vec<String>> {
+pub fn recorded_runs(path: &std::path::Path) -> Result<Vec<String>, CoordinatorError> {
     if !path.exists() {
         return Ok(Vec::new());
     }
-    let journal = Journal::open(path)
-        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    let journal = open_journal(path)?;
     Ok(journal.runs()?.into_iter().map(|r| r.run_id).collect())
 }
 
@@ -130,17 +147,15 @@ pub fn quoted_runs(ids: &[String]) -> String {
 /// The run a `--resume` without `--run` continues: the only run of the journal at `path`
 /// (`None` when there is no such file or it holds no run). A journal of several runs is an
 /// error that lists them.
-pub fn sole_run(path: &std::path::Path) -> anyhow::Result<Option<RunId>> {
+pub fn sole_run(path: &std::path::Path) -> Result<Option<RunId>, CoordinatorError> {
     let runs = recorded_runs(path)?;
     match runs.as_slice() {
         [] => Ok(None),
         [one] => Ok(Some(RunId::new(one)?)),
-        _ => bail!(
-            "the journal {} holds {} runs ({}): say which to resume with --run",
-            path.display(),
-            runs.len(),
-            quoted_runs(&runs)
-        ),
+        _ => Err(CoordinatorError::WhichRun {
+            path: path.to_path_buf(),
+            runs,
+        }),
     }
 }
 
@@ -200,12 +215,10 @@ pub fn resume_conflicts(
 
 impl Conflicts {
     /// The error for a resumed run whose flags contradict its record (`None`: none do).
-    pub fn into_error(self, run: &RunId) -> Option<anyhow::Error> {
-        (!self.0.is_empty()).then(|| {
-            anyhow::anyhow!(
-                "run {run:?} was recorded with other settings: {}. Drop these flags to resume it, or start a new run (another --run id)",
-                self.0.join("; ")
-            )
+    pub fn into_error(self, run: &RunId) -> Option<CoordinatorError> {
+        (!self.0.is_empty()).then(|| CoordinatorError::Conflicts {
+            run: run.clone(),
+            conflicts: self.0,
         })
     }
 }
@@ -218,7 +231,7 @@ pub fn reconcile(
     recorded: &RunSpec,
     given: &RunSpec,
     explicit: &dyn Fn(&str) -> bool,
-) -> anyhow::Result<RunSpec> {
+) -> Result<RunSpec, CoordinatorError> {
     if let Some(e) = resume_conflicts(recorded, given, explicit).into_error(run) {
         return Err(e);
     }
@@ -233,18 +246,17 @@ pub fn reconcile(
 pub fn trial_space(
     spec: &RunSpec,
     estimate: &ObjectEstimate,
-) -> anyhow::Result<(TrialSpace, Vec<[f64; 2]>)> {
-    let object = graspopt_convert::object_from_estimate(estimate)
-        .context("coordinator: the object estimate")?;
-    let mut space = TrialSpace::with_params(&object, &spec.params).context("run spec")?;
+) -> Result<(TrialSpace, Vec<[f64; 2]>), CoordinatorError> {
+    let object =
+        graspopt_convert::object_from_estimate(estimate).map_err(CoordinatorError::Estimate)?;
+    let mut space =
+        TrialSpace::with_params(&object, &spec.params).map_err(CoordinatorError::Spec)?;
     if let Some(bounds) = &spec.bounds {
         for (i, p) in space.params.iter_mut().enumerate() {
-            let b = bounds
-                .get(i)
-                .with_context(|| format!("run spec: no bounds for parameter {i}"))?;
+            let b = bounds.get(i).ok_or(CoordinatorError::NoBounds(i))?;
             (p.lower, p.upper) = (b[0], b[1]);
         }
-        space = TrialSpace::new(space.reference, space.params).context("run spec")?;
+        space = TrialSpace::new(space.reference, space.params).map_err(CoordinatorError::Spec)?;
     }
     let bounds = bounds_of(&space);
     Ok((space, bounds))
@@ -272,7 +284,7 @@ pub fn open_run(
     run: &RunId,
     spec: &RunSpec,
     resume: bool,
-) -> anyhow::Result<(RunSpec, RunState)> {
+) -> Result<(RunSpec, RunState), CoordinatorError> {
     let place = journal
         .path()
         .map_or_else(|| "the journal".to_string(), |p| p.display().to_string());
@@ -287,10 +299,11 @@ pub fn open_run(
             existing = None;
         } else {
             let trials = journal.trials(run.as_str())?.len();
-            bail!(
-                "run {run:?} already exists in {place} with {trials} trial{}: resume it (--resume; for a launched run, graspopt launch --resume FILE) or choose another run id",
-                if trials == 1 { "" } else { "s" }
-            );
+            return Err(CoordinatorError::RunExists {
+                run: run.clone(),
+                place,
+                trials,
+            });
         }
     }
     let spec = match existing {
@@ -324,9 +337,8 @@ fn continue_run(
     run: &RunId,
     spec: &RunSpec,
     record: &RunRecord,
-) -> anyhow::Result<RunSpec> {
-    let recorded = serde_json::from_str::<RunSpec>(&record.config_json)
-        .with_context(|| format!("run {run:?}: journal holds an unreadable run spec"))?;
+) -> Result<RunSpec, CoordinatorError> {
+    let recorded = read_spec(run, record)?;
     // A resumed run keeps its record; only its budget may grow (see `reconcile`).
     let spec = if spec.trials > recorded.trials {
         let before = recorded.trials;
@@ -350,7 +362,11 @@ fn continue_run(
 }
 
 /// The state of the run as the journal records it, with a budget of `budget` trials.
-fn rebuild_state(journal: &Journal, run: &RunId, budget: u64) -> anyhow::Result<RunState> {
+fn rebuild_state(
+    journal: &Journal,
+    run: &RunId,
+    budget: u64,
+) -> Result<RunState, CoordinatorError> {
     let mut state = RunState::new(budget);
     let mut rows = journal.trials(run.as_str())?;
     // Who each attempt went to, so that late results of attempts issued before a restart
@@ -427,7 +443,7 @@ pub fn standalone_run(
     ranges: &[ParamSpec],
     resume: bool,
     explicit: &dyn Fn(&str) -> bool,
-) -> anyhow::Result<(RunId, RunSpec)> {
+) -> Result<(RunId, RunSpec), CoordinatorError> {
     check_trials(given.trials)?;
     let mut run_id = RunId::new(run)?;
     if resume
@@ -468,8 +484,10 @@ pub fn standalone_run(
     if let Some(dir) = journal.parent()
         && !dir.as_os_str().is_empty()
     {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|source| CoordinatorError::CreateFolder {
+            path: dir.to_path_buf(),
+            source,
+        })?;
     }
     Ok((run_id, spec))
 }
@@ -480,11 +498,10 @@ pub fn standalone_run(
 pub const MAX_TRIALS: u64 = 1_000_000_000;
 
 /// Refuses a trial budget of 0 or over [`MAX_TRIALS`], naming `--trials`.
-pub fn check_trials(trials: u64) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        (1..=MAX_TRIALS).contains(&trials),
-        "--trials is {trials}: it must be between 1 and {MAX_TRIALS}"
-    );
+pub fn check_trials(trials: u64) -> Result<(), CoordinatorError> {
+    if !(1..=MAX_TRIALS).contains(&trials) {
+        return Err(CoordinatorError::Trials(trials));
+    }
     Ok(())
 }
 
