@@ -87,7 +87,7 @@ pub async fn run_embedded(
         crate::signal::shutdown_signal(),
     );
     let status = tokio::select! {
-        s = coordinator => s,
+        s = coordinator => s.map_err(anyhow::Error::from),
         Some(agent) = tasks.join_next() => {
             // An agent stopped before the run finished: that is an error.
             match agent {

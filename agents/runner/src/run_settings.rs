@@ -402,7 +402,7 @@ impl RunSettings {
             conflicts.0.extend(contrary);
         }
         if let Some(e) = conflicts.into_error(run) {
-            return Err(e);
+            return Err(e.into());
         }
         let spec = graspopt_coordinator::reconcile(run, &recorded, &given, explicit)?;
         let mut s = self.clone();
