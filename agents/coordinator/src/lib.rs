@@ -9,7 +9,7 @@
 //! - [`core`]: the rules, as a state machine without I/O: every [`Event`] goes through
 //!   [`Coordinator::handle`], which returns the [`Action`]s to carry out. [`state`] is its bookkeeping of trials and workers, [`waits`]
 //!   what the run waits for.
-//! - [`run`]: the async loop, which only moves messages, timers and journal writes.
+//! - [`run`](mod@run): the async loop, which only moves messages, timers and journal writes.
 //! - [`error`]: what stops a coordinator or refuses a run ([`CoordinatorError`]).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 

@@ -1,6 +1,6 @@
 //! The coordinator's async loop: it owns the bus, the timers and the journal, turns what
 //! arrives into [`Event`]s for the [`Coordinator`] core and carries out the actions it
-//! returns, all in one place ([`drive`]).
+//! returns, all in one place (`drive`).
 
 use std::time::Duration;
 

@@ -3,12 +3,12 @@
 //! reply, a timer) goes through [`Coordinator::handle`] with the time (`now`, milliseconds
 //! since the epoch), which returns the [`Action`]s to carry out, in order: journal writes,
 //! commands to send, questions to the planner, status to publish. The async loop in
-//! [`crate::run`] only moves messages and timers.
+//! [`crate::run`](mod@crate::run) only moves messages and timers.
 //!
-//! - [`planner`]: asking the planner and taking its proposals.
-//! - [`trials`]: leasing queued trials and accepting their results.
-//! - [`workers`]: hand workers and metric agents coming and going.
-//! - [`status`]: the run's status and what it waits for.
+//! - `planner`: asking the planner and taking its proposals.
+//! - `trials`: leasing queued trials and accepting their results.
+//! - `workers`: hand workers and metric agents coming and going.
+//! - `status`: the run's status and what it waits for.
 //!
 //! To handle a new event: a variant of [`Event`], its arm in [`Coordinator::handle`], and a
 //! method in the submodule of its concern returning the actions.

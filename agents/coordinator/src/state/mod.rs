@@ -1,9 +1,9 @@
 //! The coordinator's bookkeeping, without a network: trials and their leases, live workers,
 //! the observations for the planner, the best trial, the error counters. The async loop in
-//! [`crate::run`] feeds it events and carries out what it decides.
+//! [`crate::run`](mod@crate::run) feeds it events and carries out what it decides.
 //!
-//! - [`workers`]: live workers and the leases of their trials.
-//! - [`results`]: accepting results, the observations and the best trial.
+//! - `workers`: live workers and the leases of their trials.
+//! - `results`: accepting results, the observations and the best trial.
 
 use std::collections::{BTreeMap, BTreeSet};
 
