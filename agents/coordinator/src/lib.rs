@@ -6,13 +6,15 @@
 //! run: completed trials are kept, unfinished ones are issued again.
 //!
 //! - [`spec`]: what a run is, resuming it, opening it in the journal (journal glue).
-//! - [`core`]: the rules, as a state machine without I/O: one method per event, returning
-//!   the actions to carry out. [`state`] is its bookkeeping of trials and workers, [`waits`]
+//! - [`core`]: the rules, as a state machine without I/O: every [`Event`] goes through
+//!   [`Coordinator::handle`], which returns the [`Action`]s to carry out. [`state`] is its bookkeeping of trials and workers, [`waits`]
 //!   what the run waits for.
-//! - [`run`]: the async loop, which only moves messages, timers and journal writes.
+//! - [`run`](mod@run): the async loop, which only moves messages, timers and journal writes.
+//! - [`error`]: what stops a coordinator or refuses a run ([`CoordinatorError`]).
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod core;
+pub mod error;
 pub mod run;
 pub mod spec;
 pub mod state;
@@ -23,7 +25,8 @@ use std::path::PathBuf;
 use graspopt_protocol::RunId;
 use serde::{Deserialize, Serialize};
 
-pub use crate::core::{Action, Coordinator, Write};
+pub use crate::core::{Action, Coordinator, Event, Write};
+pub use crate::error::CoordinatorError;
 pub use crate::run::{record, run, run_until, split_writes};
 pub use crate::spec::{
     Conflicts, MAX_TRIALS, RunSpec, bounds_of, check_trials, open_run, param_names, quoted_runs,
@@ -67,15 +70,13 @@ impl CoordinatorConfig {
     /// Refuses settings the coordinator cannot keep: a lease or planner timeout of 0 (every
     /// trial would expire at once, every question time out) or over [`MAX_WAIT_MS`]. The
     /// message names the setting.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), CoordinatorError> {
         for (name, v) in [
             ("lease_ms", self.lease_ms),
             ("planner_timeout_ms", self.planner_timeout_ms),
         ] {
             if !(1..=MAX_WAIT_MS).contains(&v) {
-                return Err(format!(
-                    "{name} is {v}: it must be between 1 and {MAX_WAIT_MS} (a week)"
-                ));
+                return Err(CoordinatorError::Wait { name, value: v });
             }
         }
         Ok(())
@@ -107,16 +108,14 @@ impl graspopt_bus::Agent for CoordinatorAgent {
     const ABOUT: &'static str = "Owns the run and its journal";
     type Config = CoordinatorConfig;
     type Output = graspopt_protocol::RunStatus;
-    type Error = CoordinatorAgentError;
+    type Error = CoordinatorError;
 
     fn id(config: &mut CoordinatorConfig) -> &mut String {
         &mut config.id
     }
 
     fn validate(config: &CoordinatorConfig) -> Result<(), Self::Error> {
-        config
-            .validate()
-            .map_err(|e| CoordinatorAgentError(e.into()))
+        config.validate()
     }
 
     async fn run(
@@ -127,25 +126,7 @@ impl graspopt_bus::Agent for CoordinatorAgent {
         stop: impl Future<Output = ()> + Send,
     ) -> Result<Self::Output, Self::Error> {
         let progress = self.progress.clone();
-        run_until(bus, run, &self.spec, config, self.resume, progress, stop)
-            .await
-            .map_err(|e| CoordinatorAgentError(e.into()))
-    }
-}
-
-/// Why the coordinator agent stopped: its message and causes, as the coordinator gives them.
-#[derive(Debug)]
-pub struct CoordinatorAgentError(pub Box<dyn std::error::Error + Send + Sync>);
-
-impl std::fmt::Display for CoordinatorAgentError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.0.fmt(f)
-    }
-}
-
-impl std::error::Error for CoordinatorAgentError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.0.source()
+        run_until(bus, run, &self.spec, config, self.resume, progress, stop).await
     }
 }
 
@@ -155,20 +136,20 @@ mod tests {
 
     #[test]
     fn settings_a_coordinator_cannot_keep_are_refused_by_name() {
-        assert_eq!(CoordinatorConfig::default().validate(), Ok(()));
+        assert!(CoordinatorConfig::default().validate().is_ok());
         let zero = CoordinatorConfig {
             lease_ms: 0,
             ..Default::default()
         };
         assert_eq!(
-            zero.validate(),
-            Err("lease_ms is 0: it must be between 1 and 604800000 (a week)".into())
+            zero.validate().unwrap_err().to_string(),
+            "lease_ms is 0: it must be between 1 and 604800000 (a week)"
         );
         let forever = CoordinatorConfig {
             planner_timeout_ms: u64::MAX,
             ..Default::default()
         };
-        let err = forever.validate().unwrap_err();
+        let err = forever.validate().unwrap_err().to_string();
         assert!(
             err.starts_with("planner_timeout_ms is 18446744073709551615"),
             "{err}"

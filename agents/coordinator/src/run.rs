@@ -1,10 +1,10 @@
-//! The coordinator's async loop: it owns the bus, the timers and the journal, turns each
-//! event into one call of the [`Coordinator`] core and carries out the actions it returns.
+//! The coordinator's async loop: it owns the bus, the timers and the journal, turns what
+//! arrives into [`Event`]s for the [`Coordinator`] core and carries out the actions it
+//! returns, all in one place (`drive`).
 
 use std::time::Duration;
 
-use anyhow::Context;
-use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Server, Subscription, now_ms};
+use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Received, Server, Subscription, now_ms};
 use graspopt_journal::{Journal, ResultOutcome, RunLifecycle, Written};
 use graspopt_protocol::keys::{COMMAND, OBJECT, RESULT, STATE, STATUS, SUGGEST, alive_key};
 use graspopt_protocol::{
@@ -13,8 +13,9 @@ use graspopt_protocol::{
 use tokio::sync::watch;
 
 use crate::CoordinatorConfig;
-use crate::core::{Action, Coordinator, Write};
-use crate::spec::{RunSpec, open_run};
+use crate::core::{Action, Coordinator, Event, Write};
+use crate::error::CoordinatorError;
+use crate::spec::{RunSpec, open_journal, open_run};
 
 /// A proposal request on its way to the planner.
 type PlannerCall<'a> = std::pin::Pin<
@@ -30,7 +31,7 @@ pub async fn run(
     config: &CoordinatorConfig,
     resume: bool,
     progress: Option<watch::Sender<RunStatus>>,
-) -> anyhow::Result<RunStatus> {
+) -> Result<RunStatus, CoordinatorError> {
     let forever = std::future::pending();
     run_until(bus, run, spec, config, resume, progress, forever).await
 }
@@ -48,17 +49,16 @@ pub async fn run_until(
     resume: bool,
     progress: Option<watch::Sender<RunStatus>>,
     stop: impl std::future::Future<Output = ()>,
-) -> anyhow::Result<RunStatus> {
+) -> Result<RunStatus, CoordinatorError> {
     config
         .validate()
-        .map_err(|e| anyhow::anyhow!("coordinator settings: {e}"))?;
+        .map_err(|e| CoordinatorError::Settings(Box::new(e)))?;
     // Two coordinators on one run would issue each trial twice and fight over the journal.
     let place = bus
         .wait_until_unique(run, AgentKind::Coordinator, None, Duration::from_secs(5))
         .await?;
     let journal_path = config.journal_path(run);
-    let mut journal = Journal::open(&journal_path)
-        .with_context(|| format!("cannot open the journal {}", journal_path.display()))?;
+    let mut journal = open_journal(&journal_path)?;
     let (spec, state) = open_run(&mut journal, run, spec, resume)?;
     let engine_state = journal.planner_state(run.as_str())?;
     let inputs = Inputs::open(bus, run).await?;
@@ -92,7 +92,7 @@ struct Inputs {
 }
 
 impl Inputs {
-    async fn open(bus: &Bus, run: &RunId) -> anyhow::Result<Inputs> {
+    async fn open(bus: &Bus, run: &RunId) -> Result<Inputs, BusError> {
         let alive = |kind| alive_key(run.into(), Some(kind));
         Ok(Inputs {
             results: bus.subscribe(&RESULT.key(run.into())).await?,
@@ -109,12 +109,13 @@ impl Inputs {
     }
 }
 
-/// Feeds events to `core` until the run finishes (false) or `stop` resolves (true). The
-/// planner's answer is awaited beside everything else, so results, leases and workers are
-/// still handled while it thinks or while the bus cannot reach it. Should `lost` resolve
-/// (another coordinator holds the run too, see [`graspopt_bus::Claim::lost`]), it stops
-/// with that error: what is in the journal stays, and the run's status there is the other
-/// coordinator's to write.
+/// Feeds events to `core` until the run finishes (false) or `stop` resolves (true): each
+/// turn, what arrived becomes [`Event`]s, handled one after the other, and their actions
+/// are carried out together. The planner's answer is awaited beside everything else, so
+/// results, leases and workers are still handled while it thinks or while the bus cannot
+/// reach it. Should `lost` resolve (another coordinator holds the run too, see
+/// [`graspopt_bus::Claim::lost`]), it stops with that error: what is in the journal stays,
+/// and the run's status there is the other coordinator's to write.
 async fn drive<'a>(
     core: &mut Coordinator,
     inputs: &Inputs,
@@ -122,7 +123,7 @@ async fn drive<'a>(
     status_period: Duration,
     stop: impl std::future::Future<Output = ()>,
     lost: impl std::future::Future<Output = BusError>,
-) -> anyhow::Result<bool> {
+) -> Result<bool, CoordinatorError> {
     tokio::pin!(stop);
     tokio::pin!(lost);
     let mut tick = tokio::time::interval(status_period);
@@ -133,9 +134,9 @@ async fn drive<'a>(
         if core.finished() {
             return Ok(false);
         }
-        let actions = core.poll(now_ms())?;
+        let actions = core.handle(Event::Poll, now_ms())?;
         io.apply(actions, &mut planning).await?;
-        let actions = tokio::select! {
+        let events = tokio::select! {
             reply = async {
                 match planning.as_mut() {
                     Some(call) => call.await,
@@ -143,47 +144,29 @@ async fn drive<'a>(
                 }
             }, if planning.is_some() => {
                 planning = None;
-                core.on_reply(reply, now_ms())?
+                vec![Event::Reply(reply)]
             },
-            Some(r) = inputs.results.recv() => {
-                // Results that arrived together are handled together: their writes and the
-                // issues of the trials their workers take next make one commit.
-                let mut actions = on_result(core, &mut inbox, r);
-                for _ in 1..RESULTS_AT_ONCE {
-                    let Some(r) = inputs.results.try_recv() else { break };
-                    actions.extend(on_result(core, &mut inbox, r));
-                }
-                actions.extend(core.poll(now_ms())?);
-                actions
+            Some(r) = inputs.results.recv() => results(inputs, &mut inbox, r),
+            Some(r) = inputs.objects.recv() => {
+                let estimate = inbox.accept(r, "object estimate");
+                vec![estimate.map_or(Event::BadMessage, |e| Event::Estimate(Box::new(e)))]
             },
-            Some(r) = inputs.objects.recv() => match inbox.accept(r, "object estimate") {
-                Some(estimate) => {
-                    core.on_estimate(&estimate)?;
-                    Vec::new()
-                }
-                None => bad(core),
-            },
-            Some(ev) = inputs.hands.recv() => {
-                core.on_hand(&ev.agent, ev.alive);
-                Vec::new()
-            },
-            Some(ev) = inputs.planners.recv() => core.on_planner_alive(&ev.agent, ev.alive, now_ms()),
-            Some(ev) = inputs.metrics.recv() => {
-                core.on_metric(&ev.agent, ev.alive, now_ms());
-                Vec::new()
-            },
+            Some(e) = inputs.hands.recv() => vec![Event::Hand(e)],
+            Some(e) = inputs.planners.recv() => vec![Event::Planner(e)],
+            Some(e) = inputs.metrics.recv() => vec![Event::Metric(e)],
             Some(q) = inputs.state_server.recv() => {
                 let _ = q.reply(&core.status(now_ms())).await;
                 Vec::new()
             },
-            _ = lease_tick.tick() => {
-                core.on_lease_tick(now_ms());
-                Vec::new()
-            },
+            _ = lease_tick.tick() => vec![Event::LeaseTick],
             _ = &mut stop => return Ok(true),
             e = &mut lost => return Err(e.into()),
-            _ = tick.tick() => core.on_status_tick(now_ms()),
+            _ = tick.tick() => vec![Event::StatusTick],
         };
+        let mut actions = Vec::new();
+        for event in events {
+            actions.extend(core.handle(event, now_ms())?);
+        }
         io.apply(actions, &mut planning).await?;
     }
 }
@@ -192,22 +175,27 @@ async fn drive<'a>(
 /// does not hold back timers and workers).
 const RESULTS_AT_ONCE: usize = 256;
 
-/// A result from the bus, to the core.
-fn on_result(
-    core: &mut Coordinator,
-    inbox: &mut Inbox,
-    r: graspopt_bus::Received<TrialResult>,
-) -> Vec<Action> {
-    match inbox.accept(r, "result") {
-        Some(result) => core.on_result(&result, now_ms()),
-        None => bad(core),
+/// The results that arrived together, `first` and up to [`RESULTS_AT_ONCE`] in all, and a
+/// turn of the loop after them: their writes and the issues of the trials their workers
+/// take next make one commit.
+fn results(inputs: &Inputs, inbox: &mut Inbox, first: Received<TrialResult>) -> Vec<Event> {
+    let mut events = vec![result(inbox, first)];
+    for _ in 1..RESULTS_AT_ONCE {
+        let Some(r) = inputs.results.try_recv() else {
+            break;
+        };
+        events.push(result(inbox, r));
     }
+    events.push(Event::Poll);
+    events
 }
 
-/// Counts a message that was not acted on; nothing to do.
-fn bad(core: &mut Coordinator) -> Vec<Action> {
-    core.on_bad_message();
-    Vec::new()
+/// A result from the bus, as the core is told it.
+fn result(inbox: &mut Inbox, r: Received<TrialResult>) -> Event {
+    match inbox.accept(r, "result") {
+        Some(result) => Event::Result(Box::new(result)),
+        None => Event::BadMessage,
+    }
 }
 
 /// What carries out the core's actions.
@@ -224,7 +212,7 @@ impl<'a> Io<'a> {
         &mut self,
         actions: Vec<Action>,
         planning: &mut Option<PlannerCall<'a>>,
-    ) -> anyhow::Result<()> {
+    ) -> Result<(), CoordinatorError> {
         // The journal first, in one transaction: each write comes at most earlier than
         // the core listed it, so no command goes out before its issue is committed.
         let (writes, rest) = split_writes(actions);
@@ -264,7 +252,7 @@ impl<'a> Io<'a> {
     }
 
     /// The run finished: recorded, its final status published.
-    async fn finished(mut self, core: &Coordinator) -> anyhow::Result<RunStatus> {
+    async fn finished(mut self, core: &Coordinator) -> Result<RunStatus, CoordinatorError> {
         let run = self.run.as_str();
         self.journal
             .set_run_status(run, RunLifecycle::Finished, now_ms())?;
@@ -290,7 +278,7 @@ impl<'a> Io<'a> {
         mut self,
         core: &Coordinator,
         path: &std::path::Path,
-    ) -> anyhow::Result<RunStatus> {
+    ) -> Result<RunStatus, CoordinatorError> {
         let run = self.run;
         self.journal
             .set_run_status(run.as_str(), RunLifecycle::Stopped, now_ms())?;
@@ -345,13 +333,17 @@ pub fn split_writes(actions: Vec<Action>) -> (Vec<Write>, Vec<Action>) {
 /// (a duplicate, say) is logged; a planner state that cannot be kept is only logged (see
 /// [`Write::PlannerState`]); any other refusal, or a transaction that cannot commit, is an
 /// error, returned before any command of these writes is sent.
-pub fn record(journal: &mut Journal, run: &RunId, writes: &[Write]) -> anyhow::Result<()> {
+pub fn record(
+    journal: &mut Journal,
+    run: &RunId,
+    writes: &[Write],
+) -> Result<(), CoordinatorError> {
     if writes.is_empty() {
         return Ok(());
     }
     let outcomes = journal
         .record(run.as_str(), writes)
-        .context("the journal could not commit")?;
+        .map_err(CoordinatorError::Commit)?;
     for (write, outcome) in writes.iter().zip(outcomes) {
         match (write, outcome) {
             (_, Ok(Written::Result(ResultOutcome::Accepted))) => {}

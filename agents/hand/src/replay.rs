@@ -128,9 +128,9 @@ impl Recording {
                 Sensing::Clouds => graspopt_protocol::Message::validate(&crate::serve::tag(
                     &command, "check", None, reading,
                 )),
-                Sensing::Wrenches => graspopt_protocol::Message::validate(&crate::serve::tag_wrenches(
-                    &command, "check", None, reading,
-                )),
+                Sensing::Wrenches => graspopt_protocol::Message::validate(
+                    &crate::serve::tag_wrenches(&command, "check", None, reading),
+                ),
             }
             .map_err(|e| bad(e.to_string()))?;
             if t.params.iter().any(|v| !v.is_finite()) {

@@ -68,6 +68,13 @@ pub enum BenchError {
     Layout(Boxed),
     #[error(transparent)]
     Io(#[from] std::io::Error),
+    #[error(transparent)]
+    Coordinator(#[from] graspopt_coordinator::CoordinatorError),
+    /// A check of what a benchmark run did failed: what was found.
+    #[error("{0}")]
+    Check(String),
+    #[error("a synthetic agent panicked: {0}")]
+    Panicked(#[source] tokio::task::JoinError),
 }
 
 pub mod coordinator;

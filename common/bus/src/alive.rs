@@ -116,6 +116,19 @@ impl Claim {
     }
 }
 
+/// The place a claimant of [`Bus::wait_until_unique`] takes, and its claim's nonce.
+struct Place<'a> {
+    run: &'a RunId,
+    kind: AgentKind,
+    /// The agent's id (`None`: the run's one agent of `kind`).
+    id: Option<&'a str>,
+    /// The id, or `any`, in the claim keys.
+    slot: &'a str,
+    nonce: u64,
+    /// The key of the place's claims.
+    claims_key: String,
+}
+
 /// Where a holder stands, shared by its claims' watch and the task that settles it.
 #[derive(Default)]
 struct Standing {
@@ -279,93 +292,126 @@ impl Bus {
         let deadline = tokio::time::Instant::now() + wait;
         self.wait_for_holders(run, kind, id, deadline).await?;
         let slot = id.unwrap_or("any");
-        let nonce = claim_nonce();
-        let declare = |phase: ClaimPhase| {
-            let key = claim_token(run, kind, slot, ClaimKey { nonce, phase });
-            let session = self.session().clone();
-            async move {
-                session
-                    .liveliness()
-                    .declare_token(key.clone())
-                    .await
-                    .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
-            }
+        let place = Place {
+            run,
+            kind,
+            id,
+            slot,
+            nonce: claim_nonce(),
+            claims_key: claim_slot_key(run, kind, slot),
         };
-        let _starting = declare(ClaimPhase::Starting).await?;
-        let claims_key = claim_slot_key(run, kind, slot);
+        let _starting = self.declare_claim(&place, ClaimPhase::Starting).await?;
         loop {
             // Looks until another claimant is seen; none: hold the place, and look once
             // more in case another claimant held it at the same moment.
-            let mut seen = None;
-            for _ in 0..CLAIM_CHECKS {
-                tokio::time::sleep(CLAIM_LOOK).await;
-                seen = blocker(&self.claims(&claims_key).await?, nonce);
-                if seen.is_some() {
-                    break;
-                }
-            }
+            let mut seen = self.look_for_blocker(&place).await?;
             if seen.is_none() {
-                let held = declare(ClaimPhase::Held).await?;
+                let held = self.declare_claim(&place, ClaimPhase::Held).await?;
                 tokio::time::sleep(CLAIM_LOOK).await;
                 seen = self
-                    .claims(&claims_key)
+                    .claims(&place.claims_key)
                     .await?
                     .into_iter()
-                    .find(|c| gives_way_to(nonce, false, *c));
+                    .find(|c| gives_way_to(place.nonce, false, *c));
                 if seen.is_none() {
-                    let standing = std::sync::Arc::new(std::sync::Mutex::new(Standing::default()));
-                    let (watch, lost) = self
-                        .watch_claims(
-                            &claims_key,
-                            nonce,
-                            standing.clone(),
-                            gives_way(
-                                run,
-                                kind,
-                                id,
-                                "took its place at the same moment and keeps it",
-                            ),
-                        )
-                        .await?;
-                    let settle = declare(ClaimPhase::Settled);
-                    let settle = OwnedTask::spawn(async move {
-                        tokio::time::sleep(SETTLE_AFTER).await;
-                        {
-                            let mut standing = lock(&standing);
-                            if standing.lost {
-                                return;
-                            }
-                            // Settled before the token is out: a claim seen from now on
-                            // is judged as the others will judge this one's.
-                            standing.settled = true;
-                        }
-                        match settle.await {
-                            // The token lives as long as the task: until the claim drops.
-                            Ok(_token) => std::future::pending::<()>().await,
-                            Err(_) => lock(&standing).settled = false,
-                        }
-                    });
-                    return Ok(Claim {
-                        _held: Some(held),
-                        _watch: Some(watch),
-                        _settle: Some(settle),
-                        lost,
-                    });
+                    return self.hold(&place, held).await;
                 }
             }
             // Another agent is taking or holds the place: wait for it to go, as for a
             // predecessor, until the deadline.
             if tokio::time::Instant::now() >= deadline {
-                let e = match seen {
-                    Some(c) if c.phase.holds() => {
-                        let holders = self.holders(run, kind, id).await.unwrap_or_default();
-                        already_has(run, kind, id, holders.first())
-                    }
-                    _ => gives_way(run, kind, id, "is taking its place at the same moment"),
-                };
-                return Err(BusError::Taken(e));
+                return Err(self.kept_from(&place, seen).await);
             }
         }
+    }
+
+    /// Declares this claimant's claim of `place` in `phase` (the future owns what it
+    /// needs: it may run in a task of its own).
+    fn declare_claim(
+        &self,
+        place: &Place<'_>,
+        phase: ClaimPhase,
+    ) -> impl std::future::Future<Output = Result<LivelinessToken, BusError>> + Send + 'static {
+        let claim = ClaimKey {
+            nonce: place.nonce,
+            phase,
+        };
+        let key = claim_token(place.run, place.kind, place.slot, claim);
+        let session = self.session().clone();
+        async move {
+            session
+                .liveliness()
+                .declare_token(key.clone())
+                .await
+                .map_err(|e| BusError::zenoh(format!("declaring liveliness {key}"), e))
+        }
+    }
+
+    /// Looks at the other claims of `place` up to [`CLAIM_CHECKS`] times, [`CLAIM_LOOK`]
+    /// apart, until one keeps this claimant from it (see [`blocker`]).
+    async fn look_for_blocker(&self, place: &Place<'_>) -> Result<Option<ClaimKey>, BusError> {
+        let mut seen = None;
+        for _ in 0..CLAIM_CHECKS {
+            tokio::time::sleep(CLAIM_LOOK).await;
+            seen = blocker(&self.claims(&place.claims_key).await?, place.nonce);
+            if seen.is_some() {
+                break;
+            }
+        }
+        Ok(seen)
+    }
+
+    /// Holds `place` with the `held` claim: watches the other claims (see
+    /// [`Claim::lost`]) and settles after [`SETTLE_AFTER`].
+    async fn hold(&self, place: &Place<'_>, held: LivelinessToken) -> Result<Claim, BusError> {
+        let standing = std::sync::Arc::new(std::sync::Mutex::new(Standing::default()));
+        let why = gives_way(
+            place.run,
+            place.kind,
+            place.id,
+            "took its place at the same moment and keeps it",
+        );
+        let (watch, lost) = self
+            .watch_claims(&place.claims_key, place.nonce, standing.clone(), why)
+            .await?;
+        let settle = self.declare_claim(place, ClaimPhase::Settled);
+        let settle = OwnedTask::spawn(async move {
+            tokio::time::sleep(SETTLE_AFTER).await;
+            {
+                let mut standing = lock(&standing);
+                if standing.lost {
+                    return;
+                }
+                // Settled before the token is out: a claim seen from now on is judged as
+                // the others will judge this one's.
+                standing.settled = true;
+            }
+            match settle.await {
+                // The token lives as long as the task: until the claim drops.
+                Ok(_token) => std::future::pending::<()>().await,
+                Err(_) => lock(&standing).settled = false,
+            }
+        });
+        Ok(Claim {
+            _held: Some(held),
+            _watch: Some(watch),
+            _settle: Some(settle),
+            lost,
+        })
+    }
+
+    /// The error of a claimant kept from `place` until its deadline by `seen`: a holder
+    /// (named when alive) or another claimant.
+    async fn kept_from(&self, place: &Place<'_>, seen: Option<ClaimKey>) -> BusError {
+        let (run, kind, id) = (place.run, place.kind, place.id);
+        let e = match seen {
+            Some(c) if c.phase.holds() => {
+                let holders = self.holders(run, kind, id).await.unwrap_or_default();
+                already_has(run, kind, id, holders.first())
+            }
+            _ => gives_way(run, kind, id, "is taking its place at the same moment"),
+        };
+        BusError::Taken(e)
     }
 
     /// Watches the claims under `key` (one place's) for the holder with nonce `mine`: the

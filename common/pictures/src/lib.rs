@@ -5,4 +5,7 @@
 //! journals, files other than the one it is asked to write, or the bus.
 
 pub mod chart;
+pub mod error;
 pub mod preview;
+
+pub use error::PicturesError;

@@ -8,11 +8,11 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
-use anyhow::{Context, Result};
 use graspopt_sim::{ContactPoint, TriangleMesh};
 use nalgebra::{Point3, Vector3};
 
 use crate::chart::colour;
+use crate::error::PicturesError;
 
 mod figure;
 
@@ -118,14 +118,14 @@ impl Image {
     }
 
     /// Writes the picture as an 8-bit RGB PNG. Errors name the path.
-    pub fn save_png(&self, path: &Path) -> Result<()> {
-        let write = || -> Result<()> {
-            anyhow::ensure!(
-                self.width > 0 && self.height > 0,
-                "empty picture ({} x {})",
-                self.width,
-                self.height
-            );
+    pub fn save_png(&self, path: &Path) -> Result<(), PicturesError> {
+        let write = || -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+            if !(self.width > 0 && self.height > 0) {
+                return Err(Box::new(PicturesError::Empty {
+                    width: self.width,
+                    height: self.height,
+                }));
+            }
             let file = File::create(path)?;
             let mut encoder = png::Encoder::new(BufWriter::new(file), self.width, self.height);
             encoder.set_color(png::ColorType::Rgb);
@@ -136,7 +136,10 @@ impl Image {
             writer.finish()?;
             Ok(())
         };
-        write().with_context(|| format!("cannot write the PNG {}", path.display()))
+        write().map_err(|source| PicturesError::WritePng {
+            path: path.to_path_buf(),
+            source,
+        })
     }
 }
 

@@ -89,6 +89,7 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
     let title = best_title(folder.run, best, folder.params);
     crate::trial::preview_image(folder.evaluator, &grasp, &title)?
         .save_png(&folder.out.join("best.png"))
+        .map_err(Into::into)
 }
 
 /// The best of `done`, as the journal and the run's summary name it: the highest score, the

@@ -11,13 +11,16 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
 use base64::prelude::{BASE64_STANDARD, Engine as _};
 use gltf_json as json;
 use graspopt_sim::ContactPoint;
 use graspopt_sim::scene::NamedMesh;
 use json::validation::Checked::Valid;
 use nalgebra::{Point3, Vector3};
+
+mod error;
+
+pub use error::SceneError;
 
 /// Vertices of one contact marker (an octahedron).
 pub const MARKER_VERTICES: usize = 6;
@@ -86,7 +89,7 @@ pub fn write_obj(
     meshes: &[NamedMesh],
     contacts: &[ContactPoint],
     normal_length: f64,
-) -> Result<()> {
+) -> Result<(), SceneError> {
     let mtl = mtl_path(path);
     let mtl_name = mtl
         .file_name()
@@ -147,19 +150,28 @@ pub fn write_obj(
         let _ = writeln!(out, "l {} {}", base, base + 1);
         base += 2;
     }
+    std::fs::write(path, out).map_err(|e| SceneError::Write {
+        path: path.to_path_buf(),
+        source: Box::new(e),
+    })?;
+    std::fs::write(&mtl, mtl_text(&materials)).map_err(|source| SceneError::WriteMaterials {
+        path: mtl.clone(),
+        source,
+    })?;
+    Ok(())
+}
+
+/// The MTL file of the scene's `materials` (name, diffuse colour).
+fn mtl_text(materials: &[(String, [f64; 3])]) -> String {
     let mut mtl_text = String::from("# graspopt grasp scene colours\n");
-    for (name, kd) in &materials {
+    for (name, kd) in materials {
         let _ = writeln!(
             mtl_text,
             "newmtl {name}\nKa 0 0 0\nKd {} {} {}\nKs 0 0 0\nd 1\nillum 1",
             kd[0], kd[1], kd[2]
         );
     }
-    std::fs::write(path, out)
-        .with_context(|| format!("cannot write the scene {}", path.display()))?;
-    std::fs::write(&mtl, mtl_text)
-        .with_context(|| format!("cannot write the scene's materials {}", mtl.display()))?;
-    Ok(())
+    mtl_text
 }
 
 /// The scene's triangle parts (name, colour, vertices, triangles): the meshes, then the contact
@@ -387,7 +399,7 @@ pub fn gltf_document(
     meshes: &[NamedMesh],
     contacts: &[ContactPoint],
     normal_length: f64,
-) -> Result<json::Root> {
+) -> Result<json::Root, SceneError> {
     let mut doc = Gltf::new();
     for (name, kd, vertices, triangles) in parts(meshes, contacts, normal_length) {
         if vertices.is_empty() || triangles.is_empty() {
@@ -398,7 +410,7 @@ pub fn gltf_document(
             .flatten()
             .find(|&&i| i as usize >= vertices.len())
         {
-            anyhow::bail!("mesh {name} has a vertex index {t} out of range");
+            return Err(SceneError::VertexIndex { name, index: *t });
         }
         let positions = doc.positions(&vertices);
         let indices = doc.indices(&triangles);
@@ -434,11 +446,17 @@ pub fn write_gltf(
     meshes: &[NamedMesh],
     contacts: &[ContactPoint],
     normal_length: f64,
-) -> Result<()> {
-    let context = || format!("cannot write the scene {}", path.display());
-    let doc = gltf_document(meshes, contacts, normal_length).with_context(context)?;
-    let text = json::serialize::to_string(&doc).with_context(context)?;
-    std::fs::write(path, text).with_context(context)
+) -> Result<(), SceneError> {
+    let write = || -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        let doc = gltf_document(meshes, contacts, normal_length)?;
+        let text = json::serialize::to_string(&doc)?;
+        std::fs::write(path, text)?;
+        Ok(())
+    };
+    write().map_err(|source| SceneError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

@@ -244,7 +244,13 @@ fn a_bad_vertex_index_is_refused_with_the_mesh_and_path_named() {
     let bad = TriangleMesh::new(vec![Point3::origin(); 3], vec![[0, 1, 7]]);
     let path = Path::new("/tmp/graspopt-scene-never-written.gltf");
     let err = write_gltf(path, &[named("cup", bad)], &[], 0.1).unwrap_err();
-    let message = format!("{err:#}");
+    // The error and its sources, as `{:#}` of an `anyhow::Error` prints them.
+    let chain = std::iter::successors(Some(&err as &dyn std::error::Error), |e| e.source());
+    let message = chain.map(|e| e.to_string()).collect::<Vec<_>>().join(": ");
+    assert_eq!(
+        message,
+        "cannot write the scene /tmp/graspopt-scene-never-written.gltf: mesh cup has a vertex index 7 out of range"
+    );
     assert!(
         message.contains("cup")
             && message.contains("7")

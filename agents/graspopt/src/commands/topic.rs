@@ -138,8 +138,8 @@ pub fn run(args: &TopicArgs) -> Result<ExitCode> {
         let mut out = std::io::stdout();
         let result = match &plan {
             Plan::List(run, format) => list(&bus, run.as_ref(), *format).await,
-            Plan::Echo(s) => topic::echo(&bus, s, &mut out, shutdown_signal()).await,
-            Plan::Rate(s) => topic::rate(&bus, s, &mut out, shutdown_signal()).await,
+            Plan::Echo(s) => Ok(topic::echo(&bus, s, &mut out, shutdown_signal()).await?),
+            Plan::Rate(s) => Ok(topic::rate(&bus, s, &mut out, shutdown_signal()).await?),
         };
         let _ = bus.close().await;
         result.map(|()| ExitCode::SUCCESS)

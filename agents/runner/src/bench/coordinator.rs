@@ -28,9 +28,22 @@ use std::fmt;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail, ensure};
-use graspopt_bus::{Bus, BusConfig, now_ms};
-use graspopt_coordinator::{Action, Coordinator, CoordinatorConfig, RunSpec, Write, open_run};
+use super::BenchError;
+
+type Result<T> = std::result::Result<T, BenchError>;
+
+/// Fails with [`BenchError::Check`] unless `cond` holds.
+macro_rules! ensure {
+    ($cond:expr, $($fmt:tt)+) => {
+        if !$cond {
+            return Err(BenchError::Check(format!($($fmt)+)));
+        }
+    };
+}
+use graspopt_bus::{AliveEvent, Bus, BusConfig, now_ms};
+use graspopt_coordinator::{
+    Action, Coordinator, CoordinatorConfig, Event, RunSpec, Write, open_run,
+};
 use graspopt_journal::{Journal, TrialState, event_kind};
 use graspopt_protocol::keys::{AliveKey, COMMAND, OBJECT, RESULT, SUGGEST};
 use graspopt_protocol::{
@@ -146,14 +159,18 @@ fn estimate(run: &RunId) -> ObjectEstimate {
     }
 }
 
-fn agent(run: &RunId, kind: AgentKind, id: String) -> AliveKey {
-    AliveKey {
-        run: run.clone(),
-        kind,
-        host: "bench".into(),
-        id,
-        encoding: Encoding::Bincode,
-        publishes: None,
+/// The token of a synthetic agent appearing.
+fn agent(run: &RunId, kind: AgentKind, id: String) -> AliveEvent {
+    AliveEvent {
+        alive: true,
+        agent: AliveKey {
+            run: run.clone(),
+            kind,
+            host: "bench".into(),
+            id,
+            encoding: Encoding::Bincode,
+            publishes: None,
+        },
     }
 }
 
@@ -257,15 +274,18 @@ struct CoreClock {
 pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRow> {
     let run = RunId::new(&format!("bench-core-{workers}"))?;
     let path = dir.join(format!("core-{workers}.sqlite"));
-    let mut journal = Journal::open(&path)
-        .with_context(|| format!("cannot open the journal {}", path.display()))?;
+    let mut journal = Journal::open(&path).map_err(|e| {
+        BenchError::Check(format!("cannot open the journal {}: {e}", path.display()))
+    })?;
     let (spec, state) = open_run(&mut journal, &run, &bench_spec(trials), false)?;
     let config = CoordinatorConfig::default();
     let mut core = Coordinator::new(&run, spec, state, None, config.lease_ms, now_ms());
-    core.on_estimate(&estimate(&run))?;
-    core.on_metric(&agent(&run, AgentKind::Metric, "metric".into()), true, 0);
+    core.handle(Event::Estimate(Box::new(estimate(&run))), 0)?;
+    let metric = agent(&run, AgentKind::Metric, "metric".into());
+    core.handle(Event::Metric(metric), 0)?;
     for i in 1..=workers {
-        core.on_hand(&agent(&run, AgentKind::Hand, format!("hand-{i}")), true);
+        let hand = agent(&run, AgentKind::Hand, format!("hand-{i}"));
+        core.handle(Event::Hand(hand), 0)?;
     }
     let mut clock = CoreClock::default();
     let mut line: VecDeque<TrialCommand> = VecDeque::new();
@@ -273,25 +293,28 @@ pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRo
     let lease_period = Duration::from_millis(50);
     let (mut status_at, mut lease_at) = (Instant::now(), Instant::now());
     while !core.finished() {
-        let mut actions = core.poll(now_ms())?;
+        let mut actions = core.handle(Event::Poll, now_ms())?;
         if line.is_empty() && actions.is_empty() {
-            bail!("the coordinator stalled: nothing running, nothing to issue");
+            return Err(BenchError::Check(
+                "the coordinator stalled: nothing running, nothing to issue".into(),
+            ));
         }
         // Every worker answers at once: the results arrive together, as the loop takes
         // them (one event, then the issues of the freed workers' next trials).
         if !line.is_empty() {
             for command in line.drain(..) {
-                actions.extend(core.on_result(&answer(&command), now_ms()));
+                let result = Event::Result(Box::new(answer(&command)));
+                actions.extend(core.handle(result, now_ms())?);
             }
-            actions.extend(core.poll(now_ms())?);
+            actions.extend(core.handle(Event::Poll, now_ms())?);
         }
         if status_at.elapsed() >= status_period {
             status_at = Instant::now();
-            actions.extend(core.on_status_tick(now_ms()));
+            actions.extend(core.handle(Event::StatusTick, now_ms())?);
         }
         if lease_at.elapsed() >= lease_period {
             lease_at = Instant::now();
-            core.on_lease_tick(now_ms());
+            actions.extend(core.handle(Event::LeaseTick, now_ms())?);
         }
         carry_out(
             &mut core,
@@ -304,7 +327,7 @@ pub fn core_run(dir: &Path, workers: usize, trials: u64) -> Result<CoordinatorRo
     }
     let trials = check_journal(&journal, &run, trials)?;
     let (Some(first), Some(last)) = (clock.first_issue, clock.last_result) else {
-        bail!("no trial ran");
+        return Err(BenchError::Check("no trial ran".into()));
     };
     let seconds = last.duration_since(first).as_secs_f64();
     let (median_ms, p99_ms) = median_p99(clock.latency_ms);
@@ -360,7 +383,8 @@ fn carry_out(
                 Action::Send { command, .. } => line.push_back(command),
                 // Answered at once; what the reply leads to is the next event.
                 Action::Ask(request) => {
-                    todo.extend(core.on_reply(Ok(proposals(&request)), now_ms())?);
+                    let reply = Event::Reply(Ok(proposals(&request)));
+                    todo.extend(core.handle(reply, now_ms())?);
                 }
                 Action::CancelAsk | Action::Publish(_) | Action::Progress(_) => {}
             }
@@ -375,34 +399,90 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
     let mut args = own_bus(BusConfig::default(), &run)?;
     args.no_shm = true;
     let bus = Bus::open(&args).await?;
-    let mut tasks = tokio::task::JoinSet::new();
-    let mut tokens = Vec::new();
-    tokens.push(
-        bus.declare_alive(&run, AgentKind::Metric, "bench-metric")
-            .await?,
+    let mut synthetic = Synthetic::start(&bus, &run, workers).await?;
+    let config = CoordinatorConfig {
+        id: "bench-coordinator".into(),
+        journal: dir.join(format!("bus-{workers}.sqlite")),
+        lease_ms: 60_000,
+        ..CoordinatorConfig::default()
+    };
+    let spec = bench_spec(trials);
+    let status = tokio::select! {
+        s = graspopt_coordinator::run(&bus, &run, &spec, &config, false, None) => Ok(s?),
+        Some(t) = synthetic.tasks.join_next() => match t {
+            Ok(Ok(())) => Err(BenchError::Check("a synthetic agent stopped before the run finished".into())),
+            Ok(Err(e)) => Err(e),
+            Err(join) => Err(BenchError::Panicked(join)),
+        },
+    };
+    synthetic.stop().await;
+    let _ = bus.close().await;
+    let status = status?;
+    ensure!(
+        status.completed == trials,
+        "{} of {trials} trials completed",
+        status.completed
     );
-    tokens.push(
-        bus.declare_alive(&run, AgentKind::Planner, "bench-planner")
-            .await?,
-    );
-    let server = bus.serve::<SuggestRequest>(&SUGGEST.key(&run)).await?;
-    tasks.spawn(async move {
-        while let Some(q) = server.recv().await {
-            match &q.request {
-                Ok(request) => q.reply(&proposals(request)).await?,
-                Err(e) => q.reply_error(&e.to_string()).await?,
-            }
-        }
-        anyhow::Ok(())
-    });
-    for i in 1..=workers {
-        let id = format!("hand-{i}");
-        let commands = bus
-            .subscribe::<TrialCommand>(&COMMAND.worker_key((&run).into(), &id))
+    let journal = Journal::open(&config.journal)?;
+    let mut row = journal_row(&journal, &run, trials)?;
+    row.workers = workers;
+    Ok(row)
+}
+
+/// The synthetic agents of the bus path, one task each; a task holds its agent's
+/// liveliness token.
+struct Synthetic {
+    tasks: tokio::task::JoinSet<Result<()>>,
+}
+
+impl Synthetic {
+    /// A metric agent's token, a planner answering each question at once, `workers` hands
+    /// answering each command with a result at once, and perception saying what it sees
+    /// until the coordinator listens.
+    async fn start(bus: &Bus, run: &RunId, workers: usize) -> Result<Synthetic> {
+        let mut s = Synthetic {
+            tasks: tokio::task::JoinSet::new(),
+        };
+        let metric = bus
+            .declare_alive(run, AgentKind::Metric, "bench-metric")
             .await?;
-        tokens.push(bus.declare_alive(&run, AgentKind::Hand, &id).await?);
+        let planner = bus
+            .declare_alive(run, AgentKind::Planner, "bench-planner")
+            .await?;
+        let server = bus.serve::<SuggestRequest>(&SUGGEST.key(run)).await?;
+        s.tasks.spawn(async move {
+            let _tokens = (metric, planner);
+            while let Some(q) = server.recv().await {
+                match &q.request {
+                    Ok(request) => q.reply(&proposals(request)).await?,
+                    Err(e) => q.reply_error(&e.to_string()).await?,
+                }
+            }
+            Ok::<(), BenchError>(())
+        });
+        for i in 1..=workers {
+            s.hand(bus, run, format!("hand-{i}")).await?;
+        }
         let (b, r) = (bus.clone(), run.clone());
-        tasks.spawn(async move {
+        s.tasks.spawn(async move {
+            loop {
+                b.put(&OBJECT.key((&r).into()), &estimate(&r), Encoding::Bincode)
+                    .await?;
+                tokio::time::sleep(Duration::from_millis(200)).await;
+            }
+        });
+        Ok(s)
+    }
+
+    /// A hand (and metric agent in one) answering each command with a result at once.
+    async fn hand(&mut self, bus: &Bus, run: &RunId, id: String) -> Result<()> {
+        let commands = bus
+            .subscribe::<TrialCommand>(&COMMAND.worker_key(run.into(), &id))
+            .await?;
+        let token = bus.declare_alive(run, AgentKind::Hand, &id).await?;
+        let (b, r) = (bus.clone(), run.clone());
+        self.tasks.spawn(async move {
+            let _token = token;
             while let Some(c) = commands.recv().await {
                 if let Ok(command) = c.message {
                     b.put(
@@ -413,47 +493,22 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
                     .await?;
                 }
             }
-            anyhow::Ok(())
+            Ok::<(), BenchError>(())
         });
+        Ok(())
     }
-    {
-        // Perception says what it sees until the coordinator listens.
-        let (b, r) = (bus.clone(), run.clone());
-        tasks.spawn(async move {
-            loop {
-                b.put(&OBJECT.key((&r).into()), &estimate(&r), Encoding::Bincode)
-                    .await?;
-                tokio::time::sleep(Duration::from_millis(200)).await;
-            }
-        });
+
+    /// Stops every task (their tokens with them).
+    async fn stop(mut self) {
+        self.tasks.abort_all();
+        while self.tasks.join_next().await.is_some() {}
     }
-    let config = CoordinatorConfig {
-        id: "bench-coordinator".into(),
-        journal: dir.join(format!("bus-{workers}.sqlite")),
-        lease_ms: 60_000,
-        ..CoordinatorConfig::default()
-    };
-    let spec = bench_spec(trials);
-    let status = tokio::select! {
-        s = graspopt_coordinator::run(&bus, &run, &spec, &config, false, None) => s,
-        Some(t) = tasks.join_next() => match t {
-            Ok(Ok(())) => Err(anyhow::anyhow!("a synthetic agent stopped before the run finished")),
-            Ok(Err(e)) => Err(e),
-            Err(join) => Err(anyhow::anyhow!("a synthetic agent panicked: {join}")),
-        },
-    };
-    tasks.abort_all();
-    while tasks.join_next().await.is_some() {}
-    drop(tokens);
-    let _ = bus.close().await;
-    let status = status?;
-    ensure!(
-        status.completed == trials,
-        "{} of {trials} trials completed",
-        status.completed
-    );
-    let journal = Journal::open(&config.journal)?;
-    let trials = check_journal(&journal, &run, trials)?;
+}
+
+/// The bus path's figures, from its journal (checked first): times in milliseconds, the
+/// journal's share not measured. `workers` is left at 0 for the caller.
+fn journal_row(journal: &Journal, run: &RunId, trials: u64) -> Result<CoordinatorRow> {
+    let trials = check_journal(journal, run, trials)?;
     let rows = journal.trials(run.as_str())?;
     let first = rows.iter().map(|r| r.issued_ms).min().unwrap_or(0);
     let last = rows
@@ -468,7 +523,7 @@ pub async fn bus_run(dir: &Path, workers: usize, trials: u64) -> Result<Coordina
     let (median_ms, p99_ms) = median_p99(latency);
     Ok(CoordinatorRow {
         path: BenchPath::Bus,
-        workers,
+        workers: 0,
         trials,
         seconds: (last - first).max(1) as f64 / 1e3,
         median_ms,

@@ -3,7 +3,7 @@
 use std::future::Future;
 use std::time::{Duration, Instant};
 
-use anyhow::Result;
+use crate::error::WatchError;
 use graspopt_bus::{Bus, BusError};
 use graspopt_protocol::keys::{STATE, STATUS, alive_key};
 use graspopt_protocol::{AgentKind, RunId, Runs};
@@ -121,7 +121,7 @@ pub async fn dashboard(
     bus: &Bus,
     only: Option<&RunId>,
     stop: impl Future<Output = ()>,
-) -> Result<()> {
+) -> Result<(), WatchError> {
     let statuses = bus.subscribe_ring(&STATUS.key(runs(only)), 64).await?;
     let alive = bus.watch_alive(&coordinators(only)).await?;
     let mut keys = read_keys();
@@ -130,9 +130,7 @@ pub async fn dashboard(
         Err(e) => {
             // Raw mode may be on already: give the shell its terminal back.
             ratatui::restore();
-            return Err(anyhow::anyhow!(
-                "cannot use this terminal for the dashboard: {e} (try --once)"
-            ));
+            return Err(WatchError::Terminal(e));
         }
     };
     let mut m = Monitor::default();

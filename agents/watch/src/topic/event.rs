@@ -4,7 +4,7 @@ use std::future::Future;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use anyhow::{Result, bail};
+use crate::error::WatchError;
 use graspopt_bus::Bus;
 use graspopt_protocol::keys::alive_key;
 use graspopt_protocol::{RunId, Runs};
@@ -51,14 +51,12 @@ pub struct RateSettings {
 }
 
 /// Checks a `--duration` in seconds.
-pub fn check_duration(seconds: Option<f64>) -> Result<Option<Duration>> {
+pub fn check_duration(seconds: Option<f64>) -> Result<Option<Duration>, WatchError> {
     match seconds {
-        Some(s) if !(s.is_finite() && s > 0.0) => {
-            bail!("--duration must be a positive number of seconds, got {s}")
-        }
+        Some(s) if !(s.is_finite() && s > 0.0) => Err(WatchError::Duration(s)),
         Some(s) => Duration::try_from_secs_f64(s)
             .map(Some)
-            .map_err(|_| anyhow::anyhow!("--duration {s} is too long")),
+            .map_err(|_| WatchError::DurationTooLong(s)),
         None => Ok(None),
     }
 }
@@ -78,7 +76,7 @@ async fn until(duration: Option<Duration>, stop: impl Future<Output = ()>) {
 }
 
 /// The topics of the live agents of `run` (every run if `None`).
-pub async fn list(bus: &Bus, run: Option<&RunId>) -> Result<Vec<Row>> {
+pub async fn list(bus: &Bus, run: Option<&RunId>) -> Result<Vec<Row>, WatchError> {
     let runs = run.map_or(Runs::All, Runs::One);
     tokio::time::sleep(SETTLE).await;
     let agents = bus.alive_now(&alive_key(runs, None)).await?;
@@ -92,7 +90,7 @@ pub async fn echo(
     settings: &EchoSettings,
     out: &mut impl Write,
     stop: impl Future<Output = ()>,
-) -> Result<()> {
+) -> Result<(), WatchError> {
     let sub = bus.subscribe_raw(&settings.key, 64).await?;
     let end = until(settings.duration, stop);
     tokio::pin!(end);
@@ -148,7 +146,7 @@ pub async fn rate(
     settings: &RateSettings,
     out: &mut impl Write,
     stop: impl Future<Output = ()>,
-) -> Result<()> {
+) -> Result<(), WatchError> {
     let sub = bus.subscribe_raw(&settings.key, 1024).await?;
     let start = Instant::now();
     let mut w = Window::new(settings.window);

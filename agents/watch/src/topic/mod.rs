@@ -17,7 +17,7 @@ pub mod rows;
 pub mod text;
 pub mod window;
 
-use anyhow::{Result, bail};
+use crate::error::WatchError;
 use graspopt_protocol::{RunId, Runs, Topic};
 
 pub use event::{EchoSettings, Measure, RateSettings, check_duration, echo, list, rate};
@@ -36,10 +36,10 @@ pub enum Format {
 
 /// The key expression a `KEY` argument means: a key expression as it is, or a topic name of
 /// the key table in `run` (every run if `None`).
-pub fn resolve_key(key: &str, run: Option<&str>) -> Result<String> {
+pub fn resolve_key(key: &str, run: Option<&str>) -> Result<String, WatchError> {
     if key.contains('/') {
         if run.is_some() {
-            bail!("--run goes with a topic name, not with a key expression ({key})");
+            return Err(WatchError::RunWithKey(key.to_string()));
         }
         return Ok(key.to_string());
     }
@@ -47,10 +47,9 @@ pub fn resolve_key(key: &str, run: Option<&str>) -> Result<String> {
     let runs = run.as_ref().map_or(Runs::All, Runs::One);
     match Topic::named(key) {
         Some(topic) => Ok(topic.entry().key_expr(runs)),
-        None => bail!(
-            "unknown topic {key:?}: give a key expression (graspopt/<run>/result) or one of {}",
-            Topic::ALL.map(|t| t.entry().name).join(", ")
-        ),
+        None => Err(WatchError::UnknownTopic {
+            key: key.to_string(),
+        }),
     }
 }
 

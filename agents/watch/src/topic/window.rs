@@ -2,7 +2,7 @@
 
 use std::collections::VecDeque;
 
-use anyhow::{Result, bail};
+use crate::error::WatchError;
 
 /// Intervals a window needs before it reports a rate.
 pub const MIN_INTERVALS: usize = 2;
@@ -10,11 +10,9 @@ pub const MIN_INTERVALS: usize = 2;
 pub const MIN_WINDOW: usize = MIN_INTERVALS + 1;
 
 /// Checks the window of `topic hz` and `topic bw` (`--window`).
-pub fn check_window(window: usize) -> Result<()> {
+pub fn check_window(window: usize) -> Result<(), WatchError> {
     if window < MIN_WINDOW {
-        bail!(
-            "--window must be at least {MIN_WINDOW} messages (a rate needs {MIN_INTERVALS} intervals), got {window}"
-        );
+        return Err(WatchError::Window(window));
     }
     Ok(())
 }

@@ -78,8 +78,29 @@ pub fn trials_map(
         .max_by(|a, b| a.2.total_cmp(&b.2));
     let bound = |k: usize| range(bounds.get(k).map_or([0.0, 1.0], |b| [b.0, b.1]).into_iter());
     let label = |k: usize, default: &'static str| labels.get(k).copied().unwrap_or(default);
+    let drawn = Trials { points, zr, best };
     if bounds.len() < 2 {
-        return render((W, H), title, |area| {
+        return drawn.score_plot(title, bound(0), label(0, "parameter"));
+    }
+    let names = (label(0, "parameter 1"), label(1, "parameter 2"));
+    drawn.map(title, (bound(0), bound(1)), names)
+}
+
+/// The trials [`trials_map`] draws: (parameter 1, parameter 2 if any, score if a grasp)
+/// of each, the range of the grasps' scores, and the best.
+struct Trials {
+    points: Vec<(f64, Option<f64>, Option<f64>)>,
+    zr: (f64, f64),
+    best: Option<(f64, Option<f64>, f64)>,
+}
+
+impl Trials {
+    /// One parameter (range `xr`, named `xlabel`): the score against it, misses as grey
+    /// ticks on the bottom edge.
+    fn score_plot(&self, title: &str, xr: (f64, f64), xlabel: &str) -> String {
+        let Trials { points, zr, best } = self;
+        let zr = *zr;
+        render((W, H), title, |area| {
             let area = legend(
                 area,
                 &[
@@ -88,9 +109,9 @@ pub fn trials_map(
                     (Mark::Square(GREY), MISS_TICK_LABEL),
                 ],
             )?;
-            let names = (label(0, "parameter"), "score");
-            let mut chart = axes(&area, bound(0), zr, names, tick)?;
-            let fit = Fit { x: bound(0), y: zr };
+            let names = (xlabel, "score");
+            let mut chart = axes(&area, xr, zr, names, tick)?;
+            let fit = Fit { x: xr, y: zr };
             let ticks: Vec<_> = points
                 .iter()
                 .filter(|t| t.2.is_none())
@@ -102,51 +123,55 @@ pub fn trials_map(
                     .iter()
                     .filter_map(|&(x, _, s)| Some(dot(fit.at((x, s?)), BEST_COLOUR))),
             )?;
-            if let Some((x, _, s)) = best {
+            if let Some((x, _, s)) = *best {
                 chart.draw_series([best_ring(fit.at((x, s)))])?;
             }
             if points.is_empty() {
                 no_data(&chart)?;
             }
             Ok(())
-        });
+        })
     }
-    render((W, H), title, |area| {
-        let area = legend(
-            area,
-            &[
-                (Mark::Dot(RGBColor(170, 220, 60)), "a trial, by score"),
-                (Mark::Ring(RED), "the best"),
-                (Mark::Square(GREY), MISSING_LABEL),
-            ],
-        )?;
-        let main = with_colour_bar(&area, zr, "score")?;
-        let names = (label(0, "parameter 1"), label(1, "parameter 2"));
-        let mut chart = axes(&main, bound(0), bound(1), names, tick)?;
-        let fit = Fit {
-            x: bound(0),
-            y: bound(1),
-        };
-        // Misses first, then the grasps from the lowest score up, so the best show on top.
-        let mut order: Vec<(f64, f64, Option<f64>)> = points
-            .iter()
-            .filter_map(|&(x, y, s)| Some((x, y?, s)))
-            .collect();
-        order.sort_by(|a, b| {
-            let key = |s: Option<f64>| s.unwrap_or(f64::NEG_INFINITY);
-            key(a.2).total_cmp(&key(b.2))
-        });
-        chart.draw_series(
-            order
+
+    /// Two parameters or more (the first two's ranges `(xr, yr)`, named `names`): a dot per
+    /// trial coloured by score, beside the colour bar.
+    fn map(&self, title: &str, (xr, yr): ((f64, f64), (f64, f64)), names: (&str, &str)) -> String {
+        let Trials { points, zr, best } = self;
+        let zr = *zr;
+        render((W, H), title, |area| {
+            let area = legend(
+                area,
+                &[
+                    (Mark::Dot(RGBColor(170, 220, 60)), "a trial, by score"),
+                    (Mark::Ring(RED), "the best"),
+                    (Mark::Square(GREY), MISSING_LABEL),
+                ],
+            )?;
+            let main = with_colour_bar(&area, zr, "score")?;
+            let mut chart = axes(&main, xr, yr, names, tick)?;
+            let fit = Fit { x: xr, y: yr };
+            // Misses first, then the grasps from the lowest score up, so the best show on
+            // top.
+            let mut order: Vec<(f64, f64, Option<f64>)> = points
                 .iter()
-                .map(|&(x, y, s)| dot(fit.at((x, y)), colour_of(s.unwrap_or(f64::NAN), zr))),
-        )?;
-        if let Some((x, Some(y), _)) = best {
-            chart.draw_series([best_ring(fit.at((x, y)))])?;
-        }
-        if order.is_empty() {
-            no_data(&chart)?;
-        }
-        Ok(())
-    })
+                .filter_map(|&(x, y, s)| Some((x, y?, s)))
+                .collect();
+            order.sort_by(|a, b| {
+                let key = |s: Option<f64>| s.unwrap_or(f64::NEG_INFINITY);
+                key(a.2).total_cmp(&key(b.2))
+            });
+            chart.draw_series(
+                order
+                    .iter()
+                    .map(|&(x, y, s)| dot(fit.at((x, y)), colour_of(s.unwrap_or(f64::NAN), zr))),
+            )?;
+            if let Some((x, Some(y), _)) = *best {
+                chart.draw_series([best_ring(fit.at((x, y)))])?;
+            }
+            if order.is_empty() {
+                no_data(&chart)?;
+            }
+            Ok(())
+        })
+    }
 }

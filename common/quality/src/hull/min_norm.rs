@@ -70,70 +70,109 @@ pub fn min_norm_point<const D: usize>(points: &[SVector<f64, D>]) -> MinNormPoin
             break;
         }
         previous = xx;
-        let (j, xp) = points
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (i, x.dot(p)))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .unwrap_or((0, xx));
+        let (j, xp) = lowest_along(points, &x, xx);
         if xx - xp <= accuracy * norm || corral.contains(&j) || corral.len() > D {
             break;
         }
         corral.push(j);
         weights.push(0.0);
-        // Minor cycle: move to the affine minimiser, stepping back to the simplex
-        // boundary while it lies outside.
-        loop {
-            let Some(alpha) = affine_min_norm_weights(points, &corral) else {
-                // Numerically dependent corral: drop the newest point and stop here.
-                corral.pop();
-                weights.pop();
-                break;
-            };
-            if alpha.iter().all(|&a| a > WEIGHT_TOLERANCE) {
-                weights = alpha;
-                break;
-            }
-            let mut theta = 1.0f64;
-            for (l, a) in weights.iter().zip(&alpha) {
-                if *a <= WEIGHT_TOLERANCE && l - a > 0.0 {
-                    theta = theta.min(l / (l - a));
-                }
-            }
-            for (l, a) in weights.iter_mut().zip(&alpha) {
-                *l = (1.0 - theta) * *l + theta * a;
-            }
-            // Drop the points whose weight vanished (at least the one that set theta).
-            let min_w = weights.iter().copied().fold(f64::INFINITY, f64::min);
-            let mut k = 0;
-            while k < corral.len() {
-                if weights[k] <= WEIGHT_TOLERANCE || weights[k] == min_w {
-                    corral.swap_remove(k);
-                    weights.swap_remove(k);
-                } else {
-                    k += 1;
-                }
-            }
-            if corral.is_empty() {
-                break;
-            }
-            let sum: f64 = weights.iter().sum();
-            weights.iter_mut().for_each(|w| *w /= sum);
-        }
+        minor_cycle(points, &mut corral, &mut weights);
         if corral.is_empty() {
             corral.push(j);
             weights.push(1.0);
         }
-        x = corral
-            .iter()
-            .zip(&weights)
-            .map(|(&i, &w)| points[i] * w)
-            .sum();
+        x = combination(points, &corral, &weights);
     }
     MinNormPoint {
         distance: x.norm(),
         point: x,
         support: corral.into_iter().zip(weights).collect(),
+    }
+}
+
+/// The point with the smallest `x.p` (the one that most decreases the norm) and that
+/// product (`(0, xx)` for no points).
+fn lowest_along<const D: usize>(
+    points: &[SVector<f64, D>],
+    x: &SVector<f64, D>,
+    xx: f64,
+) -> (usize, f64) {
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (i, x.dot(p)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, xx))
+}
+
+/// The point of the corral with its weights.
+fn combination<const D: usize>(
+    points: &[SVector<f64, D>],
+    corral: &[usize],
+    weights: &[f64],
+) -> SVector<f64, D> {
+    corral
+        .iter()
+        .zip(weights)
+        .map(|(&i, &w)| points[i] * w)
+        .sum()
+}
+
+/// The minor cycle: moves the corral's weights to its affine minimiser, stepping back to
+/// the simplex boundary (and dropping the points whose weight vanished) while the
+/// minimiser lies outside. A numerically dependent corral loses its newest point instead.
+/// The corral may end up empty.
+fn minor_cycle<const D: usize>(
+    points: &[SVector<f64, D>],
+    corral: &mut Vec<usize>,
+    weights: &mut Vec<f64>,
+) {
+    loop {
+        let Some(alpha) = affine_min_norm_weights(points, corral) else {
+            // Numerically dependent corral: drop the newest point and stop here.
+            corral.pop();
+            weights.pop();
+            return;
+        };
+        if alpha.iter().all(|&a| a > WEIGHT_TOLERANCE) {
+            *weights = alpha;
+            return;
+        }
+        step_back(weights, &alpha);
+        drop_vanished(corral, weights);
+        if corral.is_empty() {
+            return;
+        }
+        let sum: f64 = weights.iter().sum();
+        weights.iter_mut().for_each(|w| *w /= sum);
+    }
+}
+
+/// Moves `weights` toward `alpha` as far as the simplex allows (to the first weight that
+/// reaches zero).
+fn step_back(weights: &mut [f64], alpha: &[f64]) {
+    let mut theta = 1.0f64;
+    for (l, a) in weights.iter().zip(alpha) {
+        if *a <= WEIGHT_TOLERANCE && l - a > 0.0 {
+            theta = theta.min(l / (l - a));
+        }
+    }
+    for (l, a) in weights.iter_mut().zip(alpha) {
+        *l = (1.0 - theta) * *l + theta * a;
+    }
+}
+
+/// Drops the points whose weight vanished (at least the one that set the step).
+fn drop_vanished(corral: &mut Vec<usize>, weights: &mut Vec<f64>) {
+    let min_w = weights.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut k = 0;
+    while k < corral.len() {
+        if weights[k] <= WEIGHT_TOLERANCE || weights[k] == min_w {
+            corral.swap_remove(k);
+            weights.swap_remove(k);
+        } else {
+            k += 1;
+        }
     }
 }
 

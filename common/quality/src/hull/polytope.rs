@@ -186,14 +186,35 @@ impl<'a, const D: usize> Polytope<'a, D> {
         seed: FacetId,
     ) -> Result<std::ops::Range<FacetId>, PolytopeError> {
         let point = self.points[p];
+        let epoch = self.next_epoch();
+        self.find_visible(&point, seed, epoch);
+        let ridges = self.find_horizon(epoch);
+        if self.facets.len() + ridges > FACET_LIMIT {
+            return Err(PolytopeError::TooManyFacets);
+        }
+        let first = self.facets.len() as FacetId;
+        self.cone_horizon(p, &point)?;
+        self.link_new_facets(first)?;
+        for &f in &self.visible {
+            self.facets[f as usize].alive = false;
+        }
+        Ok(first..self.facets.len() as FacetId)
+    }
+
+    /// The stamp of a new step (the stamps are cleared when it wraps around).
+    fn next_epoch(&mut self) -> u32 {
         self.epoch = self.epoch.wrapping_add(1);
         if self.epoch == 0 {
             self.stamp.iter_mut().for_each(|s| *s = 0);
             self.epoch = 1;
         }
-        let epoch = self.epoch;
-        // Visible set by breadth-first search from the seed. Stamps never exceed the
-        // current epoch, so `max` marks a facet exactly when it is taken.
+        self.epoch
+    }
+
+    /// The facets `point` sees, into `self.visible`, by breadth-first search from `seed`;
+    /// each is stamped with `epoch`. Stamps never exceed the current epoch, so `max`
+    /// marks a facet exactly when it is taken.
+    fn find_visible(&mut self, point: &SVector<f64, D>, seed: FacetId, epoch: u32) {
         self.visible.clear();
         self.visible.push(seed);
         self.stamp[seed as usize] = epoch;
@@ -207,7 +228,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
             }
             for g in self.facets[f].neighbors {
                 let fresh = self.stamp[g as usize] != epoch;
-                let beyond = self.facets[g as usize].distance(&point) > self.eps;
+                let beyond = self.facets[g as usize].distance(point) > self.eps;
                 let take = fresh & beyond;
                 self.visible[len] = g;
                 len += take as usize;
@@ -216,9 +237,13 @@ impl<'a, const D: usize> Polytope<'a, D> {
             }
         }
         self.visible.truncate(len);
-        // The horizon: ridges between a visible and a hidden facet.
+    }
+
+    /// The horizon, into `self.horizon`: the ridges between a visible facet (stamped with
+    /// `epoch`) and a hidden one. Returns their number.
+    fn find_horizon(&mut self, epoch: u32) -> usize {
         self.horizon.clear();
-        self.horizon.resize(len * D, (0, 0));
+        self.horizon.resize(self.visible.len() * D, (0, 0));
         let mut ridges = 0;
         for &f in &self.visible {
             for (slot, &g) in self.facets[f as usize].neighbors.iter().enumerate() {
@@ -227,12 +252,13 @@ impl<'a, const D: usize> Polytope<'a, D> {
             }
         }
         self.horizon.truncate(ridges);
-        if self.facets.len() + ridges > FACET_LIMIT {
-            return Err(PolytopeError::TooManyFacets);
-        }
-        // Cone each horizon ridge to the new point.
-        let first = self.facets.len() as FacetId;
-        for i in 0..ridges {
+        ridges
+    }
+
+    /// Cones each horizon ridge to point `p` (at `point`): one new facet each, linked to
+    /// the hidden facet across the ridge (not yet to each other).
+    fn cone_horizon(&mut self, p: usize, point: &SVector<f64, D>) -> Result<(), PolytopeError> {
+        for i in 0..self.horizon.len() {
             let (f, slot) = self.horizon[i];
             let slot = slot as usize;
             let outer = self.facets[f as usize].neighbors[slot];
@@ -244,7 +270,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
                 return Err(PolytopeError::Degenerate);
             }
             verts[slot] = p as u32;
-            let (normal, offset) = self.cone_hyperplane(f, outer, &point, &verts)?;
+            let (normal, offset) = self.cone_hyperplane(f, outer, point, &verts)?;
             let mut neighbors = [FacetId::MAX; D];
             neighbors[slot] = outer;
             let outer_facet = &mut self.facets[outer as usize];
@@ -259,11 +285,7 @@ impl<'a, const D: usize> Polytope<'a, D> {
             });
             self.stamp.push(0);
         }
-        self.link_new_facets(first)?;
-        for &f in &self.visible {
-            self.facets[f as usize].alive = false;
-        }
-        Ok(first..self.facets.len() as FacetId)
+        Ok(())
     }
 
     /// Links the new facets `first..` (the cones from the added point over the horizon,

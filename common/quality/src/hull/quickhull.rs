@@ -131,6 +131,10 @@ pub fn joggled<const D: usize>(points: &[SVector<f64, D>], joggle: f64) -> Vec<S
         .collect()
 }
 
+/// The hull of `points` grown from the initial `simplex` (indices into `points`), the
+/// points moved by `joggle` already: each point outside a facet is assigned to the first
+/// such facet, and the farthest point of a facet's outside set is added until none is
+/// left (quickhull); the result is checked for convexity.
 fn construct<const D: usize>(
     points: &[SVector<f64, D>],
     simplex: &[usize],
@@ -139,18 +143,7 @@ fn construct<const D: usize>(
     let scale = coordinate_scale(points);
     let eps = VISIBILITY_TOLERANCE * scale;
     let mut poly = Polytope::simplex(points, simplex, eps)?;
-    let mut outside: Vec<Vec<u32>> = vec![Vec::new(); poly.facets.len()];
-    for (i, p) in points.iter().enumerate() {
-        if simplex.contains(&i) {
-            continue;
-        }
-        if let Some(f) = poly
-            .live_facets()
-            .find(|&f| poly.facets[f as usize].distance(p) > eps)
-        {
-            outside[f as usize].push(i as u32);
-        }
-    }
+    let mut outside = initial_outside(&poly, simplex, eps);
     let mut stack: Vec<FacetId> = (0..outside.len() as FacetId)
         .filter(|&f| !outside[f as usize].is_empty())
         .collect();
@@ -161,16 +154,7 @@ fn construct<const D: usize>(
         if !poly.facets[fi].alive || outside[fi].is_empty() {
             continue;
         }
-        let facet = &poly.facets[fi];
-        let apex = outside[fi]
-            .iter()
-            .copied()
-            .max_by(|&a, &b| {
-                facet
-                    .distance(&points[a as usize])
-                    .total_cmp(&facet.distance(&points[b as usize]))
-            })
-            .ok_or(HullError::Degenerate)?;
+        let apex = farthest(&poly, f, &outside[fi])?;
         let new = poly.add_point(apex as usize, f)?;
         added += 1;
         orphans.clear();
@@ -192,6 +176,61 @@ fn construct<const D: usize>(
         }
         stack.extend(new.filter(|&g| !outside[g as usize].is_empty()));
     }
+    let facets = convex_facets(&poly, CONVEXITY_TOLERANCE * scale)?;
+    Ok(Hull {
+        volume: poly.volume(),
+        facets,
+        added,
+        joggle,
+    })
+}
+
+/// The outside sets of the initial simplex's facets: each point not in `simplex` that is
+/// beyond a facet (by more than `eps`), in the first such facet's set.
+fn initial_outside<const D: usize>(
+    poly: &Polytope<'_, D>,
+    simplex: &[usize],
+    eps: f64,
+) -> Vec<Vec<u32>> {
+    let mut outside: Vec<Vec<u32>> = vec![Vec::new(); poly.facets.len()];
+    for (i, p) in poly.points.iter().enumerate() {
+        if simplex.contains(&i) {
+            continue;
+        }
+        if let Some(f) = poly
+            .live_facets()
+            .find(|&f| poly.facets[f as usize].distance(p) > eps)
+        {
+            outside[f as usize].push(i as u32);
+        }
+    }
+    outside
+}
+
+/// The point of `candidates` (a facet's outside set) farthest beyond facet `f`.
+fn farthest<const D: usize>(
+    poly: &Polytope<'_, D>,
+    f: FacetId,
+    candidates: &[u32],
+) -> Result<u32, HullError> {
+    let facet = &poly.facets[f as usize];
+    candidates
+        .iter()
+        .copied()
+        .max_by(|&a, &b| {
+            facet
+                .distance(&poly.points[a as usize])
+                .total_cmp(&facet.distance(&poly.points[b as usize]))
+        })
+        .ok_or(HullError::Degenerate)
+}
+
+/// The live facets' planes, checked for convexity: no point of the polytope may lie
+/// beyond a facet by more than `limit`.
+fn convex_facets<const D: usize>(
+    poly: &Polytope<'_, D>,
+    limit: f64,
+) -> Result<Vec<(SVector<f64, D>, f64)>, HullError> {
     let facets: Vec<(SVector<f64, D>, f64)> = poly
         .live_facets()
         .map(|f| {
@@ -201,19 +240,12 @@ fn construct<const D: usize>(
             )
         })
         .collect();
-    // Convexity check: no input point may lie beyond a facet.
-    let limit = CONVEXITY_TOLERANCE * scale;
     for (n, b) in &facets {
-        if points.iter().any(|p| n.dot(p) - b > limit) {
+        if poly.points.iter().any(|p| n.dot(p) - b > limit) {
             return Err(HullError::Degenerate);
         }
     }
-    Ok(Hull {
-        volume: poly.volume(),
-        facets,
-        added,
-        joggle,
-    })
+    Ok(facets)
 }
 
 /// A tiny deterministic generator for the joggle (no dependency, same result on every
