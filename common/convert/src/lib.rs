@@ -4,11 +4,11 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 use graspopt_protocol::{
-    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData, MetricValues,
-    ObjectEstimate, Pose, RunId,
+    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData, MetricValue,
+    MetricValues, ObjectEstimate, Pose, RunId,
 };
 use graspopt_quality::forces::Resisting;
-use graspopt_quality::metrics::Metrics;
+use graspopt_quality::metrics::{Metrics, Value};
 use graspopt_sensing::Reading;
 use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::fingertips::SensorReading;
@@ -179,16 +179,22 @@ pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
     }
 }
 
-/// Metric values on the wire.
-pub fn metric_values(m: &Metrics) -> MetricValues {
-    MetricValues {
-        rank: m.rank as u32,
-        force_closure: m.force_closure,
-        epsilon: m.epsilon,
-        volume: m.volume,
-        distance: m.distance,
-        bw: m.bw,
+/// A metric value on the wire.
+pub fn metric_value(v: Value) -> MetricValue {
+    match v {
+        Value::Count(n) => MetricValue::Count(n),
+        Value::Flag(b) => MetricValue::Flag(b),
+        Value::Real(x) => MetricValue::Real(x),
     }
+}
+
+/// Metric values on the wire: every entry of the metric table by its key, in table order.
+pub fn metric_values(m: &Metrics) -> MetricValues {
+    MetricValues::new(
+        m.iter()
+            .map(|(def, v)| (def.key.to_string(), v.map(metric_value)))
+            .collect(),
+    )
 }
 
 #[cfg(test)]

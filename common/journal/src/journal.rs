@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use rusqlite::types::Value as Sql;
 use rusqlite::{Connection, OptionalExtension, Transaction, TransactionBehavior, params};
 
 use crate::error::{JournalError, Result};
@@ -26,10 +27,21 @@ const STATEMENT_CACHE: usize = 64;
 /// changes nothing of what survives a killed process; the log grows to about 40 MB.
 const WAL_CHECKPOINT_PAGES: u32 = 10_000;
 
-/// Columns read into a [`TrialRow`], in the order [`trial_from_row`] expects.
-const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, issued_ms, \
-     lease_until_ms, completed_ms, result_attempt, score, rank, force_closure, epsilon, volume, \
-     distance, bw, contacts, fingers_in_contact, cloud_points, details_json, error, forces_json";
+/// Columns read into a [`TrialRow`]: all of them, read by name ([`trial_from_row`]), so a
+/// journal without a metric's column still reads (the metric is missing).
+const TRIAL_COLUMNS: &str = "*";
+
+/// Completes a trial with its result: the fixed columns, then every metric's column
+/// ([`crate::metrics::assignments`]) from parameter 12 on.
+static COMPLETE_TRIAL: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    format!(
+        "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
+             result_attempt = ?5, score = ?6, contacts = ?7, fingers_in_contact = ?8,
+             cloud_points = ?9, details_json = ?10, forces_json = ?11, {}
+         WHERE run_id = ?1 AND trial_id = ?2",
+        crate::metrics::assignments(12)
+    )
+});
 
 /// The durable trial journal: runs, trials and their event log in one SQLite
 /// database file (write-ahead log, so a killed process loses at most the
@@ -117,6 +129,7 @@ impl Journal {
             ));
         }
         schema::ensure(&mut conn)?;
+        crate::metrics::add_missing_columns(&mut conn)?;
         Ok(Journal { conn, path })
     }
 
@@ -604,12 +617,7 @@ pub(crate) fn issue_in(tx: &Connection, issue: &TrialIssue) -> Result<()> {
 pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<ResultOutcome> {
     check_finite(|| "score".to_string(), result.score)?;
     if let Some(m) = &result.metrics {
-        check_finite(|| "metrics.epsilon".to_string(), m.epsilon)?;
-        if let Some(v) = m.volume {
-            check_finite(|| "metrics.volume".to_string(), v)?;
-        }
-        check_finite(|| "metrics.distance".to_string(), m.distance)?;
-        check_finite(|| "metrics.bw".to_string(), m.bw)?;
+        crate::metrics::check_finite(m)?;
     }
     if let Some(f) = &result.forces {
         f.validate("forces").map_err(JournalError::Invalid)?;
@@ -661,38 +669,26 @@ pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<R
             } else {
                 None
             };
-            let m = result.metrics.as_ref();
             let forces_json = match &result.forces {
                 Some(f) => Some(serde_json::to_string(f)?),
                 None => None,
             };
-            tx.prepare_cached(
-                "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
-                     result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
-                     epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
-                     fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16,
-                     forces_json = ?17
-                 WHERE run_id = ?1 AND trial_id = ?2",
-            )?
-            .execute(params![
-                result.run_id,
-                id,
-                result.worker,
-                result.at_ms,
-                result.attempt,
-                result.score,
-                m.map(|m| m.rank),
-                m.map(|m| m.force_closure),
-                m.map(|m| m.epsilon),
-                m.and_then(|m| m.volume),
-                m.map(|m| m.distance),
-                m.map(|m| m.bw),
-                result.contacts,
-                result.fingers_in_contact,
-                result.cloud_points,
-                result.details_json,
-                forces_json,
-            ])?;
+            let mut values: Vec<Sql> = vec![
+                result.run_id.clone().into(),
+                id.into(),
+                result.worker.clone().into(),
+                result.at_ms.into(),
+                result.attempt.into(),
+                result.score.into(),
+                result.contacts.into(),
+                result.fingers_in_contact.into(),
+                result.cloud_points.into(),
+                result.details_json.clone().into(),
+                forces_json.into(),
+            ];
+            values.extend(crate::metrics::sql_values(result.metrics.as_ref())?);
+            tx.prepare_cached(&COMPLETE_TRIAL)?
+                .execute(rusqlite::params_from_iter(values))?;
             insert_event(
                 tx,
                 &result.run_id,

@@ -10,9 +10,11 @@ use serde::{Deserialize, Serialize};
 use crate::keys::RunId;
 
 mod forces;
+mod metrics;
 
 pub use forces::ForceAnalysis;
 use forces::ForceAnalysisBeforeUnavailable;
+pub use metrics::{MAX_METRIC_KEY, MAX_METRICS, MetricValue, MetricValues};
 
 /// Implemented by every message type.
 pub trait Message: Serialize + for<'de> Deserialize<'de> {
@@ -409,17 +411,6 @@ impl CloudPoint {
     }
 }
 
-/// The grasp-quality metrics of a trial (thesis chapter 2).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MetricValues {
-    pub rank: u32,
-    pub force_closure: bool,
-    pub epsilon: f64,
-    pub volume: Option<f64>,
-    pub distance: f64,
-    pub bw: f64,
-}
-
 /// metric -> coordinator: the score of one trial.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialResult {
@@ -479,10 +470,7 @@ impl Message for TrialResult {
             finite("score", &[self.score])?;
         }
         if let Some(m) = &self.metrics {
-            finite(
-                "metrics",
-                &[m.epsilon, m.distance, m.bw, m.volume.unwrap_or(0.0)],
-            )?;
+            m.validate("metrics")?;
         }
         if let Some(f) = &self.forces {
             f.validate("forces")?;

@@ -50,14 +50,15 @@ fn result() -> TrialResult {
         worker: "hand-1".into(),
         scorer: "metric-1".into(),
         score: 0.123_456_789_012_345_67,
-        metrics: Some(MetricValues {
-            rank: 6,
-            force_closure: true,
-            epsilon: 0.123_456_789_012_345_67,
-            volume: None,
-            distance: 0.0,
-            bw: 0.123_456_789_012_345_67,
-        }),
+        metrics: Some(
+            MetricValues::default()
+                .with("rank", Some(MetricValue::Count(6)))
+                .with("force_closure", Some(MetricValue::Flag(true)))
+                .with("epsilon", Some(MetricValue::Real(0.123_456_789_012_345_67)))
+                .with("volume", None)
+                .with("distance", Some(MetricValue::Real(0.0)))
+                .with("bw", Some(MetricValue::Real(0.123_456_789_012_345_67))),
+        ),
         contacts: 63,
         fingers_in_contact: 3,
         cloud_points: 120,

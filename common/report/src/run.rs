@@ -163,14 +163,15 @@ mod tests {
     #[test]
     fn the_best_picture_s_title_names_the_run_and_rounds_the_score() {
         let best = TrialRow {
-            metrics: Some(MetricValues {
-                rank: 6,
-                force_closure: true,
-                epsilon: 0.1,
-                volume: None,
-                distance: 0.2,
-                bw: 0.20025899065118113,
-            }),
+            metrics: Some(
+                MetricValues::default()
+                    .with("rank", Some(MetricValue::Count(6)))
+                    .with("force_closure", Some(MetricValue::Flag(true)))
+                    .with("epsilon", Some(MetricValue::Real(0.1)))
+                    .with("volume", None)
+                    .with("distance", Some(MetricValue::Real(0.2)))
+                    .with("bw", Some(MetricValue::Real(0.20025899065118113))),
+            ),
             contacts: 3,
             fingers_in_contact: 3,
             cloud_points: 30,

@@ -8,9 +8,9 @@ use std::time::{Duration, Instant};
 
 use graspopt_journal::export::{write_csv, write_json};
 use graspopt_journal::{
-    EventRow, Journal, JournalError, MetricValues, ResultOutcome, RunExport, RunLifecycle,
-    RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState,
-    event_kind,
+    EventRow, Journal, JournalError, MetricValue, MetricValues, ResultOutcome, RunExport,
+    RunLifecycle, RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow,
+    TrialState, event_kind,
 };
 
 // ------------------------------------------------------------------ helpers
@@ -64,14 +64,19 @@ fn issue(run_id: &str, trial: u64, attempt: u32, worker: &str, at_ms: i64) -> Tr
 }
 
 fn metrics_for(trial: u64) -> MetricValues {
-    MetricValues {
-        rank: 6,
-        force_closure: trial.is_multiple_of(2),
-        epsilon: 0.0123456789012345 * (trial as f64 + 1.0),
-        volume: Some(1.0 / 3.0 + trial as f64),
-        distance: 2.0f64.sqrt(),
-        bw: 1e-17 * (trial as f64 + 1.0),
-    }
+    MetricValues::default()
+        .with("rank", Some(MetricValue::Count(6)))
+        .with(
+            "force_closure",
+            Some(MetricValue::Flag(trial.is_multiple_of(2))),
+        )
+        .with(
+            "epsilon",
+            Some(MetricValue::Real(0.0123456789012345 * (trial as f64 + 1.0))),
+        )
+        .with("volume", Some(MetricValue::Real(1.0 / 3.0 + trial as f64)))
+        .with("distance", Some(MetricValue::Real(2.0f64.sqrt())))
+        .with("bw", Some(MetricValue::Real(1e-17 * (trial as f64 + 1.0))))
 }
 
 fn score_for(trial: u64) -> f64 {
@@ -296,22 +301,34 @@ fn non_finite_values_refused() {
         ("score", result(RUN, 1, 1, "w1", 200, f64::INFINITY)),
         ("metrics.epsilon", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().epsilon = f64::NEG_INFINITY;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("epsilon", Some(MetricValue::Real(f64::NEG_INFINITY)));
             r
         }),
         ("metrics.volume", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().volume = Some(f64::NAN);
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("volume", Some(MetricValue::Real(f64::NAN)));
             r
         }),
         ("metrics.distance", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().distance = f64::NAN;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("distance", Some(MetricValue::Real(f64::NAN)));
             r
         }),
         ("metrics.bw", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().bw = f64::INFINITY;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("bw", Some(MetricValue::Real(f64::INFINITY)));
             r
         }),
     ];
@@ -503,10 +520,10 @@ fn csv_export_fields() {
     assert_eq!(f64_at(done, 9), (0.1f64 + 0.2).to_bits());
     assert_eq!(done[10], "6");
     assert_eq!(done[11], "false");
-    assert_eq!(f64_at(done, 12), m.epsilon.to_bits());
-    assert_eq!(f64_at(done, 13), m.volume.unwrap().to_bits());
-    assert_eq!(f64_at(done, 14), m.distance.to_bits());
-    assert_eq!(f64_at(done, 15), m.bw.to_bits());
+    assert_eq!(f64_at(done, 12), m.real("epsilon").unwrap().to_bits());
+    assert_eq!(f64_at(done, 13), m.real("volume").unwrap().to_bits());
+    assert_eq!(f64_at(done, 14), m.real("distance").unwrap().to_bits());
+    assert_eq!(f64_at(done, 15), m.real("bw").unwrap().to_bits());
     assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", "", ""]);
 
     let failed = &records[2];
@@ -536,7 +553,7 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
     let mut j = journal_with_run();
     j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let mut r1 = result(RUN, 1, 1, "w1", 250, 0.5);
-    r1.metrics.as_mut().unwrap().volume = None;
+    r1.metrics.as_mut().unwrap().set("volume", None);
     j.record_result(&r1).unwrap();
     j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
     let mut out = Vec::new();
@@ -548,8 +565,14 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
     assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
     let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
     let m = metrics_for(1);
-    assert_eq!(records[1][column("epsilon")], format!("{:?}", m.epsilon));
-    assert_eq!(records[1][column("distance")], format!("{:?}", m.distance));
+    assert_eq!(
+        records[1][column("epsilon")],
+        format!("{:?}", m.real("epsilon").unwrap())
+    );
+    assert_eq!(
+        records[1][column("distance")],
+        format!("{:?}", m.real("distance").unwrap())
+    );
     assert_eq!(records[1][column("contacts")], "7");
     assert!(
         records[2][column("score")..column("error")]

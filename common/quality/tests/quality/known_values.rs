@@ -18,17 +18,17 @@ fn three_equator_contacts_epsilon_and_volume() {
     let grasp = equator(&[0.0, 120.0, 240.0]);
     for (mu, eps) in [(0.3, 0.162210364), (0.5, 0.275925156), (1.0, 0.554694462)] {
         let m = metrics(&grasp, friction(mu));
-        assert!(m.force_closure, "mu {mu}");
-        assert_eq!(m.rank, 6);
-        assert!((m.epsilon - eps).abs() < 1e-9, "mu {mu}: {}", m.epsilon);
-        assert_eq!(m.bw, m.epsilon);
-        assert!(m.distance < 1e-12);
+        assert!(m.force_closure(), "mu {mu}");
+        assert_eq!(m.rank(), 6);
+        assert!((m.epsilon() - eps).abs() < 1e-9, "mu {mu}: {}", m.epsilon());
+        assert_eq!(m.bw(), m.epsilon());
+        assert!(m.distance() < 1e-12);
     }
     let m = metrics(&grasp, friction(0.5));
     assert!(
-        (m.volume.unwrap() - 0.0788798).abs() < 1e-7,
+        (m.volume().unwrap() - 0.0788798).abs() < 1e-7,
         "{:?}",
-        m.volume
+        m.volume()
     );
 }
 
@@ -36,29 +36,29 @@ fn three_equator_contacts_epsilon_and_volume() {
 fn two_antipodal_contacts() {
     let grasp = equator(&[0.0, 180.0]);
     let m = metrics(&grasp, friction(0.5));
-    assert_eq!(m.rank, 5);
-    assert!(!m.force_closure);
-    assert_eq!(m.epsilon, 0.0);
-    assert_eq!(m.volume, Some(0.0));
-    assert!(m.bw.abs() < 1e-12 && m.bw <= 0.0);
+    assert_eq!(m.rank(), 5);
+    assert!(!m.force_closure());
+    assert_eq!(m.epsilon(), 0.0);
+    assert_eq!(m.volume(), Some(0.0));
+    assert!(m.bw().abs() < 1e-12 && m.bw() <= 0.0);
     let soft = GraspModel::new(FrictionModel::SoftFinger {
         mu: 0.5,
         edges: 8,
         gamma: 0.2,
     });
     let m = metrics(&grasp, soft);
-    assert!(m.force_closure);
-    assert_eq!(m.rank, 6);
-    assert!((m.epsilon - 0.2).abs() < 1e-9, "{}", m.epsilon);
+    assert!(m.force_closure());
+    assert_eq!(m.rank(), 6);
+    assert!((m.epsilon() - 0.2).abs() < 1e-9, "{}", m.epsilon());
 }
 
 #[test]
 fn one_contact() {
     let m = metrics(&equator(&[30.0]), friction(0.5));
-    assert!((m.distance - 1.0).abs() < 1e-12);
-    assert!((m.bw + 1.0).abs() < 1e-12);
-    assert!(!m.force_closure);
-    assert_eq!(m.rank, 2);
+    assert!((m.distance() - 1.0).abs() < 1e-12);
+    assert!((m.bw() + 1.0).abs() < 1e-12);
+    assert!(!m.force_closure());
+    assert_eq!(m.rank(), 2);
 }
 
 #[test]
@@ -72,13 +72,13 @@ fn cross_polytope_and_cube() {
         }
     }
     let m = evaluate_wrenches(&cross, &MetricsOptions::default()).unwrap();
-    assert!((m.epsilon - 1.0 / 6.0f64.sqrt()).abs() < 1e-12);
-    assert!((m.volume.unwrap() - 64.0 / 720.0).abs() < 1e-12);
+    assert!((m.epsilon() - 1.0 / 6.0f64.sqrt()).abs() < 1e-12);
+    assert!((m.volume().unwrap() - 64.0 / 720.0).abs() < 1e-12);
     let cube: Vec<Wrench> = (0..64)
         .map(|bits| Wrench::from_fn(|i, _| if bits & (1 << i) != 0 { 1.0 } else { -1.0 }))
         .collect();
     let m = evaluate_wrenches(&cube, &MetricsOptions::default()).unwrap();
-    assert!((m.epsilon - 1.0).abs() < 1e-12);
-    assert!((m.volume.unwrap() - 64.0).abs() < 1e-9);
-    assert!(m.force_closure && m.rank == 6);
+    assert!((m.epsilon() - 1.0).abs() < 1e-12);
+    assert!((m.volume().unwrap() - 64.0).abs() < 1e-9);
+    assert!(m.force_closure() && m.rank() == 6);
 }
