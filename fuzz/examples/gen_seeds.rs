@@ -11,7 +11,7 @@ use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, ali
 use graspopt_protocol::{
     BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, FingertipSurface,
     FingertipWrench, FingertipWrenches, MeshData, Message,
-    MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
+    MetricValue, MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
     SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
     WorkerStatus, decode, encode, layout,
 };

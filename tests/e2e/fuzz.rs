@@ -22,8 +22,8 @@ use graspopt_protocol::keys::{
 };
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, FingertipSurface, FingertipWrench,
-    FingertipWrenches, Message, MetricValues, ObjectEstimate, PlannerMethod, Pose, RunId,
-    SuggestRequest, TrialCommand, TrialResult, decode, encode,
+    FingertipWrenches, Message, MetricValue, MetricValues, ObjectEstimate, PlannerMethod, Pose,
+    RunId, SuggestRequest, TrialCommand, TrialResult, decode, encode,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -9,7 +9,7 @@ use graspopt_pictures::chart;
 use graspopt_protocol::named_params;
 use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
-use graspopt_trial::Evaluator;
+use graspopt_trial::{Evaluator, Metric};
 
 /// What the results of a run are written from.
 pub struct RunFolder<'a> {
@@ -106,7 +106,9 @@ fn best_trial<'a>(done: &[&'a TrialRow]) -> Option<&'a TrialRow> {
 /// (the score rounded as a person reads it).
 fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
     let words = match (&best.metrics, best.score) {
-        (Some(m), Some(s)) if m.force_closure => format!("score {}, force closure", rounded(s)),
+        (Some(m), Some(s)) if m.flag(Metric::ForceClosure.key()) == Some(true) => {
+            format!("score {}, force closure", rounded(s))
+        }
         (Some(_), Some(s)) => format!("score {}", rounded(s)),
         _ => "no contact".to_string(),
     };

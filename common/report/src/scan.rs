@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use graspopt_pictures::{chart, preview};
 use graspopt_sim::ParamKind;
-use graspopt_trial::{Evaluator, ReferenceFrame, ScanPoint};
+use graspopt_trial::{Evaluator, Metric, ReferenceFrame, ScanPoint};
 
 /// The score of a grasp that touched something, `None` for one that touched nothing (drawn
 /// grey, off every scale; the CSV keeps its defined no-contact score).
@@ -31,27 +31,43 @@ pub fn touched_grid(axes: &[Vec<f64>], points: &[ScanPoint]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// A scan as CSV: one column per parameter (`names`), then the score and what it came from.
+/// A scan as CSV: one column per parameter (`names`), then the score and what it came from:
+/// the metrics of the metric table that scans show (`in_scan`: force_closure, epsilon,
+/// distance...), the contacts and fingers in contact.
 pub fn csv(names: &[&str], points: &[ScanPoint]) -> String {
+    let metrics: Vec<Metric> = Metric::ALL
+        .into_iter()
+        .filter(|m| m.def().in_scan)
+        .collect();
     let mut out = String::new();
+    let keys: Vec<&str> = metrics.iter().map(|m| m.key()).collect();
     let _ = writeln!(
         out,
-        "{},score,force_closure,epsilon,distance,contacts,fingers_in_contact",
-        names.join(",")
+        "{},score,{},contacts,fingers_in_contact",
+        names.join(","),
+        keys.join(",")
     );
     for p in points {
         for v in &p.params {
             let _ = write!(out, "{v},");
         }
         // A grasp that touched nothing has no metrics: empty fields, as in trials.csv.
-        let metrics = p.score.metrics.map_or_else(
-            || ",,".to_string(),
-            |m| format!("{},{},{}", m.force_closure, m.epsilon, m.distance),
-        );
+        let values: Vec<String> = metrics
+            .iter()
+            .map(|&m| {
+                p.score
+                    .metrics
+                    .and_then(|v| v.get(m))
+                    .map_or(String::new(), |v| v.to_string())
+            })
+            .collect();
         let _ = writeln!(
             out,
-            "{},{metrics},{},{}",
-            p.score.score, p.score.contacts, p.score.fingers_in_contact
+            "{},{},{},{}",
+            p.score.score,
+            values.join(","),
+            p.score.contacts,
+            p.score.fingers_in_contact
         );
     }
     out

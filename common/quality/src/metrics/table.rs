@@ -48,6 +48,17 @@ impl Value {
     }
 }
 
+/// As `Display` writes the number or flag (`6`, `true`, `0.25`, `0`).
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Count(n) => n.fmt(f),
+            Value::Flag(b) => b.fmt(f),
+            Value::Real(x) => x.fmt(f),
+        }
+    }
+}
+
 /// What a metric's compute function gets: the wrench set, the options, and what several
 /// metrics share (computed once, before the table is evaluated).
 #[derive(Debug, Clone, Copy)]

@@ -130,7 +130,7 @@ fn approach_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Res
         let xs = &m.scan.axes[0];
         let mut csv = String::from("approach,ls,gwv,bw,force_closure,contacts\n");
         for (p, ((l, g), b)) in m.scan.points.iter().zip(m.ls.iter().zip(&m.gwv).zip(&m.bw)) {
-            let fc = p.score.metrics.is_some_and(|m| m.force_closure);
+            let fc = p.score.metrics.is_some_and(|m| m.force_closure());
             let _ = writeln!(csv, "{},{l},{g},{b},{fc},{}", p.params[0], p.score.contacts);
         }
         let mut files = vec![write(dir, &format!("fig{fig}-{object}.csv"), &csv)?];
@@ -183,7 +183,7 @@ fn map_row(dir: &Path, stem: &str, title: &str, map: &Map) -> Result<String> {
     let axes = &map.scan.axes;
     let mut csv = String::from("approach,vertical,bw,force_closure,contacts\n");
     for p in points {
-        let fc = p.score.metrics.is_some_and(|m| m.force_closure);
+        let fc = p.score.metrics.is_some_and(|m| m.force_closure());
         let _ = writeln!(
             csv,
             "{},{},{},{fc},{}",
