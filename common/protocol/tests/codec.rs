@@ -180,7 +180,7 @@ fn bincode_payload_starts_with_the_wire_version() {
 #[test]
 fn a_hand_written_json_result_decodes() {
     // What an agent in another language writes, from docs/protocol.md.
-    let text = r#"{"wire": 3, "run_id": "run-1", "trial_id": 4, "attempt": 1,
+    let text = r#"{"wire": 4, "run_id": "run-1", "trial_id": 4, "attempt": 1,
         "worker": "py-hand", "scorer": "py", "score": -2.5, "metrics": null,
         "contacts": 0, "fingers_in_contact": 0, "cloud_points": 0, "cloud_transport": "",
         "error": null}"#;
@@ -253,7 +253,7 @@ fn invalid_content_is_refused_naming_the_field() {
         .unwrap_err();
     assert!(e.to_string().contains("score"), "{e}");
 
-    let text = r#"{"wire": 3, "run_id": "a/b", "trial_id": 4}"#;
+    let text = r#"{"wire": 4, "run_id": "a/b", "trial_id": 4}"#;
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
 }

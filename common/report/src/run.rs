@@ -123,7 +123,7 @@ fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use graspopt_journal::{MetricValues, TrialState};
+    use graspopt_journal::{MetricValue, MetricValues, TrialState};
 
     fn trial(trial_id: u64, score: f64) -> TrialRow {
         TrialRow {

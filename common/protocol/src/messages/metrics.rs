@@ -37,10 +37,22 @@ impl MetricValue {
 }
 
 /// The grasp-quality metrics of a trial (thesis chapter 2): each metric's key and value
-/// (`None`: not computed, as the volume unless the score is the volume), in table order.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// (`None`: not computed, as the volume unless the score is the volume), in table order as
+/// sent. Equal when they have the same values by key, in any order (a JSON decoder may
+/// reorder an object's keys).
+#[derive(Debug, Clone, Default)]
 pub struct MetricValues {
     values: Vec<(String, Option<MetricValue>)>,
+}
+
+impl PartialEq for MetricValues {
+    fn eq(&self, other: &Self) -> bool {
+        self.values.len() == other.values.len()
+            && self
+                .values
+                .iter()
+                .all(|(k, v)| other.values.iter().any(|(k2, v2)| k == k2 && v == v2))
+    }
 }
 
 impl MetricValues {
