@@ -97,8 +97,8 @@ CREATE TABLE events (
 CREATE INDEX events_by_run ON events (run_id, seq);
 ";
 
-/// The columns each table must have, in order. `trials` may have more after these: the
-/// columns of metrics of the metric table that version 1 did not have (see `metrics.rs`).
+/// The columns each table must have, in order. `trials` may have more: the columns of
+/// metrics of the metric table that version 1 did not have (see `metrics.rs`).
 const LAYOUT: &[(&str, &[&str])] = &[
     (
         "runs",
@@ -218,13 +218,15 @@ fn check_layout(conn: &Connection) -> Result<()> {
         if found.is_empty() {
             return Err(JournalError::Schema(format!("table {table} is missing")));
         }
-        // The trials' columns after the layout's must be metric columns.
-        let (known, extra) = match *table {
-            "trials" => found.split_at(expected.len().min(found.len())),
-            _ => (&found[..], &[][..]),
+        // Besides the layout's, trials may have metric columns (anywhere: an upgrade appends
+        // the columns of its version after them).
+        let added_metric = |c: &&String| {
+            *table == "trials"
+                && !expected.contains(&c.as_str())
+                && graspopt_quality::metrics::Metric::from_key(c).is_some()
         };
-        let metric = |c: &String| graspopt_quality::metrics::Metric::from_key(c).is_some();
-        if known != *expected || !extra.iter().all(metric) {
+        let known = found.iter().filter(|c| !added_metric(c)).map(String::as_str);
+        if !known.eq(expected.iter().copied()) {
             return Err(JournalError::Schema(format!(
                 "table {table} has columns {found:?}, expected {expected:?}"
             )));
