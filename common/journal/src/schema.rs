@@ -225,7 +225,10 @@ fn check_layout(conn: &Connection) -> Result<()> {
                 && !expected.contains(&c.as_str())
                 && graspopt_quality::metrics::Metric::from_key(c).is_some()
         };
-        let known = found.iter().filter(|c| !added_metric(c)).map(String::as_str);
+        let known = found
+            .iter()
+            .filter(|c| !added_metric(c))
+            .map(String::as_str);
         if !known.eq(expected.iter().copied()) {
             return Err(JournalError::Schema(format!(
                 "table {table} has columns {found:?}, expected {expected:?}"

@@ -12,6 +12,7 @@ use graspopt_journal::{
     RunLifecycle, RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow,
     TrialState, event_kind,
 };
+use graspopt_quality::metrics::TABLE;
 
 // ------------------------------------------------------------------ helpers
 
@@ -472,38 +473,49 @@ fn csv_export_fields() {
 
     let records = parse_csv(&text);
     assert_eq!(records.len(), 5, "{text}");
+    // The metric columns are the metric table's keys, in its order.
+    let mut header = vec![
+        "trial",
+        "state",
+        "attempts",
+        "worker",
+        "issued_ms",
+        "completed_ms",
+        "approach_x",
+        "roll",
+        "aperture",
+        "score",
+    ];
+    header.extend(TABLE.iter().map(|d| d.key));
+    header.extend([
+        "contacts",
+        "fingers_in_contact",
+        "cloud_points",
+        "can_resist",
+        "resisting_force",
+        "resisting_max",
+        "net_force",
+        "min_slip_margin",
+        "forces_unavailable",
+        "error",
+    ]);
     assert_eq!(
-        records[0],
+        &header[10..16],
         [
-            "trial",
-            "state",
-            "attempts",
-            "worker",
-            "issued_ms",
-            "completed_ms",
-            "approach_x",
-            "roll",
-            "aperture",
-            "score",
             "rank",
             "force_closure",
             "epsilon",
             "volume",
             "distance",
-            "bw",
-            "contacts",
-            "fingers_in_contact",
-            "cloud_points",
-            "can_resist",
-            "resisting_force",
-            "resisting_max",
-            "net_force",
-            "min_slip_margin",
-            "forces_unavailable",
-            "error"
+            "bw"
         ]
     );
-    assert!(records.iter().all(|r| r.len() == 26), "{records:?}");
+    assert_eq!(records[0], header);
+    assert!(
+        records.iter().all(|r| r.len() == header.len()),
+        "{records:?}"
+    );
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let f64_at = |rec: &[String], i: usize| rec[i].parse::<f64>().unwrap().to_bits();
 
     let done = &records[1];
@@ -518,27 +530,33 @@ fn csv_export_fields() {
     }
     let m = metrics_for(1);
     assert_eq!(f64_at(done, 9), (0.1f64 + 0.2).to_bits());
-    assert_eq!(done[10], "6");
-    assert_eq!(done[11], "false");
-    assert_eq!(f64_at(done, 12), m.real("epsilon").unwrap().to_bits());
-    assert_eq!(f64_at(done, 13), m.real("volume").unwrap().to_bits());
-    assert_eq!(f64_at(done, 14), m.real("distance").unwrap().to_bits());
-    assert_eq!(f64_at(done, 15), m.real("bw").unwrap().to_bits());
-    assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", "", ""]);
+    assert_eq!(done[col("rank")], "6");
+    assert_eq!(done[col("force_closure")], "false");
+    for key in ["epsilon", "volume", "distance", "bw"] {
+        assert_eq!(f64_at(done, col(key)), m.real(key).unwrap().to_bits());
+    }
+    let counts = col("contacts");
+    assert_eq!(
+        &done[counts..],
+        ["7", "3", "4096", "", "", "", "", "", "", ""]
+    );
 
     let failed = &records[2];
     assert_eq!(&failed[..6], ["2", "failed", "1", "w,2", "300", ""]);
-    assert!(failed[9..25].iter().all(String::is_empty), "{failed:?}");
-    assert_eq!(failed[25], message);
+    assert!(
+        failed[9..col("error")].iter().all(String::is_empty),
+        "{failed:?}"
+    );
+    assert_eq!(failed[col("error")], message);
 
     let no_metrics = &records[3];
     assert_eq!(no_metrics[9], "1.0");
     assert!(
-        no_metrics[10..16].iter().all(String::is_empty),
+        no_metrics[10..counts].iter().all(String::is_empty),
         "{no_metrics:?}"
     );
     assert_eq!(
-        &no_metrics[16..],
+        &no_metrics[counts..],
         ["7", "3", "4096", "", "", "", "", "", "", ""]
     );
 
@@ -562,7 +580,9 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
     let records = parse_csv(&text);
     assert_eq!(records.len(), 3, "{text}");
     assert!(!records[0].contains(&"volume".to_string()), "{text}");
-    assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
+    // 20 columns besides the metrics', and every metric but the volume.
+    let width = 20 + TABLE.len() - 1;
+    assert!(records.iter().all(|r| r.len() == width), "{records:?}");
     let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
     let m = metrics_for(1);
     assert_eq!(

@@ -38,8 +38,8 @@ impl MetricValue {
 
 /// The grasp-quality metrics of a trial (thesis chapter 2): each metric's key and value
 /// (`None`: not computed, as the volume unless the score is the volume), in table order as
-/// sent. Equal when they have the same values by key, in any order (a JSON decoder may
-/// reorder an object's keys).
+/// sent. Equal when the same metrics have the same values, in any order (a JSON decoder may
+/// reorder an object's keys), a metric not computed (`None`) being the same as one absent.
 #[derive(Debug, Clone, Default)]
 pub struct MetricValues {
     values: Vec<(String, Option<MetricValue>)>,
@@ -47,11 +47,9 @@ pub struct MetricValues {
 
 impl PartialEq for MetricValues {
     fn eq(&self, other: &Self) -> bool {
-        self.values.len() == other.values.len()
-            && self
-                .values
-                .iter()
-                .all(|(k, v)| other.values.iter().any(|(k2, v2)| k == k2 && v == v2))
+        let within =
+            |a: &Self, b: &Self| a.values.iter().all(|(k, v)| v.is_none() || b.get(k) == *v);
+        within(self, other) && within(other, self)
     }
 }
 
