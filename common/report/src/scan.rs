@@ -228,9 +228,19 @@ mod tests {
         );
         let csv = std::fs::read_to_string(&written[0]).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
+        // The metrics of the table that scans show, in its order.
+        let shown: Vec<&str> = Metric::ALL
+            .into_iter()
+            .filter(|m| m.def().in_scan)
+            .map(Metric::key)
+            .collect();
+        assert_eq!(shown[..3], ["force_closure", "epsilon", "distance"]);
         assert_eq!(
             lines[0],
-            "approach,score,force_closure,epsilon,distance,contacts,fingers_in_contact"
+            format!(
+                "approach,score,{},contacts,fingers_in_contact",
+                shown.join(",")
+            )
         );
         assert_eq!(lines.len(), 6);
         assert!(lines[1].starts_with(&format!("{},{},", axes[0][0], points[0].score.score)));
