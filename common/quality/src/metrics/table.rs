@@ -225,6 +225,26 @@ metric_table! {
         .short("bw", 16)
         .objective()
         .describe("Bimodal Wrench: epsilon with force closure, else -distance"),
+    Isotropy => MetricDef::new("isotropy", Kind::Real, isotropy)
+        .objective()
+        .in_scan()
+        .describe("grasp isotropy index: smallest over largest singular value of the wrenches"),
+}
+
+/// The grasp isotropy index (Roa and Suárez 2015, "Grasp quality measures: review and
+/// performance", Autonomous Robots 38): `sigma_min / sigma_max` of the 6 x m matrix `G` whose
+/// columns are the wrenches, from the eigenvalues of `G G^T` (the sum of `w w^T`). 1 when
+/// every direction of wrench space is reached alike, 0 when `G` has rank below 6 (a ratio
+/// below 1e-7, the rounding of the eigenvalues, counts as 0).
+fn isotropy(s: &WrenchSet<'_>) -> Result<Option<Value>, QualityError> {
+    let mut gram = nalgebra::Matrix6::<f64>::zeros();
+    for w in s.wrenches {
+        gram.ger(1.0, w, w, 1.0);
+    }
+    let eigen = gram.symmetric_eigenvalues();
+    let (low, high) = (eigen.min().max(0.0), eigen.max());
+    let ratio = if high > 0.0 { (low / high).sqrt() } else { 0.0 };
+    Ok(Some(Value::Real(if ratio < 1e-7 { 0.0 } else { ratio })))
 }
 
 fn volume(s: &WrenchSet<'_>) -> Result<Option<Value>, QualityError> {
