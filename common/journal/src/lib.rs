@@ -25,6 +25,7 @@ pub mod output;
 mod rows;
 mod schema;
 mod types;
+mod writes;
 
 pub use batch::{Write, Written};
 pub use error::{JournalError, Result};
