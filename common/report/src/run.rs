@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_journal::{Journal, TrialRow};
 use graspopt_pictures::chart;
 use graspopt_protocol::named_params;
@@ -82,13 +82,18 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
     let Some(best) = best_trial(&done) else {
         return Ok(());
     };
-    let grasp = folder
-        .evaluator
-        .evaluate(&best.params)
-        .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
+    let grasp =
+        folder
+            .evaluator
+            .evaluate(&best.params)
+            .map_err(|source| ReportError::Resimulate {
+                trial: best.trial_id,
+                source,
+            })?;
     let title = best_title(folder.run, best, folder.params);
     crate::trial::preview_image(folder.evaluator, &grasp, &title)?
         .save_png(&folder.out.join("best.png"))
+        .map_err(ReportError::picture)
 }
 
 /// The best of `done`, as the journal and the run's summary name it: the highest score, the

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_pictures::{chart, preview};
 use graspopt_sim::ParamKind;
 use graspopt_trial::{Evaluator, Metric, ReferenceFrame, ScanPoint};
@@ -133,8 +133,10 @@ pub fn write_scan(
     let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
     let stem = format!("{}-{}-{}", ev.object.name(), metric, names.join("-"));
     let csv_path = out.join(format!("{stem}.csv"));
-    std::fs::write(&csv_path, csv(&names, points))
-        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    std::fs::write(&csv_path, csv(&names, points)).map_err(|source| ReportError::Write {
+        path: csv_path.clone(),
+        source,
+    })?;
     let mut written = vec![csv_path];
     let value = metric.to_uppercase();
     let title = format!(
@@ -188,10 +190,12 @@ pub fn write_scan(
         _ => return Ok(written),
     };
     let svg_path = out.join(format!("{stem}.svg"));
-    std::fs::write(&svg_path, svg)
-        .with_context(|| format!("cannot write {}", svg_path.display()))?;
+    std::fs::write(&svg_path, svg).map_err(|source| ReportError::Write {
+        path: svg_path.clone(),
+        source,
+    })?;
     let png_path = out.join(format!("{stem}.png"));
-    png.save_png(&png_path)?;
+    png.save_png(&png_path).map_err(ReportError::picture)?;
     written.extend([svg_path, png_path]);
     Ok(written)
 }

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use crate::error::{ReportError, Result};
 use graspopt_pictures::preview;
 use graspopt_quality::metrics::{Metrics, Value};
 use graspopt_trial::{Evaluation, Evaluator, Metric};
@@ -153,20 +153,20 @@ pub fn check_outputs(scene: Option<&Path>, preview: Option<&Path>) -> Result<()>
         } else {
             ""
         };
-        anyhow::bail!(
+        return Err(ReportError::Output(format!(
             "--scene {}: unsupported file type{note}; the supported extensions are .gltf (glTF 2.0) \
              and .obj (Wavefront OBJ with an MTL)",
             path.display()
-        );
+        )));
     }
     if let Some(path) = preview
         && !has_extension(path, "png")
     {
-        anyhow::bail!(
+        return Err(ReportError::Output(format!(
             "--preview {}: unsupported file type; previews are PNG pictures, the supported \
              extension is .png",
             path.display()
-        );
+        )));
     }
     Ok(())
 }
@@ -189,16 +189,20 @@ pub fn write_pictures(
         let (lo, hi) = ev.object.aabb();
         let normal_length = ((hi - lo).norm() * 0.15).clamp(1e-3, 0.05);
         if has_extension(path, "gltf") {
-            graspopt_scene::write_gltf(path, &meshes, &contacts, normal_length)?;
+            graspopt_scene::write_gltf(path, &meshes, &contacts, normal_length)
+                .map_err(ReportError::picture)?;
             written.push(path.to_path_buf());
         } else {
-            graspopt_scene::write_obj(path, &meshes, &contacts, normal_length)?;
+            graspopt_scene::write_obj(path, &meshes, &contacts, normal_length)
+                .map_err(ReportError::picture)?;
             written.push(path.to_path_buf());
             written.push(graspopt_scene::mtl_path(path));
         }
     }
     if let Some(path) = preview {
-        preview_image(ev, e, title)?.save_png(path)?;
+        preview_image(ev, e, title)?
+            .save_png(path)
+            .map_err(ReportError::picture)?;
         written.push(path.to_path_buf());
     }
     Ok(written)

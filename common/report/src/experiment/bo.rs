@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_bayesopt::{InitialDesign, Method, Settings};
 use graspopt_experiment::bo_study::{
     BoStudy, ModelCapChoice, ONE_D_FIGURES, Part, THESIS_TABLE_4_1, summary,
@@ -112,7 +112,10 @@ pub fn write_bo_study(
         started.elapsed().as_secs_f64()
     );
     let path = dir.join("report.md");
-    std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
     Ok(path)
 }
 
@@ -182,7 +185,7 @@ fn one_d(dir: &Path, study: &BoStudy, report: &mut String) -> Result<()> {
             )?);
         }
         let best = trace.best().map_or(f64::NAN, |b| b.1);
-        let top = graspopt_experiment::scans::argmax(&one.truth).context("empty scan")?;
+        let top = graspopt_experiment::scans::argmax(&one.truth).ok_or(ReportError::EmptyScan)?;
         let _ = writeln!(
             report,
             "| {} | {}{} | {best:.4} | {:.4} at {:.3} m | {} |",
@@ -362,7 +365,7 @@ fn two_d(
             r[2],
             two.median_best
         );
-        let first = bo.traces.first().context("no BO run")?;
+        let first = bo.traces.first().ok_or(ReportError::NoBoRun)?;
         let shown = first.ei_stop_at.unwrap_or(first.scores.len());
         let samples: Vec<(f64, f64, f64)> = first.params[..shown]
             .iter()

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_experiment::metric_study::{
     APPROACH_FIGURES, CONTACT_MODEL_OBJECTS, Map, MetricStudy, SPHERE_MAP_MODELS, Variant,
 };
@@ -113,7 +113,10 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         )?);
     }
     let path = dir.join("report.md");
-    std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
     Ok(path)
 }
 
@@ -159,7 +162,7 @@ fn approach_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Res
 
 /// The best point of a variant's scan.
 fn best(v: &Variant) -> Result<&graspopt_trial::ScanPoint> {
-    v.scan.argmax().context("empty scan")
+    v.scan.argmax().ok_or(ReportError::EmptyScan)
 }
 
 /// Plots the BW of every variant along the approach axis together into `dir/file` (grasps
@@ -217,7 +220,8 @@ fn map_row(dir: &Path, stem: &str, title: &str, map: &Map) -> Result<String> {
         missing: chart::MISSING_LABEL,
         cell: 8,
     })
-    .save_png(&dir.join(format!("{stem}.png")))?;
+    .save_png(&dir.join(format!("{stem}.png")))
+    .map_err(ReportError::picture)?;
     let best = map.best()?;
     Ok(format!(
         "| {} | {:.4} | ({:.3}, {:.3}) | {}/{} | {file} |\n",
