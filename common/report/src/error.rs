@@ -45,12 +45,19 @@ pub enum ReportError {
     Trial(#[from] graspopt_trial::TrialError),
     #[error(transparent)]
     Sim(#[from] graspopt_sim::SimError),
+    /// (Boxed: a study's error is large.)
     #[error(transparent)]
-    Experiment(#[from] graspopt_experiment::ExperimentError),
+    Experiment(Box<graspopt_experiment::ExperimentError>),
     /// A picture or a scene that could not be drawn or written (said by
     /// `graspopt-pictures` or `graspopt-scene`).
     #[error(transparent)]
     Picture(Box<dyn std::error::Error + Send + Sync>),
+}
+
+impl From<graspopt_experiment::ExperimentError> for ReportError {
+    fn from(e: graspopt_experiment::ExperimentError) -> Self {
+        ReportError::Experiment(Box::new(e))
+    }
 }
 
 impl ReportError {

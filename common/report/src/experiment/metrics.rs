@@ -42,7 +42,20 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
     );
 
     approach_section(dir, study, &mut report)?;
+    contact_models_section(dir, study, &mut report)?;
+    sphere_maps_section(dir, study, &mut report)?;
+    frames_section(dir, study, &mut report)?;
+    object_maps_section(dir, study, &mut report)?;
+    let path = dir.join("report.md");
+    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
+    Ok(path)
+}
 
+/// Figure 4.6: BW along the approach axis under each contact model.
+fn contact_models_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.6: contact models.
     report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n");
     for object in CONTACT_MODEL_OBJECTS {
@@ -66,7 +79,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         }
         let _ = writeln!(report, "\nFile: {file}\n");
     }
+    Ok(())
+}
 
+/// Figure 4.7: 2D BW maps of the sphere, mean point and surface model.
+fn sphere_maps_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.7: 2D sphere maps, mean point vs surface model.
     report.push_str("\n## Figure 4.7: 2D BW maps of the sphere, mean point and surface model\n\n");
     report.push_str(MAP_TABLE);
@@ -79,7 +96,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
             &map,
         )?);
     }
+    Ok(())
+}
 
+/// Figure 4.8: the reference frames, the torque scale fixed.
+fn frames_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.8: reference frames with the torque scale fixed.
     report.push_str("\n## Figure 4.8: reference-frame independence (sphere, approach axis, torque scale 0.05 m)\n\n| frame | BW max | at approach |\n|---|---|---|\n");
     let variants = study.frames()?;
@@ -98,7 +119,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         );
     }
     let _ = writeln!(report, "\nFile: {file}");
+    Ok(())
+}
 
+/// Figures 4.9-4.15: 2D BW maps of the seven objects.
+fn object_maps_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.9-4.15: 2D maps of the seven objects.
     report.push_str("\n## Figures 4.9-4.15: 2D BW maps (approach x vertical, surface model)\n\n");
     report.push_str(MAP_TABLE);
@@ -112,12 +137,7 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
             &map,
         )?);
     }
-    let path = dir.join("report.md");
-    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
-        path: path.clone(),
-        source,
-    })?;
-    Ok(path)
+    Ok(())
 }
 
 /// Figures 4.3-4.5: LS, GWV and BW along the approach axis of three objects, a CSV and three
