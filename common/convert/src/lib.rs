@@ -202,6 +202,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn metric_values_carry_every_metric_of_the_table_by_key() {
+        use graspopt_quality::metrics::{MetricsOptions, TABLE, evaluate_wrenches};
+        let w: Vec<graspopt_quality::Wrench> = (0..12)
+            .map(|k| {
+                graspopt_quality::Wrench::from_fn(|i, _| {
+                    f64::from(u8::from(i == k / 2)) * [-1.0, 1.0][k % 2]
+                })
+            })
+            .collect();
+        let m = evaluate_wrenches(&w, &MetricsOptions::without_volume()).unwrap();
+        let wire = metric_values(&m);
+        let keys: Vec<&str> = wire.iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, TABLE.map(|d| d.key));
+        assert_eq!(wire.count("rank"), Some(6));
+        assert_eq!(wire.flag("force_closure"), Some(true));
+        assert_eq!(wire.real("bw"), Some(m.bw()));
+        assert_eq!(wire.get("volume"), None);
+    }
+
+    #[test]
     fn poses_round_trip() {
         let iso = Isometry3::from_parts(
             Translation3::new(0.1, -0.2, 0.3),

@@ -657,3 +657,36 @@ fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
         Some(vec![9])
     );
 }
+
+#[test]
+fn a_journal_without_a_metric_column_gains_it_and_reads_the_metric_as_missing() {
+    // A journal written before the last metric of the table existed.
+    let dir = TempDir::new("metric-column");
+    let db = dir.db();
+    let newest = graspopt_quality::metrics::TABLE.last().unwrap().key;
+    {
+        let mut j = Journal::open(&db).unwrap();
+        j.create_run(&run_record(RUN)).unwrap();
+        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+    }
+    {
+        let raw = rusqlite::Connection::open(&db).unwrap();
+        raw.execute_batch(&format!("ALTER TABLE trials DROP COLUMN {newest}"))
+            .unwrap();
+    }
+    let j = Journal::open_existing(&db).unwrap();
+    let t = j.trial(RUN, 1).unwrap().unwrap();
+    let m = t.metrics.unwrap();
+    assert_eq!(m.get(newest), None);
+    assert_eq!(m, metrics_for(1));
+    let raw = rusqlite::Connection::open(&db).unwrap();
+    let has: bool = raw
+        .query_row(
+            "SELECT count(*) FROM pragma_table_info('trials') WHERE name = ?1",
+            [newest],
+            |r| r.get(0),
+        )
+        .unwrap();
+    assert!(has, "the column is added back when the journal is opened");
+}
