@@ -11,7 +11,7 @@ use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, STATUS, ali
 use graspopt_protocol::{
     BestTrial, CloudPoint, ContactClouds, Encoding, ErrorCounts, FingerCloud, FingertipSurface,
     FingertipWrench, FingertipWrenches, MeshData, Message,
-    MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
+    MetricValue, MetricValues, ObjectEstimate, Observation, PlannerMethod, Pose, RunId, RunPhase, RunStatus,
     SuggestReply, SuggestRequest, Topic, TrialCommand, TrialResult, WaitReason, Waiting,
     WorkerStatus, decode, encode, layout,
 };
@@ -180,14 +180,13 @@ fn main() {
         worker: "hand-1".into(),
         scorer: "metric-1".into(),
         score: 0.125,
-        metrics: Some(MetricValues {
-            rank: 6,
-            force_closure: true,
-            epsilon: 0.125,
-            volume: Some(0.002),
-            distance: 0.01,
-            bw: 0.5,
-        }),
+        metrics: Some(MetricValues::default()
+.with("rank", Some(MetricValue::Count(6)))
+.with("force_closure", Some(MetricValue::Flag(true)))
+.with("epsilon", Some(MetricValue::Real(0.125)))
+.with("volume", Some(MetricValue::Real(0.002)))
+.with("distance", Some(MetricValue::Real(0.01)))
+.with("bw", Some(MetricValue::Real(0.5)))),
         contacts: 3,
         fingers_in_contact: 2,
         cloud_points: 3,

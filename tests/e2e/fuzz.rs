@@ -22,8 +22,8 @@ use graspopt_protocol::keys::{
 };
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, FingertipSurface, FingertipWrench,
-    FingertipWrenches, Message, MetricValues, ObjectEstimate, PlannerMethod, Pose, RunId,
-    SuggestRequest, TrialCommand, TrialResult, decode, encode,
+    FingertipWrenches, Message, MetricValue, MetricValues, ObjectEstimate, PlannerMethod, Pose,
+    RunId, SuggestRequest, TrialCommand, TrialResult, decode, encode,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -126,14 +126,15 @@ fn templates() -> Templates {
         worker: "fuzzer".into(),
         scorer: "fuzzer".into(),
         score: 0.5,
-        metrics: Some(MetricValues {
-            rank: 6,
-            force_closure: true,
-            epsilon: 0.1,
-            volume: None,
-            distance: 0.0,
-            bw: 0.1,
-        }),
+        metrics: Some(
+            MetricValues::default()
+                .with("rank", Some(MetricValue::Count(6)))
+                .with("force_closure", Some(MetricValue::Flag(true)))
+                .with("epsilon", Some(MetricValue::Real(0.1)))
+                .with("volume", None)
+                .with("distance", Some(MetricValue::Real(0.0)))
+                .with("bw", Some(MetricValue::Real(0.1))),
+        ),
         contacts: 3,
         fingers_in_contact: 3,
         cloud_points: 3,

@@ -68,7 +68,7 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
             t.trial_id
         );
         if let Some(m) = &t.metrics {
-            assert_eq!(score, m.epsilon, "trial {}", t.trial_id);
+            assert_eq!(Some(score), m.real("epsilon"), "trial {}", t.trial_id);
         }
     }
     let j = Journal::open(&journal).unwrap();

@@ -395,8 +395,10 @@ pub fn check_journal(path: &Path, run: &str, n: usize) -> Vec<graspopt_journal::
         );
         assert!(t.score.unwrap().is_finite());
         if let Some(m) = &t.metrics {
-            assert!(m.bw.is_finite() && m.epsilon >= 0.0 && m.distance >= 0.0);
-            assert_eq!(m.bw > 0.0, m.force_closure, "trial {}", t.trial_id);
+            let real = |key| m.real(key).unwrap();
+            assert!(real("bw").is_finite() && real("epsilon") >= 0.0 && real("distance") >= 0.0);
+            let fc = m.flag("force_closure");
+            assert_eq!(Some(real("bw") > 0.0), fc, "trial {}", t.trial_id);
         }
     }
     trials

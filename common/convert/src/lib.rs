@@ -4,11 +4,11 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 use graspopt_protocol::{
-    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData, MetricValues,
-    ObjectEstimate, Pose, RunId,
+    CloudPoint, ContactClouds, FingerCloud, FingertipWrench, ForceAnalysis, MeshData, MetricValue,
+    MetricValues, ObjectEstimate, Pose, RunId,
 };
 use graspopt_quality::forces::Resisting;
-use graspopt_quality::metrics::Metrics;
+use graspopt_quality::metrics::{Metrics, Value};
 use graspopt_sensing::Reading;
 use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::fingertips::SensorReading;
@@ -179,21 +179,47 @@ pub fn force_analysis(g: &GraspForces) -> ForceAnalysis {
     }
 }
 
-/// Metric values on the wire.
-pub fn metric_values(m: &Metrics) -> MetricValues {
-    MetricValues {
-        rank: m.rank as u32,
-        force_closure: m.force_closure,
-        epsilon: m.epsilon,
-        volume: m.volume,
-        distance: m.distance,
-        bw: m.bw,
+/// A metric value on the wire.
+pub fn metric_value(v: Value) -> MetricValue {
+    match v {
+        Value::Count(n) => MetricValue::Count(n),
+        Value::Flag(b) => MetricValue::Flag(b),
+        Value::Real(x) => MetricValue::Real(x),
     }
+}
+
+/// Metric values on the wire: every entry of the metric table by its key, in table order.
+pub fn metric_values(m: &Metrics) -> MetricValues {
+    MetricValues::new(
+        m.iter()
+            .map(|(def, v)| (def.key.to_string(), v.map(metric_value)))
+            .collect(),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn metric_values_carry_every_metric_of_the_table_by_key() {
+        use graspopt_quality::metrics::{MetricsOptions, TABLE, evaluate_wrenches};
+        let w: Vec<graspopt_quality::Wrench> = (0..12)
+            .map(|k| {
+                graspopt_quality::Wrench::from_fn(|i, _| {
+                    f64::from(u8::from(i == k / 2)) * [-1.0, 1.0][k % 2]
+                })
+            })
+            .collect();
+        let m = evaluate_wrenches(&w, &MetricsOptions::without_volume()).unwrap();
+        let wire = metric_values(&m);
+        let keys: Vec<&str> = wire.iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, TABLE.map(|d| d.key));
+        assert_eq!(wire.count("rank"), Some(6));
+        assert_eq!(wire.flag("force_closure"), Some(true));
+        assert_eq!(wire.real("bw"), Some(m.bw()));
+        assert_eq!(wire.get("volume"), None);
+    }
 
     #[test]
     fn poses_round_trip() {

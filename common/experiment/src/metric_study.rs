@@ -80,7 +80,7 @@ impl Variant {
     /// Width of the force-closure range, m.
     pub fn force_closure_range(&self) -> f64 {
         span(&self.scan.axes[0], &self.scan.points, |p| {
-            p.score.metrics.is_some_and(|m| m.force_closure)
+            p.score.metrics.is_some_and(|m| m.force_closure())
         })
     }
 }
@@ -128,12 +128,12 @@ impl MetricStudy {
         let scan = scan(&ev, &[self.steps], self.threads)?;
         let points = &scan.points;
         let get = |f: &dyn Fn(&ScanPoint) -> f64| points.iter().map(f).collect::<Vec<f64>>();
-        let ls = get(&|p| p.score.metrics.map_or(0.0, |m| m.epsilon));
-        let gwv = get(&|p| p.score.metrics.and_then(|m| m.volume).unwrap_or(0.0));
-        let bw = get(&|p| p.score.metrics.map_or(f64::NAN, |m| m.bw));
+        let ls = get(&|p| p.score.metrics.map_or(0.0, |m| m.epsilon()));
+        let gwv = get(&|p| p.score.metrics.and_then(|m| m.volume()).unwrap_or(0.0));
+        let bw = get(&|p| p.score.metrics.map_or(f64::NAN, |m| m.bw()));
         let xs = &scan.axes[0];
         let force_closure_range = span(xs, points, |p| {
-            p.score.metrics.is_some_and(|m| m.epsilon > 0.0)
+            p.score.metrics.is_some_and(|m| m.epsilon() > 0.0)
         });
         let touched_range = span(xs, points, |p| p.score.metrics.is_some());
         let bw_max_at = points

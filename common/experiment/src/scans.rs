@@ -25,7 +25,7 @@ impl Scan {
     pub fn force_closure(&self) -> usize {
         self.points
             .iter()
-            .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure))
+            .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure()))
             .count()
     }
 }

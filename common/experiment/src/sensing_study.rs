@@ -176,7 +176,7 @@ pub fn round_trip(
                 score_measured(&m, &ev.object, &contacts, &score).map(|(s, _)| s)
             };
             let true_score = scored(&truth)?;
-            if !true_score.metrics.is_some_and(|m| m.force_closure) {
+            if !true_score.metrics.is_some_and(|m| m.force_closure()) {
                 continue;
             }
             row.force_closure += 1;

@@ -17,8 +17,9 @@
 use rusqlite::Connection;
 
 use crate::error::Result;
-use crate::journal::{Journal, failure_in, issue_in, planner_state_in, result_in};
+use crate::journal::Journal;
 use crate::types::{ResultOutcome, TrialIssue, TrialResultRecord};
+use crate::writes::{failure_in, issue_in, planner_state_in, result_in};
 
 /// One write of a run's journal (the run is given to [`Journal::record`]).
 #[derive(Debug, Clone, PartialEq)]

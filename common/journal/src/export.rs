@@ -5,17 +5,11 @@ use std::io::Write;
 
 use crate::error::Result;
 use crate::journal::Journal;
-use crate::types::TrialRow;
+use crate::types::{MetricValue, TrialRow};
+use graspopt_quality::metrics::TABLE;
 
-/// The columns after `completed_ms` and the parameter columns.
-const RESULT_COLUMNS: [&str; 17] = [
-    "score",
-    "rank",
-    "force_closure",
-    "epsilon",
-    "volume",
-    "distance",
-    "bw",
+/// The columns after the metric columns.
+const RESULT_COLUMNS: [&str; 10] = [
     "contacts",
     "fingers_in_contact",
     "cloud_points",
@@ -31,10 +25,11 @@ const RESULT_COLUMNS: [&str; 17] = [
 /// Writes the run's trials as CSV, one row per trial by trial id.
 ///
 /// Header: `trial,state,attempts,worker,issued_ms,completed_ms,<param
-/// names...>,score,rank,force_closure,epsilon,volume,distance,bw,contacts,
+/// names...>,score,<metric keys...>,contacts,
 /// fingers_in_contact,cloud_points,can_resist,resisting_force,resisting_max,net_force,
-/// min_slip_margin,forces_unavailable,error`, without `volume` when no trial has one (only
-/// runs scored by the volume compute it). The force columns come from the result's force
+/// min_slip_margin,forces_unavailable,error`. The metric columns are the metric table's keys
+/// in its order (`rank,force_closure,epsilon,volume,distance,bw,...`), without an optional
+/// metric's when no trial has it (`volume`: only runs scored by the volume compute it). The force columns come from the result's force
 /// analysis ([`crate::ForceAnalysis`]): whether forces in the friction cones can resist the
 /// object's weight, the 2-norm of the least such forces over all contacts and the largest at
 /// one contact (N), and for hands that measure forces the net measured force (N) and the
@@ -56,17 +51,16 @@ pub fn write_csv(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result
         "completed_ms",
     ];
     header.extend(export.run.param_names.iter().map(String::as_str));
-    let volume = export
-        .trials
-        .iter()
-        .any(|t| t.metrics.as_ref().is_some_and(|m| m.volume.is_some()));
-    header.extend(RESULT_COLUMNS.iter().filter(|&&c| volume || c != "volume"));
+    header.push("score");
+    let metrics = metric_columns(&export.trials);
+    header.extend(metrics.iter().copied());
+    header.extend(RESULT_COLUMNS);
     let mut line = String::new();
     push_record(&mut line, header.iter().map(|h| Cow::Borrowed(*h)));
     out.write_all(line.as_bytes())?;
     for trial in &export.trials {
         line.clear();
-        push_record(&mut line, trial_fields(trial, volume));
+        push_record(&mut line, trial_fields(trial, &metrics));
         out.write_all(line.as_bytes())?;
     }
     out.flush()?;
@@ -94,8 +88,32 @@ fn opt<T: std::fmt::Debug>(v: Option<T>) -> Cow<'static, str> {
     v.map_or(Cow::Borrowed(""), num)
 }
 
-/// The CSV fields of `t`, with the `volume` field if `volume`.
-fn trial_fields(t: &TrialRow, volume: bool) -> Vec<Cow<'_, str>> {
+/// The metric columns of the CSV: every metric of the table, an optional one only if a
+/// trial has it.
+fn metric_columns(trials: &[TrialRow]) -> Vec<&'static str> {
+    let has = |key: &str| {
+        trials
+            .iter()
+            .any(|t| t.metrics.as_ref().is_some_and(|m| m.get(key).is_some()))
+    };
+    TABLE
+        .iter()
+        .filter(|d| !d.optional || has(d.key))
+        .map(|d| d.key)
+        .collect()
+}
+
+fn metric_field(v: Option<MetricValue>) -> Cow<'static, str> {
+    match v {
+        None => Cow::Borrowed(""),
+        Some(MetricValue::Count(n)) => num(n),
+        Some(MetricValue::Flag(b)) => num(b),
+        Some(MetricValue::Real(x)) => num(x),
+    }
+}
+
+/// The CSV fields of `t`, with the metric fields of `metrics`.
+fn trial_fields<'a>(t: &'a TrialRow, metrics: &[&str]) -> Vec<Cow<'a, str>> {
     let mut f: Vec<Cow<'_, str>> = vec![
         num(t.trial_id),
         Cow::Borrowed(t.state.as_str()),
@@ -108,14 +126,11 @@ fn trial_fields(t: &TrialRow, volume: bool) -> Vec<Cow<'_, str>> {
     let m = t.metrics.as_ref();
     let has_result = t.score.is_some();
     f.push(opt(t.score));
-    f.push(opt(m.map(|m| m.rank)));
-    f.push(opt(m.map(|m| m.force_closure)));
-    f.push(opt(m.map(|m| m.epsilon)));
-    if volume {
-        f.push(opt(m.and_then(|m| m.volume)));
-    }
-    f.push(opt(m.map(|m| m.distance)));
-    f.push(opt(m.map(|m| m.bw)));
+    f.extend(
+        metrics
+            .iter()
+            .map(|key| metric_field(m.and_then(|m| m.get(key)))),
+    );
     f.push(opt(has_result.then_some(t.contacts)));
     f.push(opt(has_result.then_some(t.fingers_in_contact)));
     f.push(opt(has_result.then_some(t.cloud_points)));

@@ -10,8 +10,9 @@ use crate::rows::{run_from_row, trial_from_row, u64_col};
 use crate::schema;
 use crate::types::{
     EventRow, ResultOutcome, RunExport, RunLifecycle, RunRecord, StateCounts, TrialIssue,
-    TrialResultRecord, TrialRow, TrialState, event_kind,
+    TrialResultRecord, TrialRow, TrialState,
 };
+use crate::writes::{db_id, failure_in, issue_in, parse_state, planner_state_in, result_in};
 
 /// How long a statement waits for another connection's lock before failing.
 const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
@@ -26,10 +27,9 @@ const STATEMENT_CACHE: usize = 64;
 /// changes nothing of what survives a killed process; the log grows to about 40 MB.
 const WAL_CHECKPOINT_PAGES: u32 = 10_000;
 
-/// Columns read into a [`TrialRow`], in the order [`trial_from_row`] expects.
-const TRIAL_COLUMNS: &str = "run_id, trial_id, state, attempts, params, worker, issued_ms, \
-     lease_until_ms, completed_ms, result_attempt, score, rank, force_closure, epsilon, volume, \
-     distance, bw, contacts, fingers_in_contact, cloud_points, details_json, error, forces_json";
+/// Columns read into a [`TrialRow`]: all of them, read by name ([`trial_from_row`]), so a
+/// journal without a metric's column still reads (the metric is missing).
+const TRIAL_COLUMNS: &str = "*";
 
 /// The durable trial journal: runs, trials and their event log in one SQLite
 /// database file (write-ahead log, so a killed process loses at most the
@@ -117,6 +117,7 @@ impl Journal {
             ));
         }
         schema::ensure(&mut conn)?;
+        crate::metrics::add_missing_columns(&mut conn)?;
         Ok(Journal { conn, path })
     }
 
@@ -465,305 +466,6 @@ impl Journal {
     }
 }
 
-pub(crate) fn planner_state_in(
-    tx: &Connection,
-    run_id: &str,
-    state: &[u8],
-    at_ms: i64,
-) -> Result<()> {
-    let known: bool = tx
-        .prepare_cached("SELECT EXISTS (SELECT 1 FROM runs WHERE run_id = ?1)")?
-        .query_row(params![run_id], |r| r.get(0))?;
-    if !known {
-        return Err(JournalError::UnknownRun(run_id.to_string()));
-    }
-    tx.prepare_cached(
-        "INSERT INTO planner_state (run_id, state, updated_ms) VALUES (?1, ?2, ?3)
-         ON CONFLICT (run_id) DO UPDATE SET state = excluded.state,
-                                            updated_ms = excluded.updated_ms",
-    )?
-    .execute(params![run_id, state, at_ms])?;
-    Ok(())
-}
-
-pub(crate) fn issue_in(tx: &Connection, issue: &TrialIssue) -> Result<()> {
-    for (i, p) in issue.params.iter().enumerate() {
-        check_finite(|| format!("params[{i}]"), *p)?;
-    }
-    let id = db_id(issue.trial_id)?;
-    let params_json = serde_json::to_string(&issue.params)?;
-    let names: Option<String> = tx
-        .prepare_cached("SELECT param_names FROM runs WHERE run_id = ?1")?
-        .query_row([&issue.run_id], |r| r.get(0))
-        .optional()?;
-    let Some(names) = names else {
-        return Err(JournalError::UnknownRun(issue.run_id.clone()));
-    };
-    let names: Vec<String> = serde_json::from_str(&names)?;
-    if names.len() != issue.params.len() {
-        return Err(JournalError::ParamCount {
-            run_id: issue.run_id.clone(),
-            trial_id: issue.trial_id,
-            expected: names.len(),
-            found: issue.params.len(),
-        });
-    }
-    let existing: Option<(String, u32, String)> = tx
-        .prepare_cached(
-            "SELECT state, attempts, params FROM trials WHERE run_id = ?1 AND trial_id = ?2",
-        )?
-        .query_row(params![issue.run_id, id], |r| {
-            Ok((r.get(0)?, r.get(1)?, r.get(2)?))
-        })
-        .optional()?;
-    match existing {
-        None => {
-            if issue.attempt != 1 {
-                return Err(JournalError::AttemptMismatch {
-                    run_id: issue.run_id.clone(),
-                    trial_id: issue.trial_id,
-                    expected: 1,
-                    found: issue.attempt,
-                });
-            }
-            tx.prepare_cached(
-                "INSERT INTO trials (run_id, trial_id, state, attempts, params, worker,
-                                     issued_ms, lease_until_ms)
-                 VALUES (?1, ?2, 'running', 1, ?3, ?4, ?5, ?6)",
-            )?
-            .execute(params![
-                issue.run_id,
-                id,
-                params_json,
-                issue.worker,
-                issue.at_ms,
-                issue.lease_until_ms
-            ])?;
-            insert_event(
-                tx,
-                &issue.run_id,
-                id,
-                issue.attempt,
-                event_kind::ISSUED,
-                &issue.worker,
-                issue.at_ms,
-                issue.reason.as_deref(),
-            )?;
-        }
-        Some((state, attempts, stored_params)) => {
-            let state = parse_state(&state)?;
-            if state != TrialState::Running {
-                return Err(JournalError::TrialClosed {
-                    run_id: issue.run_id.clone(),
-                    trial_id: issue.trial_id,
-                    state,
-                });
-            }
-            let expected = attempts.saturating_add(1);
-            if issue.attempt != expected {
-                return Err(JournalError::AttemptMismatch {
-                    run_id: issue.run_id.clone(),
-                    trial_id: issue.trial_id,
-                    expected,
-                    found: issue.attempt,
-                });
-            }
-            let stored: Vec<f64> = serde_json::from_str(&stored_params)?;
-            if !same_bits(&stored, &issue.params) {
-                return Err(JournalError::ParamsMismatch {
-                    run_id: issue.run_id.clone(),
-                    trial_id: issue.trial_id,
-                });
-            }
-            tx.prepare_cached(
-                "UPDATE trials SET attempts = ?3, worker = ?4, lease_until_ms = ?5
-                 WHERE run_id = ?1 AND trial_id = ?2",
-            )?
-            .execute(params![
-                issue.run_id,
-                id,
-                issue.attempt,
-                issue.worker,
-                issue.lease_until_ms
-            ])?;
-            insert_event(
-                tx,
-                &issue.run_id,
-                id,
-                issue.attempt,
-                event_kind::REISSUED,
-                &issue.worker,
-                issue.at_ms,
-                issue.reason.as_deref(),
-            )?;
-        }
-    }
-    Ok(())
-}
-
-pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<ResultOutcome> {
-    check_finite(|| "score".to_string(), result.score)?;
-    if let Some(m) = &result.metrics {
-        check_finite(|| "metrics.epsilon".to_string(), m.epsilon)?;
-        if let Some(v) = m.volume {
-            check_finite(|| "metrics.volume".to_string(), v)?;
-        }
-        check_finite(|| "metrics.distance".to_string(), m.distance)?;
-        check_finite(|| "metrics.bw".to_string(), m.bw)?;
-    }
-    if let Some(f) = &result.forces {
-        f.validate("forces")
-            .map_err(|e| JournalError::Invalid(e.to_string()))?;
-    }
-    let Ok(id) = db_id(result.trial_id) else {
-        return Ok(ResultOutcome::UnknownTrial);
-    };
-    let existing: Option<(String, u32, Option<u32>)> = tx
-        .prepare_cached(
-            "SELECT state, attempts, result_attempt FROM trials
-             WHERE run_id = ?1 AND trial_id = ?2",
-        )?
-        .query_row(params![result.run_id, id], |r| {
-            Ok((r.get(0)?, r.get(1)?, r.get(2)?))
-        })
-        .optional()?;
-    let Some((state, attempts, result_attempt)) = existing else {
-        return Ok(ResultOutcome::UnknownTrial);
-    };
-    let outcome = match parse_state(&state)? {
-        TrialState::Completed | TrialState::Failed => {
-            let note = match result_attempt {
-                Some(a) => format!("trial already completed by attempt {a}"),
-                None => "trial already failed".to_string(),
-            };
-            insert_event(
-                tx,
-                &result.run_id,
-                id,
-                result.attempt,
-                event_kind::DUPLICATE,
-                &result.worker,
-                result.at_ms,
-                Some(&note),
-            )?;
-            ResultOutcome::Duplicate
-        }
-        TrialState::Running => {
-            let note = if result.attempt < attempts {
-                Some(format!(
-                    "late result from attempt {} (latest attempt {attempts})",
-                    result.attempt
-                ))
-            } else if result.attempt > attempts {
-                Some(format!(
-                    "result from attempt {} which was never issued (latest attempt {attempts})",
-                    result.attempt
-                ))
-            } else {
-                None
-            };
-            let m = result.metrics.as_ref();
-            let forces_json = match &result.forces {
-                Some(f) => Some(serde_json::to_string(f)?),
-                None => None,
-            };
-            tx.prepare_cached(
-                "UPDATE trials SET state = 'completed', worker = ?3, completed_ms = ?4,
-                     result_attempt = ?5, score = ?6, rank = ?7, force_closure = ?8,
-                     epsilon = ?9, volume = ?10, distance = ?11, bw = ?12, contacts = ?13,
-                     fingers_in_contact = ?14, cloud_points = ?15, details_json = ?16,
-                     forces_json = ?17
-                 WHERE run_id = ?1 AND trial_id = ?2",
-            )?
-            .execute(params![
-                result.run_id,
-                id,
-                result.worker,
-                result.at_ms,
-                result.attempt,
-                result.score,
-                m.map(|m| m.rank),
-                m.map(|m| m.force_closure),
-                m.map(|m| m.epsilon),
-                m.and_then(|m| m.volume),
-                m.map(|m| m.distance),
-                m.map(|m| m.bw),
-                result.contacts,
-                result.fingers_in_contact,
-                result.cloud_points,
-                result.details_json,
-                forces_json,
-            ])?;
-            insert_event(
-                tx,
-                &result.run_id,
-                id,
-                result.attempt,
-                event_kind::RESULT,
-                &result.worker,
-                result.at_ms,
-                note.as_deref(),
-            )?;
-            ResultOutcome::Accepted
-        }
-    };
-    Ok(outcome)
-}
-
-pub(crate) fn failure_in(
-    tx: &Connection,
-    run_id: &str,
-    trial_id: u64,
-    attempt: u32,
-    message: &str,
-    at_ms: i64,
-) -> Result<bool> {
-    let Ok(id) = db_id(trial_id) else {
-        return Ok(false);
-    };
-    let existing: Option<(String, String)> = tx
-        .prepare_cached("SELECT state, worker FROM trials WHERE run_id = ?1 AND trial_id = ?2")?
-        .query_row(params![run_id, id], |r| Ok((r.get(0)?, r.get(1)?)))
-        .optional()?;
-    let Some((state, worker)) = existing else {
-        return Ok(false);
-    };
-    if parse_state(&state)? != TrialState::Running {
-        return Ok(false);
-    }
-    tx.prepare_cached(
-        "UPDATE trials SET state = 'failed', error = ?3 WHERE run_id = ?1 AND trial_id = ?2",
-    )?
-    .execute(params![run_id, id, message])?;
-    insert_event(
-        tx,
-        run_id,
-        id,
-        attempt,
-        event_kind::FAILED,
-        &worker,
-        at_ms,
-        Some(message),
-    )?;
-    Ok(true)
-}
-
-fn db_id(trial_id: u64) -> Result<i64> {
-    i64::try_from(trial_id).map_err(|_| JournalError::TrialIdRange(trial_id))
-}
-
-fn check_finite(field: impl FnOnce() -> String, v: f64) -> Result<()> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(JournalError::NonFinite { field: field() })
-    }
-}
-
-fn same_bits(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
-}
-
 /// Equal text, or both valid JSON with equal values (key order and spacing ignored).
 fn same_json(a: &str, b: &str) -> bool {
     if a == b {
@@ -776,11 +478,6 @@ fn same_json(a: &str, b: &str) -> bool {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
     }
-}
-
-fn parse_state(s: &str) -> Result<TrialState> {
-    TrialState::parse(s)
-        .ok_or_else(|| JournalError::Schema(format!("unknown trial state {s:?} in the database")))
 }
 
 pub(crate) fn require_run(conn: &Connection, run_id: &str) -> Result<()> {
@@ -800,27 +497,6 @@ fn query_trials(conn: &Connection, run_id: &str) -> Result<Vec<TrialRow>> {
         .query_map([run_id], trial_from_row)?
         .collect::<rusqlite::Result<Vec<_>>>()?;
     Ok(rows)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn insert_event(
-    conn: &Connection,
-    run_id: &str,
-    trial_id: i64,
-    attempt: u32,
-    kind: &str,
-    worker: &str,
-    at_ms: i64,
-    note: Option<&str>,
-) -> Result<()> {
-    let mut stmt = conn.prepare_cached(
-        "INSERT INTO events (run_id, trial_id, attempt, kind, worker, at_ms, note)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-    )?;
-    stmt.execute(params![
-        run_id, trial_id, attempt, kind, worker, at_ms, note
-    ])?;
-    Ok(())
 }
 
 /// Why SQLite could not open or write the journal at `path` (it says only "unable to open

@@ -9,7 +9,8 @@
 //! [`output`]).
 //!
 //! It must not know the network or the bus, the planner, the simulator or any
-//! other graspopt crate but protocol's plain data (a result's `MetricValues`): it
+//! other graspopt crate but protocol's plain data (a result's `MetricValues`) and the
+//! quality crate's metric table (which metric columns a trial has: see `metrics.rs`): it
 //! defines its own record types, and the caller converts. It reads no clock (every timestamp is given by the caller) and
 //! starts no thread: one owner (a thread, a task or a mutex) calls it; a
 //! [`Journal`] is `Send`, not `Sync`.
@@ -19,10 +20,12 @@ mod error;
 pub mod export;
 mod failures;
 mod journal;
+mod metrics;
 pub mod output;
 mod rows;
 mod schema;
 mod types;
+mod writes;
 
 pub use batch::{Write, Written};
 pub use error::{JournalError, Result};
@@ -30,6 +33,6 @@ pub use failures::{FailureReason, NO_REASON};
 pub use journal::Journal;
 pub use schema::SCHEMA_VERSION;
 pub use types::{
-    EventRow, ForceAnalysis, MetricValues, ResultOutcome, RunExport, RunLifecycle, RunRecord,
-    StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+    EventRow, ForceAnalysis, MetricValue, MetricValues, ResultOutcome, RunExport, RunLifecycle,
+    RunRecord, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
 };

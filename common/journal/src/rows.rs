@@ -3,7 +3,7 @@
 use rusqlite::Row;
 use rusqlite::types::Type;
 
-use crate::types::{MetricValues, RunLifecycle, RunRecord, TrialRow, TrialState};
+use crate::types::{RunLifecycle, RunRecord, TrialRow, TrialState};
 
 pub(crate) fn conversion_error(
     idx: usize,
@@ -34,49 +34,54 @@ pub(crate) fn run_from_row(r: &Row<'_>) -> rusqlite::Result<RunRecord> {
     })
 }
 
-/// Reads a row selected with [`TRIAL_COLUMNS`].
+/// The index of the column `name` of `r` (for an error's message).
+pub(crate) fn index(r: &Row<'_>, name: &str) -> usize {
+    r.as_ref().column_index(name).unwrap_or(0)
+}
+
+/// Reads a trial row (`SELECT * FROM trials`) by column name.
 pub(crate) fn trial_from_row(r: &Row<'_>) -> rusqlite::Result<TrialRow> {
-    let state: String = r.get(2)?;
-    let state = TrialState::parse(&state)
-        .ok_or_else(|| conversion_error(2, Type::Text, format!("unknown trial state {state:?}")))?;
-    let params: String = r.get(4)?;
+    let at = |name| index(r, name);
+    let state: String = r.get("state")?;
+    let state = TrialState::parse(&state).ok_or_else(|| {
+        conversion_error(
+            at("state"),
+            Type::Text,
+            format!("unknown trial state {state:?}"),
+        )
+    })?;
+    let params: String = r.get("params")?;
     let params: Vec<f64> =
-        serde_json::from_str(&params).map_err(|e| conversion_error(4, Type::Text, e))?;
-    let metrics = match r.get::<_, Option<u32>>(11)? {
-        None => None,
-        Some(rank) => Some(MetricValues {
-            rank,
-            force_closure: r.get(12)?,
-            epsilon: r.get(13)?,
-            volume: r.get(14)?,
-            distance: r.get(15)?,
-            bw: r.get(16)?,
-        }),
-    };
-    let forces = match r.get::<_, Option<String>>(22)? {
+        serde_json::from_str(&params).map_err(|e| conversion_error(at("params"), Type::Text, e))?;
+    let forces = match r.get::<_, Option<String>>("forces_json")? {
         None => None,
         Some(json) => {
-            Some(serde_json::from_str(&json).map_err(|e| conversion_error(22, Type::Text, e))?)
+            let e = |e| conversion_error(at("forces_json"), Type::Text, e);
+            Some(serde_json::from_str(&json).map_err(e)?)
         }
     };
+    let count =
+        |name: &str| Ok::<u32, rusqlite::Error>(r.get::<_, Option<u32>>(name)?.unwrap_or(0));
+    let trial_id: i64 = r.get("trial_id")?;
     Ok(TrialRow {
-        run_id: r.get(0)?,
-        trial_id: u64_col(r, 1)?,
+        run_id: r.get("run_id")?,
+        trial_id: u64::try_from(trial_id)
+            .map_err(|e| conversion_error(at("trial_id"), Type::Integer, e))?,
         state,
-        attempts: r.get(3)?,
+        attempts: r.get("attempts")?,
         params,
-        worker: r.get(5)?,
-        issued_ms: r.get(6)?,
-        lease_until_ms: r.get(7)?,
-        completed_ms: r.get(8)?,
-        result_attempt: r.get(9)?,
-        score: r.get(10)?,
-        metrics,
-        contacts: r.get::<_, Option<u32>>(17)?.unwrap_or(0),
-        fingers_in_contact: r.get::<_, Option<u32>>(18)?.unwrap_or(0),
-        cloud_points: r.get::<_, Option<u32>>(19)?.unwrap_or(0),
-        details_json: r.get(20)?,
-        error: r.get(21)?,
+        worker: r.get("worker")?,
+        issued_ms: r.get("issued_ms")?,
+        lease_until_ms: r.get("lease_until_ms")?,
+        completed_ms: r.get("completed_ms")?,
+        result_attempt: r.get("result_attempt")?,
+        score: r.get("score")?,
+        metrics: crate::metrics::read(r)?,
+        contacts: count("contacts")?,
+        fingers_in_contact: count("fingers_in_contact")?,
+        cloud_points: count("cloud_points")?,
+        details_json: r.get("details_json")?,
+        error: r.get("error")?,
         forces,
     })
 }

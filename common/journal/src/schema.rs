@@ -97,7 +97,8 @@ CREATE TABLE events (
 CREATE INDEX events_by_run ON events (run_id, seq);
 ";
 
-/// The columns each table must have, in order.
+/// The columns each table must have, in order. `trials` may have more: the columns of
+/// metrics of the metric table that version 1 did not have (see `metrics.rs`).
 const LAYOUT: &[(&str, &[&str])] = &[
     (
         "runs",
@@ -212,15 +213,23 @@ fn create(conn: &mut Connection) -> Result<()> {
 }
 
 fn check_layout(conn: &Connection) -> Result<()> {
-    let mut stmt = conn.prepare("SELECT name FROM pragma_table_info(?1) ORDER BY cid")?;
     for (table, expected) in LAYOUT {
-        let found = stmt
-            .query_map([table], |r| r.get::<_, String>(0))?
-            .collect::<rusqlite::Result<Vec<String>>>()?;
+        let found = crate::metrics::columns(conn, table)?;
         if found.is_empty() {
             return Err(JournalError::Schema(format!("table {table} is missing")));
         }
-        if found != *expected {
+        // Besides the layout's, trials may have metric columns (anywhere: an upgrade appends
+        // the columns of its version after them).
+        let added_metric = |c: &&String| {
+            *table == "trials"
+                && !expected.contains(&c.as_str())
+                && graspopt_quality::metrics::Metric::from_key(c).is_some()
+        };
+        let known = found
+            .iter()
+            .filter(|c| !added_metric(c))
+            .map(String::as_str);
+        if !known.eq(expected.iter().copied()) {
             return Err(JournalError::Schema(format!(
                 "table {table} has columns {found:?}, expected {expected:?}"
             )));

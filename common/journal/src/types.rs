@@ -79,9 +79,9 @@ pub struct TrialResultRecord {
     pub forces: Option<ForceAnalysis>,
 }
 
-/// Grasp-quality metrics of one trial, stored as real columns: the result message's own
-/// type, so a result is journaled without a copy of its fields.
-pub use graspopt_protocol::MetricValues;
+/// Grasp-quality metrics of one trial, stored one column per metric of the metric table:
+/// the result message's own type, so a result is journaled without a copy of its fields.
+pub use graspopt_protocol::{MetricValue, MetricValues};
 
 /// A trial's contact-force analysis: the result message's own type, stored as JSON.
 pub use graspopt_protocol::ForceAnalysis;

@@ -29,4 +29,4 @@ pub use keys::{AgentKind, Key, QueryKey, RunId, Runs, Topic};
 pub use messages::*;
 
 /// The wire version every payload carries. Bumped on any incompatible change of a message.
-pub const WIRE_VERSION: u16 = 3;
+pub const WIRE_VERSION: u16 = 4;

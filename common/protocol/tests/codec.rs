@@ -16,14 +16,15 @@ fn result() -> TrialResult {
         worker: "hand-1".into(),
         scorer: "metric-1".into(),
         score: 0.123_456_789_012_345_67,
-        metrics: Some(MetricValues {
-            rank: 6,
-            force_closure: true,
-            epsilon: 0.123_456_789_012_345_67,
-            volume: None,
-            distance: 0.0,
-            bw: 0.123_456_789_012_345_67,
-        }),
+        metrics: Some(
+            MetricValues::default()
+                .with("rank", Some(MetricValue::Count(6)))
+                .with("force_closure", Some(MetricValue::Flag(true)))
+                .with("epsilon", Some(MetricValue::Real(0.123_456_789_012_345_67)))
+                .with("volume", None)
+                .with("distance", Some(MetricValue::Real(0.0)))
+                .with("bw", Some(MetricValue::Real(0.123_456_789_012_345_67))),
+        ),
         contacts: 63,
         fingers_in_contact: 3,
         cloud_points: 120,
@@ -186,7 +187,7 @@ fn bincode_payload_starts_with_the_wire_version() {
 #[test]
 fn a_hand_written_json_result_decodes() {
     // What an agent in another language writes, from docs/protocol.md.
-    let text = r#"{"wire": 3, "run_id": "run-1", "trial_id": 4, "attempt": 1,
+    let text = r#"{"wire": 4, "run_id": "run-1", "trial_id": 4, "attempt": 1,
         "worker": "py-hand", "scorer": "py", "score": -2.5, "metrics": null,
         "contacts": 0, "fingers_in_contact": 0, "cloud_points": 0, "cloud_transport": "",
         "error": null}"#;
@@ -259,7 +260,7 @@ fn invalid_content_is_refused_naming_the_field() {
         .unwrap_err();
     assert!(e.to_string().contains("score"), "{e}");
 
-    let text = r#"{"wire": 3, "run_id": "a/b", "trial_id": 4}"#;
+    let text = r#"{"wire": 4, "run_id": "a/b", "trial_id": 4}"#;
     let e = decode::<TrialResult>(text.as_bytes(), Encoding::Json).unwrap_err();
     assert!(matches!(e, DecodeError::Malformed { .. }), "{e}");
 }

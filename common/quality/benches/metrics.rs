@@ -97,7 +97,7 @@ fn random_grasps(c: &mut Criterion) {
         let g = GraspMap::from_contacts(&contacts, &model).expect("grasp");
         let fc = evaluate(&g, &MetricsOptions::without_volume())
             .expect("metrics")
-            .force_closure;
+            .force_closure();
         if fc { closed.push(g) } else { open.push(g) }
     }
     for (name, set) in [("force closure", &closed), ("no force closure", &open)] {

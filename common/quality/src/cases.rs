@@ -16,6 +16,7 @@ use serde::de::IgnoredAny;
 use crate::contact::{Contact, FrictionModel, GraspModel};
 use crate::error::QualityError;
 use crate::grasp_map::GraspMap;
+use crate::metrics::Metrics;
 use crate::wrench::Wrench;
 
 /// A case file.
@@ -31,8 +32,9 @@ pub struct Case {
     pub params: Option<CaseParams>,
     pub contacts: Option<Vec<CaseContact>>,
     pub wrenches: Option<Vec<[f64; 6]>>,
-    /// The reference values, where the file has them.
-    pub expected: Option<Expected>,
+    /// The reference values, where the file has them: any metric of the table by its key
+    /// (other keys are ignored).
+    pub expected: Option<Metrics>,
     /// Descriptive keys, accepted whatever their value and not kept.
     #[serde(default)]
     pub kind: IgnoredAny,
@@ -76,17 +78,6 @@ pub struct CaseParams {
 pub struct CaseContact {
     pub position: [f64; 3],
     pub normal: [f64; 3],
-}
-
-/// Reference values of a case, any of them (other keys of the reference file are ignored).
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-pub struct Expected {
-    pub rank: Option<usize>,
-    pub force_closure: Option<bool>,
-    pub epsilon: Option<f64>,
-    pub volume: Option<f64>,
-    pub distance: Option<f64>,
-    pub bw: Option<f64>,
 }
 
 /// What is wrong with a case, naming the field.

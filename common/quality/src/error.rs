@@ -147,6 +147,13 @@ pub enum QualityError {
         num(*limit)
     )]
     ExternalWrench { value: [f64; 6], limit: f64 },
+    /// A name that is not a metric that may be the score (see
+    /// [`Metric::parse`](crate::metrics::Metric::parse)).
+    #[error(
+        "unknown metric {name:?}: expected {}",
+        crate::metrics::objective_names()
+    )]
+    UnknownMetric { name: String },
     /// The conic solver (Clarabel) failed; the text names the problem and its status.
     #[error("the conic solver failed: {0}")]
     Solver(String),

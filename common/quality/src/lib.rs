@@ -40,5 +40,5 @@ pub use forces::{
     slip_margins,
 };
 pub use grasp_map::GraspMap;
-pub use metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
+pub use metrics::{DistanceSolver, Metric, Metrics, MetricsOptions, evaluate};
 pub use wrench::Wrench;

@@ -13,19 +13,23 @@
 //! - [`experiment`]: the folders of `graspopt experiment metrics` and `experiment bo`.
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod error;
 pub mod experiment;
 pub mod run;
 pub mod scan;
 pub mod trial;
 
-use std::path::Path;
+pub use error::{ReportError, Result};
 
-use anyhow::{Context, Result};
+use std::path::Path;
 
 /// Writes `text` to `dir/name`; returns `name` (for a report's list of files).
 pub(crate) fn write(dir: &Path, name: &str, text: &str) -> Result<String> {
     let path = dir.join(name);
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, text).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
     Ok(name.to_string())
 }
 
@@ -42,7 +46,10 @@ pub(crate) fn shell_word(word: &str) -> String {
 
 /// Creates `dir` and its parents.
 pub(crate) fn create_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
+        dir: dir.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

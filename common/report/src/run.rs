@@ -3,13 +3,13 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_journal::{Journal, TrialRow};
 use graspopt_pictures::chart;
 use graspopt_protocol::named_params;
 use graspopt_protocol::text::rounded;
 use graspopt_sim::ParamKind;
-use graspopt_trial::Evaluator;
+use graspopt_trial::{Evaluator, Metric};
 
 /// What the results of a run are written from.
 pub struct RunFolder<'a> {
@@ -82,14 +82,18 @@ pub fn write_pictures(folder: &RunFolder, object: &str, trials: &[TrialRow]) -> 
     let Some(best) = best_trial(&done) else {
         return Ok(());
     };
-    let grasp = folder
-        .evaluator
-        .evaluate(&best.params)
-        .with_context(|| format!("cannot simulate the best trial {} again", best.trial_id))?;
+    let grasp =
+        folder
+            .evaluator
+            .evaluate(&best.params)
+            .map_err(|source| ReportError::Resimulate {
+                trial: best.trial_id,
+                source,
+            })?;
     let title = best_title(folder.run, best, folder.params);
     crate::trial::preview_image(folder.evaluator, &grasp, &title)?
         .save_png(&folder.out.join("best.png"))
-        .map_err(Into::into)
+        .map_err(ReportError::picture)
 }
 
 /// The best of `done`, as the journal and the run's summary name it: the highest score, the
@@ -107,7 +111,9 @@ fn best_trial<'a>(done: &[&'a TrialRow]) -> Option<&'a TrialRow> {
 /// (the score rounded as a person reads it).
 fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
     let words = match (&best.metrics, best.score) {
-        (Some(m), Some(s)) if m.force_closure => format!("score {}, force closure", rounded(s)),
+        (Some(m), Some(s)) if m.flag(Metric::ForceClosure.key()) == Some(true) => {
+            format!("score {}, force closure", rounded(s))
+        }
         (Some(_), Some(s)) => format!("score {}", rounded(s)),
         _ => "no contact".to_string(),
     };
@@ -122,7 +128,7 @@ fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use graspopt_journal::{MetricValues, TrialState};
+    use graspopt_journal::{MetricValue, MetricValues, TrialState};
 
     fn trial(trial_id: u64, score: f64) -> TrialRow {
         TrialRow {
@@ -164,14 +170,15 @@ mod tests {
     #[test]
     fn the_best_picture_s_title_names_the_run_and_rounds_the_score() {
         let best = TrialRow {
-            metrics: Some(MetricValues {
-                rank: 6,
-                force_closure: true,
-                epsilon: 0.1,
-                volume: None,
-                distance: 0.2,
-                bw: 0.20025899065118113,
-            }),
+            metrics: Some(
+                MetricValues::default()
+                    .with("rank", Some(MetricValue::Count(6)))
+                    .with("force_closure", Some(MetricValue::Flag(true)))
+                    .with("epsilon", Some(MetricValue::Real(0.1)))
+                    .with("volume", None)
+                    .with("distance", Some(MetricValue::Real(0.2)))
+                    .with("bw", Some(MetricValue::Real(0.20025899065118113))),
+            ),
             contacts: 3,
             fingers_in_contact: 3,
             cloud_points: 30,

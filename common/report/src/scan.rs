@@ -4,10 +4,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_pictures::{chart, preview};
 use graspopt_sim::ParamKind;
-use graspopt_trial::{Evaluator, ReferenceFrame, ScanPoint};
+use graspopt_trial::{Evaluator, Metric, ReferenceFrame, ScanPoint};
 
 /// The score of a grasp that touched something, `None` for one that touched nothing (drawn
 /// grey, off every scale; the CSV keeps its defined no-contact score).
@@ -31,27 +31,43 @@ pub fn touched_grid(axes: &[Vec<f64>], points: &[ScanPoint]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// A scan as CSV: one column per parameter (`names`), then the score and what it came from.
+/// A scan as CSV: one column per parameter (`names`), then the score and what it came from:
+/// the metrics of the metric table that scans show (`in_scan`: force_closure, epsilon,
+/// distance...), the contacts and fingers in contact.
 pub fn csv(names: &[&str], points: &[ScanPoint]) -> String {
+    let metrics: Vec<Metric> = Metric::ALL
+        .into_iter()
+        .filter(|m| m.def().in_scan)
+        .collect();
     let mut out = String::new();
+    let keys: Vec<&str> = metrics.iter().map(|m| m.key()).collect();
     let _ = writeln!(
         out,
-        "{},score,force_closure,epsilon,distance,contacts,fingers_in_contact",
-        names.join(",")
+        "{},score,{},contacts,fingers_in_contact",
+        names.join(","),
+        keys.join(",")
     );
     for p in points {
         for v in &p.params {
             let _ = write!(out, "{v},");
         }
         // A grasp that touched nothing has no metrics: empty fields, as in trials.csv.
-        let metrics = p.score.metrics.map_or_else(
-            || ",,".to_string(),
-            |m| format!("{},{},{}", m.force_closure, m.epsilon, m.distance),
-        );
+        let values: Vec<String> = metrics
+            .iter()
+            .map(|&m| {
+                p.score
+                    .metrics
+                    .and_then(|v| v.get(m))
+                    .map_or(String::new(), |v| v.to_string())
+            })
+            .collect();
         let _ = writeln!(
             out,
-            "{},{metrics},{},{}",
-            p.score.score, p.score.contacts, p.score.fingers_in_contact
+            "{},{},{},{}",
+            p.score.score,
+            values.join(","),
+            p.score.contacts,
+            p.score.fingers_in_contact
         );
     }
     out
@@ -117,8 +133,10 @@ pub fn write_scan(
     let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
     let stem = format!("{}-{}-{}", ev.object.name(), metric, names.join("-"));
     let csv_path = out.join(format!("{stem}.csv"));
-    std::fs::write(&csv_path, csv(&names, points))
-        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    std::fs::write(&csv_path, csv(&names, points)).map_err(|source| ReportError::Write {
+        path: csv_path.clone(),
+        source,
+    })?;
     let mut written = vec![csv_path];
     let value = metric.to_uppercase();
     let title = format!(
@@ -172,10 +190,12 @@ pub fn write_scan(
         _ => return Ok(written),
     };
     let svg_path = out.join(format!("{stem}.svg"));
-    std::fs::write(&svg_path, svg)
-        .with_context(|| format!("cannot write {}", svg_path.display()))?;
+    std::fs::write(&svg_path, svg).map_err(|source| ReportError::Write {
+        path: svg_path.clone(),
+        source,
+    })?;
     let png_path = out.join(format!("{stem}.png"));
-    png.save_png(&png_path)?;
+    png.save_png(&png_path).map_err(ReportError::picture)?;
     written.extend([svg_path, png_path]);
     Ok(written)
 }
@@ -212,9 +232,19 @@ mod tests {
         );
         let csv = std::fs::read_to_string(&written[0]).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
+        // The metrics of the table that scans show, in its order.
+        let shown: Vec<&str> = Metric::ALL
+            .into_iter()
+            .filter(|m| m.def().in_scan)
+            .map(Metric::key)
+            .collect();
+        assert_eq!(shown[..3], ["force_closure", "epsilon", "distance"]);
         assert_eq!(
             lines[0],
-            "approach,score,force_closure,epsilon,distance,contacts,fingers_in_contact"
+            format!(
+                "approach,score,{},contacts,fingers_in_contact",
+                shown.join(",")
+            )
         );
         assert_eq!(lines.len(), 6);
         assert!(lines[1].starts_with(&format!("{},{},", axes[0][0], points[0].score.score)));

@@ -29,11 +29,11 @@ fn scan(object: &str, space_2d: bool, steps: &[usize], resolution: f64) -> Vec<S
 }
 
 fn bw(p: &ScanPoint) -> f64 {
-    p.score.metrics.map_or(p.score.score, |m| m.bw)
+    p.score.metrics.map_or(p.score.score, |m| m.bw())
 }
 
 fn closure(p: &ScanPoint) -> bool {
-    p.score.metrics.is_some_and(|m| m.force_closure)
+    p.score.metrics.is_some_and(|m| m.force_closure())
 }
 
 fn main() {

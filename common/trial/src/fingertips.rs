@@ -252,6 +252,26 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
     settings: &FingertipSettings,
     rng: &mut R,
 ) -> Result<Vec<SimulatedFingertip>, TrialError> {
+    check_settings(settings)?;
+    let touching = touching_tips(outcome, hand, object, settings)?;
+    let contacts: Vec<Contact> = touching
+        .iter()
+        .map(|t| Contact::new(t.point.coords, t.normal))
+        .collect();
+    let model = fingertip_model(settings.kind, &score.model);
+    let reference = grasp_model(outcome, object, score)?.reference_point;
+    forces.validate()?;
+    let applied = applied_forces(&contacts, &model, &reference, object, forces, settings);
+    Ok(touching
+        .into_iter()
+        .enumerate()
+        .map(|(i, touch)| sensed(touch, &applied, i, settings, rng))
+        .collect())
+}
+
+/// The noise valid, the sensor depth finite, the squeeze finite and > 0, the grip finite
+/// and >= 0.
+fn check_settings(settings: &FingertipSettings) -> Result<(), TrialError> {
     settings.noise.validate().map_err(sensing_settings)?;
     if !(settings.sensor_depth.is_finite()
         && settings.squeeze.is_finite()
@@ -264,6 +284,26 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
             settings.sensor_depth, settings.squeeze, settings.grip
         )));
     }
+    Ok(())
+}
+
+/// A fingertip that touches the object: its sensor's pose, and the contact point and normal
+/// (into the object) on the tip's sphere.
+struct Touch {
+    tip: Fingertip,
+    sensor_pose: Isometry3<f64>,
+    point: Point3<f64>,
+    normal: Vector3<f64>,
+}
+
+/// The fingertips whose link touches the object, each touching it at the point of its
+/// sphere nearest the object.
+fn touching_tips(
+    outcome: &TrialOutcome,
+    hand: &dyn Hand,
+    object: &Object,
+    settings: &FingertipSettings,
+) -> Result<Vec<Touch>, TrialError> {
     let grasp = &outcome.grasp;
     let mut touching = Vec::new();
     for tip in fingertips(hand)? {
@@ -282,66 +322,89 @@ pub fn simulate_readings<R: rand::Rng + ?Sized>(
         let normal = to.normalize();
         let sensor_pose = body * Translation3::new(0.0, 0.0, -settings.sensor_depth);
         let point = centre + normal * tip.radius;
-        touching.push((tip, sensor_pose, point, normal));
+        touching.push(Touch {
+            tip,
+            sensor_pose,
+            point,
+            normal,
+        });
     }
-    let contacts: Vec<Contact> = touching
-        .iter()
-        .map(|(_, _, p, n)| Contact::new(p.coords, *n))
-        .collect();
-    let model = fingertip_model(settings.kind, &score.model);
-    let reference = grasp_model(outcome, object, score)?.reference_point;
-    // Least forces that are unavailable (a solver that stopped on a degenerate grasp) count
-    // as "cannot resist": the tips squeeze.
-    forces.validate()?;
-    let held = match analyse_contacts(&contacts, &model, &reference, object, forces, None) {
+    Ok(touching)
+}
+
+/// The forces the tips apply: the least forces that hold the object plus the grip, or, when
+/// none hold it, a squeeze along each normal. Least forces that are unavailable (a solver
+/// that stopped on a degenerate grasp) count as "cannot resist": the tips squeeze.
+fn applied_forces(
+    contacts: &[Contact],
+    model: &FrictionModel,
+    reference: &Vector3<f64>,
+    object: &Object,
+    forces: &ForceSettings,
+    settings: &FingertipSettings,
+) -> ContactForces {
+    let held = match analyse_contacts(contacts, model, reference, object, forces, None) {
         Ok(g) => match g.resisting {
             Resisting::Forces { forces, .. } if !contacts.is_empty() => Some(forces),
             _ => None,
         },
         Err(_) => None,
     };
-    let applied = match held {
-        Some(least) => with_grip(&contacts, least, &model, &reference, settings.grip),
+    match held {
+        Some(least) => with_grip(contacts, least, model, reference, settings.grip),
         None => ContactForces::without_torsion(
             contacts
                 .iter()
                 .map(|c| c.normal * settings.squeeze)
                 .collect(),
         ),
-    };
-    let mut out = Vec::with_capacity(touching.len());
-    for (i, (tip, sensor_pose, point, normal)) in touching.into_iter().enumerate() {
-        let truth = FingertipContact {
-            point,
-            normal,
-            force: applied.forces[i],
-            torsion: applied.torsions[i],
-        };
-        let surface = FingertipSurface::Sphere {
-            center: [0.0, 0.0, settings.sensor_depth],
-            radius: tip.radius,
-            base_z: None,
-        };
-        let inverse = sensor_pose.inverse();
-        let exact = reading_of(
-            &surface,
-            &(inverse * point),
-            &(inverse * truth.force),
-            truth.torsion,
-        );
-        let reading = sample_mean(&settings.noise, &exact, settings.samples, rng);
-        out.push(SimulatedFingertip {
-            sensor: SensorReading {
-                finger: tip.finger,
-                link: tip.name,
-                sensor_pose,
-                surface,
-                reading,
-            },
-            truth,
-        });
     }
-    Ok(out)
+}
+
+/// What the sensor of `touch` (the `i`-th touching tip) reads of the force `applied` to it,
+/// with noise.
+fn sensed<R: rand::Rng + ?Sized>(
+    touch: Touch,
+    applied: &ContactForces,
+    i: usize,
+    settings: &FingertipSettings,
+    rng: &mut R,
+) -> SimulatedFingertip {
+    let Touch {
+        tip,
+        sensor_pose,
+        point,
+        normal,
+    } = touch;
+    let truth = FingertipContact {
+        point,
+        normal,
+        force: applied.forces[i],
+        torsion: applied.torsions[i],
+    };
+    let surface = FingertipSurface::Sphere {
+        center: [0.0, 0.0, settings.sensor_depth],
+        radius: tip.radius,
+        base_z: None,
+    };
+    let inverse = sensor_pose.inverse();
+    let exact = reading_of(
+        &surface,
+        &(inverse * point),
+        &(inverse * truth.force),
+        truth.torsion,
+    );
+    let reading = sample_mean(&settings.noise, &exact, settings.samples, rng);
+    SimulatedFingertip {
+        sensor: SensorReading {
+            finger: tip.finger,
+            link: tip.name,
+            sensor_pose,
+            surface,
+            reading,
+        },
+        truth,
+    }
 }
 
 /// The mean of `samples` noisy samples of `exact` (one sample when `samples` is 0 or 1).

@@ -10,7 +10,7 @@
 //! object (so `-B` is below the BW of every touching grasp), `d` is the closed hand's
 //! smallest distance to the object and `rho` the torque scale: finite, always below any
 //! touching grasp, and better the nearer the hand came, so an optimiser still learns from
-//! it. For epsilon and volume, which are 0 without force closure, it scores 0.
+//! it. Scored by another metric (epsilon, volume: 0 without force closure), it scores 0.
 
 use graspopt_quality::metrics::{Metrics, MetricsOptions, evaluate_contacts};
 use graspopt_quality::{Contact, FrictionModel, GraspModel};
@@ -20,47 +20,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::TrialError;
 
-/// The metric that becomes the score.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Metric {
-    /// The Bimodal Wrench metric (thesis 2.6): the default.
-    #[default]
-    Bw,
-    /// Largest Sphere (epsilon), 0 without force closure.
-    Epsilon,
-    /// Grasp Wrench Volume.
-    Volume,
-}
-
-impl Metric {
-    /// The name users see: `bw`, `epsilon`, `volume`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Metric::Bw => "bw",
-            Metric::Epsilon => "epsilon",
-            Metric::Volume => "volume",
-        }
-    }
-
-    /// Parses `bw`, `epsilon` (or `ls`), `volume` (or `gwv`).
-    pub fn parse(name: &str) -> Result<Self, TrialError> {
-        match name {
-            "bw" => Ok(Metric::Bw),
-            "epsilon" | "ls" => Ok(Metric::Epsilon),
-            "volume" | "gwv" => Ok(Metric::Volume),
-            other => Err(TrialError::Settings(format!(
-                "unknown metric {other:?}: expected bw, epsilon (ls) or volume (gwv)"
-            ))),
-        }
-    }
-}
-
-impl std::fmt::Display for Metric {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+/// The metric that becomes the score: an objective of the quality crate's metric table
+/// (`bw` by default, `epsilon`, `volume`; [`Metric::parse`] also takes `ls` and `gwv`).
+pub use graspopt_quality::metrics::Metric;
 
 /// The point about which torques are taken.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -172,16 +134,9 @@ pub fn score_outcome(
             metrics: None,
         });
     }
-    let options = MetricsOptions {
-        volume: settings.metric == Metric::Volume,
-        ..MetricsOptions::default()
-    };
+    let options = MetricsOptions::for_score(settings.metric);
     let metrics = evaluate_contacts(&contacts, &grasp_model, &options)?;
-    let score = match settings.metric {
-        Metric::Bw => metrics.bw,
-        Metric::Epsilon => metrics.epsilon,
-        Metric::Volume => metrics.volume.unwrap_or(0.0),
-    };
+    let score = metrics.real(settings.metric).unwrap_or(0.0);
     Ok(TrialScore {
         score,
         contacts: contacts.len(),

@@ -140,7 +140,7 @@ pub(crate) fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
         worker: r.worker.clone(),
         at_ms,
         score: r.score,
-        metrics: r.metrics,
+        metrics: r.metrics.clone(),
         contacts: r.contacts,
         fingers_in_contact: r.fingers_in_contact,
         cloud_points: r.cloud_points,

@@ -155,7 +155,7 @@ fn rebuild_state(
                 row.trial_id,
                 row.params.clone(),
                 score,
-                row.metrics.as_ref().map(|m| m.force_closure),
+                row.metrics.as_ref().and_then(|m| m.flag("force_closure")),
                 row.forces.as_ref(),
             );
         }

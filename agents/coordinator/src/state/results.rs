@@ -62,7 +62,10 @@ impl RunState {
             result.trial_id,
             params,
             result.score,
-            result.metrics.map(|m| m.force_closure),
+            result
+                .metrics
+                .as_ref()
+                .and_then(|m| m.flag("force_closure")),
             result.forces.as_ref(),
         );
         Disposition::Completed

@@ -4,8 +4,9 @@
 //!
 //! One output row per case, in order. A bad case prints an error naming the case index
 //! and the field (on stderr, and as `{"error": ...}` in its JSON row) and the others are
-//! still evaluated; the exit status is then 1. A metric is never printed as `null`
-//! (only `volume`, with `--no-volume`) nor as `-0.0`.
+//! still evaluated; the exit status is then 1. The metrics are the metric table's
+//! (`graspopt_quality::metrics::TABLE`), in its order. A metric is never printed as `null`
+//! (only `volume`, with `--no-volume`) nor as `-0.0` (`evaluate` guarantees both).
 //!
 //! Keys (any other key is an error naming it, so a misspelling is not silently replaced
 //! by a default): see [`graspopt_quality::cases`].
@@ -29,7 +30,9 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use graspopt_quality::cases::Case;
-use graspopt_quality::metrics::{DistanceSolver, Metrics, MetricsOptions, evaluate};
+use graspopt_quality::metrics::{
+    DistanceSolver, Metrics, MetricsOptions, TABLE, Value as MetricValue, evaluate,
+};
 use graspopt_quality::{GraspMap, QualityError};
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -102,7 +105,6 @@ pub fn run(args: &QualityArgs) -> Result<ExitCode> {
                         } => anyhow::anyhow!("{e}, or pass --no-volume"),
                         e => e.into(),
                     })?;
-                    let metrics = printable(metrics)?;
                     let micros = args.timing.then(|| median_micros(&grasp, &options));
                     Ok((metrics, micros))
                 })
@@ -138,31 +140,6 @@ struct JsonRow {
     micros: Option<f64>,
 }
 
-/// The metrics as printed: an error if one is not finite (it would print as `null`),
-/// and `-0.0` turned into `0.0`.
-fn printable(m: Metrics) -> Result<Metrics> {
-    for (name, value) in [
-        ("epsilon", Some(m.epsilon)),
-        ("volume", m.volume),
-        ("distance", Some(m.distance)),
-        ("bw", Some(m.bw)),
-    ] {
-        if let Some(v) = value
-            && !v.is_finite()
-        {
-            bail!("the {name} came out as {v}: numerical failure");
-        }
-    }
-    let zero = |x: f64| x + 0.0; // -0.0 + 0.0 == +0.0
-    Ok(Metrics {
-        epsilon: zero(m.epsilon),
-        volume: m.volume.map(zero),
-        distance: zero(m.distance),
-        bw: zero(m.bw),
-        ..m
-    })
-}
-
 fn json_row(row: &Row) -> String {
     match row {
         Ok((m, micros)) => serde_json::to_string(&JsonRow {
@@ -174,28 +151,32 @@ fn json_row(row: &Row) -> String {
     }
 }
 
+/// `case`, then each metric's short name in its column (the metric table's), then `micros`.
 fn write_table_header(out: &mut impl Write, timing: bool) -> std::io::Result<()> {
-    write!(
-        out,
-        "{:>5} {:>4} {:>5} {:>15} {:>15} {:>15} {:>16}",
-        "case", "rank", "fc", "epsilon", "volume", "distance", "bw"
-    )?;
+    write!(out, "{:>5}", "case")?;
+    for def in &TABLE {
+        write!(out, " {:>w$}", def.short, w = def.width)?;
+    }
     if timing {
         write!(out, " {:>10}", "micros")?;
     }
     writeln!(out)
 }
 
+/// One row: the metrics as `evaluate` returns them (finite, no negative zero), reals in
+/// scientific notation, `-` for one not computed.
 fn write_table_row(out: &mut impl Write, i: usize, row: &Row) -> std::io::Result<()> {
     match row {
         Ok((m, micros)) => {
-            // Rows carry `printable` metrics: finite, no negative zero.
-            let volume = m.volume.map_or("-".to_string(), |v| format!("{v:.9e}"));
-            write!(
-                out,
-                "{i:>5} {:>4} {:>5} {:>15.9e} {volume:>15} {:>15.9e} {:>16.9e}",
-                m.rank, m.force_closure, m.epsilon, m.distance, m.bw
-            )?;
+            write!(out, "{i:>5}")?;
+            for (def, value) in m.iter() {
+                let w = def.width;
+                match value {
+                    Some(MetricValue::Real(x)) => write!(out, " {x:>w$.9e}")?,
+                    Some(v) => write!(out, " {v:>w$}")?,
+                    None => write!(out, " {:>w$}", "-")?,
+                }
+            }
             if let Some(us) = micros {
                 write!(out, " {us:>10.1}")?;
             }

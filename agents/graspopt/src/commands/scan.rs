@@ -91,7 +91,7 @@ pub fn run(args: &ScanArgs) -> Result<std::process::ExitCode> {
         .context("empty scan")?;
     let closed = points
         .iter()
-        .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure))
+        .filter(|p| p.score.metrics.is_some_and(|m| m.force_closure()))
         .count();
     eprintln!(
         "{total} trials in {:.2} s ({:.2} ms per trial per thread); force closure in {closed}; best {} {:.6} at {:?}",

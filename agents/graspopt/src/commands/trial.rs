@@ -77,8 +77,7 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
     point
         .check_within(&ev.space, ev.object.name())
         .context("--at")?;
-    let (kinds, values) = (&point.kinds, &point.values);
-    let e = ev.evaluate(values)?;
+    let e = ev.evaluate(&point.values)?;
     let force_settings = ForceSettings {
         object_mass: args.object_mass,
         ..ForceSettings::default()
@@ -86,22 +85,13 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
     let grasp_forces = analyse_outcome(&e.outcome, &ev.object, &ev.score, &force_settings)
         .context("force analysis")?;
     let forces = force_analysis(&grasp_forces);
-    let at: Vec<String> = kinds
+    let at: Vec<(&str, f64)> = point
+        .kinds
         .iter()
-        .zip(values)
-        .map(|(k, v)| format!("{}={v}", k.name()))
+        .map(|k| k.name())
+        .zip(point.values.iter().copied())
         .collect();
-    let title = format!(
-        "{}, {} hand, {}: {}",
-        ev.object.name(),
-        ev.hand.name(),
-        if at.is_empty() {
-            "reference pose".to_string()
-        } else {
-            at.join(",")
-        },
-        trial_report::score_words(&e.score)
-    );
+    let title = trial_report::title(&ev, &e, &at);
     let written = trial_report::write_pictures(
         args.scene.as_deref(),
         args.preview.as_deref(),
@@ -115,72 +105,14 @@ pub fn run(args: &TrialArgs) -> Result<std::process::ExitCode> {
             serde_json::to_string_pretty(&TrialJson::of(&e, &forces))?
         )?,
         TrialFormat::Text => {
-            outln!(
-                "object {}  hand {}  contacts {}  metric {}",
-                ev.object.name(),
-                ev.hand.name(),
-                ev.score.contacts,
-                args.sim.metric
-            )?;
-            for (k, v) in kinds.iter().zip(values) {
-                outln!("  {} = {v}", k.name())?;
-            }
-            let t = e.outcome.grasp.palm_pose.translation.vector;
-            outln!(
-                "palm at ({:.4}, {:.4}, {:.4}) m, retreated {:.4} m",
-                t.x,
-                t.y,
-                t.z,
-                e.outcome.grasp.retreat
-            )?;
-            for f in e
-                .outcome
-                .fingers
-                .iter()
-                .chain(std::iter::once(&e.outcome.palm))
-            {
-                let name = f
-                    .finger
-                    .map_or("palm".to_string(), |i| format!("finger {}", i + 1));
-                let modelled = f.contacts(ev.score.contacts);
-                match f.mean_point() {
-                    Some(m) => outln!(
-                        "  {name}: {} cloud points, {} modelled contacts, mean at ({:.4}, {:.4}, {:.4}) normal ({:.3}, {:.3}, {:.3})",
-                        f.cloud.points.len(),
-                        modelled.len(),
-                        m.position.x,
-                        m.position.y,
-                        m.position.z,
-                        m.normal.x,
-                        m.normal.y,
-                        m.normal.z
-                    )?,
-                    None => outln!("  {name}: no contact")?,
-                }
-            }
-            match e.score.metrics {
-                Some(m) => outln!(
-                    "rank {}  force closure {}  epsilon {:.6}  distance {:.6}  bw {:.6}{}",
-                    m.rank,
-                    m.force_closure,
-                    m.epsilon,
-                    m.distance,
-                    m.bw,
-                    m.volume
-                        .map_or(String::new(), |v| format!("  volume {v:.6e}"))
-                )?,
-                None => outln!("no contact: nothing to score")?,
-            }
-            outln!("score {:.6}", e.score.score)?;
-            outln!(
-                "forces ({} kg object): {}{}",
-                args.object_mass,
-                forces.describe(),
-                match &grasp_forces.resisting {
-                    Resisting::CannotResist { reason } => format!(": {reason}"),
-                    _ => String::new(), // held, or unavailable: `describe` says why
-                }
-            )?;
+            let text = trial_report::text(&ev, &e, &at, args.sim.metric);
+            let why = match &grasp_forces.resisting {
+                Resisting::CannotResist { reason } => format!(": {reason}"),
+                _ => String::new(), // held, or unavailable: `describe` says why
+            };
+            outln!("{text}")?;
+            let (mass, words) = (args.object_mass, forces.describe());
+            outln!("forces ({mass} kg object): {words}{why}")?;
         }
     }
     for path in written {

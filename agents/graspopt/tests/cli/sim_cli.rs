@@ -160,10 +160,11 @@ fn a_one_axis_scan_writes_a_png_line_plot_with_its_misses_grey() {
     let png = dir.join("sphere-bw-approach.png");
     assert!(stdout.contains(png.to_str().unwrap()), "{stdout}");
     let csv = std::fs::read_to_string(dir.join("sphere-bw-approach.csv")).unwrap();
+    let contacts = column(&csv, "contacts");
     let misses = csv
         .lines()
         .skip(1)
-        .filter(|l| l.split(',').nth(5) == Some("0"))
+        .filter(|l| l.split(',').nth(contacts) == Some("0"))
         .count();
     assert!(misses > 0 && misses < 9, "{csv}");
     let (w, h, px) = decode_png(&png);
@@ -175,6 +176,12 @@ fn a_one_axis_scan_writes_a_png_line_plot_with_its_misses_grey() {
     assert!(px.contains(&[31, 119, 180]));
     assert!(px.iter().filter(|c| **c == [20, 20, 20]).count() > 500);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The index of the column `name` of a CSV's header.
+fn column(csv: &str, name: &str) -> usize {
+    let header = csv.lines().next().unwrap_or_default();
+    header.split(',').position(|h| h == name).unwrap()
 }
 
 #[test]
@@ -194,15 +201,17 @@ fn scan_marks_grasps_that_touch_nothing_grey_with_a_legend() {
     // CSV: a grasp that touched nothing has empty metric cells, never NaN.
     let csv = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.csv")).unwrap();
     assert!(!csv.contains("NaN"), "{csv}");
+    let contacts = column(&csv, "contacts");
     let misses: Vec<&str> = csv
         .lines()
         .skip(1)
-        .filter(|l| l.split(',').nth(6) == Some("0"))
+        .filter(|l| l.split(',').nth(contacts) == Some("0"))
         .collect();
     assert!(!misses.is_empty() && misses.len() < 30, "{csv}");
     for l in &misses {
+        // Every metric cell, between the score and the contacts, is empty.
         let f: Vec<&str> = l.split(',').collect();
-        assert_eq!(f[3..6], ["", "", ""], "{l}");
+        assert!(f[3..contacts].iter().all(|c| c.is_empty()), "{l}");
     }
     // SVG: grey cells, one per miss, the legend's grey square, and the legend's text.
     let svg = std::fs::read_to_string(dir.join("sphere-bw-approach-vertical.svg")).unwrap();

@@ -46,7 +46,7 @@ fn three_tip_trial() -> (Evaluator, Evaluation, Vec<SimulatedFingertip>) {
                 &mut rng,
             )
             .unwrap();
-            if tips.len() == 3 && truth_score(&ev, &e, &tips).metrics.unwrap().force_closure {
+            if tips.len() == 3 && truth_score(&ev, &e, &tips).metrics.unwrap().force_closure() {
                 return (ev, e, tips);
             }
         }

@@ -50,9 +50,18 @@ fn issue_result_round_trip() {
     assert_eq!(bits(&row.params), bits(&iss.params));
     let m = row.metrics.as_ref().unwrap();
     let want = metrics_for(1);
-    assert_eq!(m.epsilon.to_bits(), want.epsilon.to_bits());
-    assert_eq!(m.bw.to_bits(), want.bw.to_bits());
-    assert_eq!(m.volume.unwrap().to_bits(), want.volume.unwrap().to_bits());
+    assert_eq!(
+        m.real("epsilon").unwrap().to_bits(),
+        want.real("epsilon").unwrap().to_bits()
+    );
+    assert_eq!(
+        m.real("bw").unwrap().to_bits(),
+        want.real("bw").unwrap().to_bits()
+    );
+    assert_eq!(
+        m.real("volume").unwrap().to_bits(),
+        want.real("volume").unwrap().to_bits()
+    );
 
     // Metrics absent, and metrics with no volume, read back as such.
     j.record_issue(&issue(RUN, 2, 1, "worker-2", 3_000))
@@ -63,7 +72,7 @@ fn issue_result_round_trip() {
     j.record_issue(&issue(RUN, 3, 1, "worker-2", 3_200))
         .unwrap();
     let mut r3 = result(RUN, 3, 1, "worker-2", 3_300, f64::MAX);
-    r3.metrics.as_mut().unwrap().volume = None;
+    r3.metrics.as_mut().unwrap().set("volume", None);
     j.record_result(&r3).unwrap();
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().metrics, None);
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().score, Some(-1.5));

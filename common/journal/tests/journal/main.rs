@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use graspopt_journal::export::{write_csv, write_json};
 use graspopt_journal::{
-    EventRow, Journal, JournalError, MetricValues, ResultOutcome, RunExport, RunLifecycle,
+    EventRow, Journal, JournalError, MetricValue, MetricValues, ResultOutcome, RunLifecycle,
     RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState,
     event_kind,
 };
@@ -64,14 +64,19 @@ fn issue(run_id: &str, trial: u64, attempt: u32, worker: &str, at_ms: i64) -> Tr
 }
 
 fn metrics_for(trial: u64) -> MetricValues {
-    MetricValues {
-        rank: 6,
-        force_closure: trial.is_multiple_of(2),
-        epsilon: 0.0123456789012345 * (trial as f64 + 1.0),
-        volume: Some(1.0 / 3.0 + trial as f64),
-        distance: 2.0f64.sqrt(),
-        bw: 1e-17 * (trial as f64 + 1.0),
-    }
+    MetricValues::default()
+        .with("rank", Some(MetricValue::Count(6)))
+        .with(
+            "force_closure",
+            Some(MetricValue::Flag(trial.is_multiple_of(2))),
+        )
+        .with(
+            "epsilon",
+            Some(MetricValue::Real(0.0123456789012345 * (trial as f64 + 1.0))),
+        )
+        .with("volume", Some(MetricValue::Real(1.0 / 3.0 + trial as f64)))
+        .with("distance", Some(MetricValue::Real(2.0f64.sqrt())))
+        .with("bw", Some(MetricValue::Real(1e-17 * (trial as f64 + 1.0))))
 }
 
 fn score_for(trial: u64) -> f64 {
@@ -158,6 +163,8 @@ fn parse_csv(text: &str) -> Vec<Vec<String>> {
 
 /// Issue, result, re-issue, failure and reopening: the life of a trial in the journal.
 mod batch;
+/// The CSV and JSON exports of a run.
+mod export;
 mod forces;
 mod lifecycle;
 
@@ -296,22 +303,34 @@ fn non_finite_values_refused() {
         ("score", result(RUN, 1, 1, "w1", 200, f64::INFINITY)),
         ("metrics.epsilon", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().epsilon = f64::NEG_INFINITY;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("epsilon", Some(MetricValue::Real(f64::NEG_INFINITY)));
             r
         }),
         ("metrics.volume", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().volume = Some(f64::NAN);
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("volume", Some(MetricValue::Real(f64::NAN)));
             r
         }),
         ("metrics.distance", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().distance = f64::NAN;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("distance", Some(MetricValue::Real(f64::NAN)));
             r
         }),
         ("metrics.bw", {
             let mut r = result(RUN, 1, 1, "w1", 200, 0.5);
-            r.metrics.as_mut().unwrap().bw = f64::INFINITY;
+            r.metrics
+                .as_mut()
+                .unwrap()
+                .set("bw", Some(MetricValue::Real(f64::INFINITY)));
             r
         }),
     ];
@@ -426,172 +445,6 @@ fn unknown_run_reads_are_errors() {
     check(write_json(&j, ghost, &mut out).unwrap_err());
     assert!(out.is_empty());
     assert!(j.trials(RUN).unwrap().is_empty());
-}
-
-#[test]
-fn csv_export_fields() {
-    let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
-        .unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w,2", 300)).unwrap();
-    let message = "hand error: finger 2, \"jammed\" at 3 N";
-    assert!(j.record_failure(RUN, 2, 1, message, 400).unwrap());
-    j.record_issue(&issue(RUN, 3, 1, "w3", 500)).unwrap();
-    let mut r3 = result(RUN, 3, 1, "w3", 600, 1.0);
-    r3.metrics = None;
-    j.record_result(&r3).unwrap();
-    j.record_issue(&issue(RUN, 4, 1, "w4", 700)).unwrap();
-
-    let mut out = Vec::new();
-    write_csv(&j, RUN, &mut out).unwrap();
-    let text = String::from_utf8(out).unwrap();
-    // The message is quoted and its quotes doubled, per RFC 4180.
-    assert!(
-        text.contains(r#","hand error: finger 2, ""jammed"" at 3 N""#),
-        "{text}"
-    );
-    assert!(text.contains(r#","w,2","#), "{text}");
-
-    let records = parse_csv(&text);
-    assert_eq!(records.len(), 5, "{text}");
-    assert_eq!(
-        records[0],
-        [
-            "trial",
-            "state",
-            "attempts",
-            "worker",
-            "issued_ms",
-            "completed_ms",
-            "approach_x",
-            "roll",
-            "aperture",
-            "score",
-            "rank",
-            "force_closure",
-            "epsilon",
-            "volume",
-            "distance",
-            "bw",
-            "contacts",
-            "fingers_in_contact",
-            "cloud_points",
-            "can_resist",
-            "resisting_force",
-            "resisting_max",
-            "net_force",
-            "min_slip_margin",
-            "forces_unavailable",
-            "error"
-        ]
-    );
-    assert!(records.iter().all(|r| r.len() == 26), "{records:?}");
-    let f64_at = |rec: &[String], i: usize| rec[i].parse::<f64>().unwrap().to_bits();
-
-    let done = &records[1];
-    assert_eq!(&done[..6], ["1", "completed", "1", "w1", "100", "250"]);
-    for (k, p) in params_for(1).iter().enumerate() {
-        assert_eq!(
-            f64_at(done, 6 + k),
-            p.to_bits(),
-            "param {k}: {}",
-            done[6 + k]
-        );
-    }
-    let m = metrics_for(1);
-    assert_eq!(f64_at(done, 9), (0.1f64 + 0.2).to_bits());
-    assert_eq!(done[10], "6");
-    assert_eq!(done[11], "false");
-    assert_eq!(f64_at(done, 12), m.epsilon.to_bits());
-    assert_eq!(f64_at(done, 13), m.volume.unwrap().to_bits());
-    assert_eq!(f64_at(done, 14), m.distance.to_bits());
-    assert_eq!(f64_at(done, 15), m.bw.to_bits());
-    assert_eq!(&done[16..], ["7", "3", "4096", "", "", "", "", "", "", ""]);
-
-    let failed = &records[2];
-    assert_eq!(&failed[..6], ["2", "failed", "1", "w,2", "300", ""]);
-    assert!(failed[9..25].iter().all(String::is_empty), "{failed:?}");
-    assert_eq!(failed[25], message);
-
-    let no_metrics = &records[3];
-    assert_eq!(no_metrics[9], "1.0");
-    assert!(
-        no_metrics[10..16].iter().all(String::is_empty),
-        "{no_metrics:?}"
-    );
-    assert_eq!(
-        &no_metrics[16..],
-        ["7", "3", "4096", "", "", "", "", "", "", ""]
-    );
-
-    let running = &records[4];
-    assert_eq!(&running[..6], ["4", "running", "1", "w4", "700", ""]);
-    assert!(running[9..].iter().all(String::is_empty), "{running:?}");
-}
-
-#[test]
-fn csv_export_leaves_out_a_volume_no_trial_has() {
-    // Runs not scored by the volume never compute it: no always-empty column.
-    let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    let mut r1 = result(RUN, 1, 1, "w1", 250, 0.5);
-    r1.metrics.as_mut().unwrap().volume = None;
-    j.record_result(&r1).unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
-    let mut out = Vec::new();
-    write_csv(&j, RUN, &mut out).unwrap();
-    let text = String::from_utf8(out).unwrap();
-    let records = parse_csv(&text);
-    assert_eq!(records.len(), 3, "{text}");
-    assert!(!records[0].contains(&"volume".to_string()), "{text}");
-    assert!(records.iter().all(|r| r.len() == 25), "{records:?}");
-    let column = |name: &str| records[0].iter().position(|h| h == name).unwrap();
-    let m = metrics_for(1);
-    assert_eq!(records[1][column("epsilon")], format!("{:?}", m.epsilon));
-    assert_eq!(records[1][column("distance")], format!("{:?}", m.distance));
-    assert_eq!(records[1][column("contacts")], "7");
-    assert!(
-        records[2][column("score")..column("error")]
-            .iter()
-            .all(String::is_empty)
-    );
-}
-
-#[test]
-fn json_export_parses_back() {
-    let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
-        .unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
-    j.record_failure(RUN, 2, 1, "hand error, \"jammed\"", 400)
-        .unwrap();
-
-    let mut out = Vec::new();
-    write_json(&j, RUN, &mut out).unwrap();
-    let text = String::from_utf8(out).unwrap();
-    assert!(text.contains("\n  \"run\": {"), "pretty: {text}");
-
-    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
-    assert_eq!(value["run"]["run_id"], RUN);
-    assert_eq!(value["run"]["status"], "running");
-    assert_eq!(value["trials"][0]["state"], "completed");
-    assert_eq!(value["trials"][1]["state"], "failed");
-    assert_eq!(value["trials"].as_array().unwrap().len(), 2);
-
-    let back: RunExport = serde_json::from_str(&text).unwrap();
-    assert_eq!(back.run, run_record(RUN));
-    assert_eq!(back.trials, j.trials(RUN).unwrap());
-    assert_eq!(
-        bits(&back.trials[0].params),
-        bits(&params_for(1)),
-        "exact f64 through JSON"
-    );
-    assert_eq!(
-        back.trials[0].score.unwrap().to_bits(),
-        (0.1f64 + 0.2).to_bits()
-    );
 }
 
 // ------------------------------------------------------------ kill -9 test
@@ -803,4 +656,37 @@ fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
         Journal::open(&db).unwrap().planner_state(RUN).unwrap(),
         Some(vec![9])
     );
+}
+
+#[test]
+fn a_journal_without_a_metric_column_gains_it_and_reads_the_metric_as_missing() {
+    // A journal written before the last metric of the table existed.
+    let dir = TempDir::new("metric-column");
+    let db = dir.db();
+    let newest = graspopt_quality::metrics::TABLE.last().unwrap().key;
+    {
+        let mut j = Journal::open(&db).unwrap();
+        j.create_run(&run_record(RUN)).unwrap();
+        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+    }
+    {
+        let raw = rusqlite::Connection::open(&db).unwrap();
+        raw.execute_batch(&format!("ALTER TABLE trials DROP COLUMN {newest}"))
+            .unwrap();
+    }
+    let j = Journal::open_existing(&db).unwrap();
+    let t = j.trial(RUN, 1).unwrap().unwrap();
+    let m = t.metrics.unwrap();
+    assert_eq!(m.get(newest), None);
+    assert_eq!(m, metrics_for(1));
+    let raw = rusqlite::Connection::open(&db).unwrap();
+    let has: bool = raw
+        .query_row(
+            "SELECT count(*) FROM pragma_table_info('trials') WHERE name = ?1",
+            [newest],
+            |r| r.get(0),
+        )
+        .unwrap();
+    assert!(has, "the column is added back when the journal is opened");
 }

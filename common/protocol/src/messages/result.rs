@@ -3,20 +3,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::forces::ForceAnalysisBeforeUnavailable;
-use super::{ForceAnalysis, Message, finite};
+use super::{ForceAnalysis, Message, MetricValues, finite};
 use crate::error::{Problem, ValidationError};
 use crate::keys::RunId;
-
-/// The grasp-quality metrics of a trial (thesis chapter 2).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MetricValues {
-    pub rank: u32,
-    pub force_closure: bool,
-    pub epsilon: f64,
-    pub volume: Option<f64>,
-    pub distance: f64,
-    pub bw: f64,
-}
 
 /// metric -> coordinator: the score of one trial.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -78,11 +67,7 @@ impl Message for TrialResult {
             finite(Self::TYPE, "score", &[self.score])?;
         }
         if let Some(m) = &self.metrics {
-            finite(
-                Self::TYPE,
-                "metrics",
-                &[m.epsilon, m.distance, m.bw, m.volume.unwrap_or(0.0)],
-            )?;
+            m.validate_in(Self::TYPE, "metrics")?;
         }
         if let Some(f) = &self.forces {
             f.validate_in(Self::TYPE, "forces")?;

@@ -18,7 +18,7 @@ fn model() -> GraspModel {
 }
 
 fn eval(contacts: &[Contact], model: &GraspModel) -> Result<f64, QualityError> {
-    evaluate_contacts(contacts, model, &MetricsOptions::default()).map(|m| m.bw)
+    evaluate_contacts(contacts, model, &MetricsOptions::default()).map(|m| m.bw())
 }
 
 #[test]
@@ -130,17 +130,17 @@ fn duplicated_points_give_the_same_result() {
     let base = evaluate_contacts(&g, &model(), &MetricsOptions::default()).unwrap();
     let doubled: Vec<Contact> = g.iter().chain(g.iter()).copied().collect();
     let m = evaluate_contacts(&doubled, &model(), &MetricsOptions::default()).unwrap();
-    assert!((m.epsilon - base.epsilon).abs() < 1e-12);
-    assert!((m.volume.unwrap() - base.volume.unwrap()).abs() < 1e-12);
+    assert!((m.epsilon() - base.epsilon()).abs() < 1e-12);
+    assert!((m.volume().unwrap() - base.volume().unwrap()).abs() < 1e-12);
     // All contacts at one point with one normal: a defined, non-closing result.
     let same = vec![g[0]; 5];
     let m = evaluate_contacts(&same, &model(), &MetricsOptions::default()).unwrap();
-    assert_eq!(m.rank, 2);
-    assert!(!m.force_closure && m.bw < 0.0);
+    assert_eq!(m.rank(), 2);
+    assert!(!m.force_closure() && m.bw() < 0.0);
     // Zero friction: every cone edge is the normal; still defined.
     let frictionless_cone = GraspModel::new(FrictionModel::PointFriction { mu: 0.0, edges: 8 });
     let m = evaluate_contacts(&g, &frictionless_cone, &MetricsOptions::default()).unwrap();
-    assert!(!m.force_closure && m.rank < 6);
+    assert!(!m.force_closure() && m.rank() < 6);
 }
 
 #[test]
@@ -174,8 +174,8 @@ fn edge_counts_are_bounded_before_anything_is_allocated() {
     let g = GraspMap::from_contacts(&sphere_grasp()[..1], &fine).unwrap();
     assert_eq!(g.wrenches().len(), 4096);
     let m = evaluate_contacts(&sphere_grasp()[..1], &fine, &MetricsOptions::default()).unwrap();
-    assert_eq!(m.rank, 2);
-    assert!((m.distance - 1.0).abs() < 1e-12 && (m.bw + 1.0).abs() < 1e-12);
+    assert_eq!(m.rank(), 2);
+    assert!((m.distance() - 1.0).abs() < 1e-12 && (m.bw() + 1.0).abs() < 1e-12);
 }
 
 #[test]
@@ -327,7 +327,7 @@ fn both_solvers_agree_up_to_the_magnitude_limit() {
     }
     let m = evaluate_wrenches(&mixed, &MetricsOptions::default()).unwrap();
     assert!(
-        m.distance < 1e-3 && m.bw == 0.0 && !m.force_closure,
+        m.distance() < 1e-3 && m.bw() == 0.0 && !m.force_closure(),
         "{m:?}"
     );
     // One contact (distance 1) and two contacts (distance 0.0669872981) in units from
@@ -363,10 +363,10 @@ fn bw_is_a_positive_zero_on_the_boundary() {
             distance_solver: solver,
         };
         let r = evaluate_contacts(&g, &m, &options).unwrap();
-        assert_eq!((r.rank, r.force_closure), (1, false));
-        assert_eq!(r.bw, 0.0);
-        assert!(r.bw.is_sign_positive(), "{solver:?}: bw = {:?}", r.bw);
-        assert!(r.distance.is_sign_positive() && r.volume == Some(0.0));
+        assert_eq!((r.rank(), r.force_closure()), (1, false));
+        assert_eq!(r.bw(), 0.0);
+        assert!(r.bw().is_sign_positive(), "{solver:?}: bw = {:?}", r.bw());
+        assert!(r.distance().is_sign_positive() && r.volume() == Some(0.0));
     }
 }
 
@@ -393,7 +393,11 @@ fn hulls_too_large_for_memory_are_refused() {
         "{err}"
     );
     let m = evaluate_contacts(&sphere_grasp(), &dense, &MetricsOptions::without_volume()).unwrap();
-    assert!(m.force_closure);
+    assert!(m.force_closure());
     // Between the 8-edge value and the friction cone's limit.
-    assert!((m.epsilon - 0.287_685_384).abs() < 1e-8, "{}", m.epsilon);
+    assert!(
+        (m.epsilon() - 0.287_685_384).abs() < 1e-8,
+        "{}",
+        m.epsilon()
+    );
 }

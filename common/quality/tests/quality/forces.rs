@@ -535,12 +535,12 @@ fn force_closure_grasps_resist_any_wrench() {
                 resisted += 1;
             }
             Resisting::CannotResist { .. } => {
-                assert!(!metrics.force_closure, "{contacts:?} {external:?}");
+                assert!(!metrics.force_closure(), "{contacts:?} {external:?}");
                 refused += 1;
             }
             Resisting::Unavailable { reason } => panic!("{contacts:?} {external:?}: {reason}"),
         }
-        closed += usize::from(metrics.force_closure);
+        closed += usize::from(metrics.force_closure());
     }
     // The sample holds both outcomes and grasps in force closure.
     assert!(

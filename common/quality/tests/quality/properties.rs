@@ -36,7 +36,7 @@ fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
         .with_reference_point(c)
         .with_torque_scale(1.3);
     let base = evaluate_contacts(&contacts, &model, &MetricsOptions::default()).unwrap();
-    assert!(base.force_closure, "{base:?}");
+    assert!(base.force_closure(), "{base:?}");
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     for _ in 0..5 {
         let r = Rotation3::from_euler_angles(
@@ -54,8 +54,8 @@ fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
             &MetricsOptions::default(),
         )
         .unwrap();
-        assert!((m.epsilon - base.epsilon).abs() < 1e-10);
-        let (v, v0) = (m.volume.unwrap(), base.volume.unwrap());
+        assert!((m.epsilon() - base.epsilon()).abs() < 1e-10);
+        let (v, v0) = (m.volume().unwrap(), base.volume().unwrap());
         assert!((v - v0).abs() < 1e-9 * v0, "{v} vs {v0}");
     }
     // Soft-finger wrench sets rotated in wrench space (R acting on force and torque).
@@ -77,8 +77,8 @@ fn epsilon_and_volume_do_not_change_under_a_common_rotation() {
         })
         .collect();
     let m = evaluate_wrenches(&rotated, &MetricsOptions::default()).unwrap();
-    assert!((m.bw - base.bw).abs() < 1e-10);
-    assert!((m.volume.unwrap() - base.volume.unwrap()).abs() < 1e-9 * base.volume.unwrap());
+    assert!((m.bw() - base.bw()).abs() < 1e-10);
+    assert!((m.volume().unwrap() - base.volume().unwrap()).abs() < 1e-9 * base.volume().unwrap());
 }
 
 #[test]
@@ -104,13 +104,13 @@ fn bw_sign_agrees_with_force_closure() {
             })
             .collect();
         let m = evaluate_contacts(&contacts, &model, &MetricsOptions::without_volume()).unwrap();
-        if m.force_closure {
+        if m.force_closure() {
             closed += 1;
-            assert!(m.bw > 0.0 && m.bw == m.epsilon);
+            assert!(m.bw() > 0.0 && m.bw() == m.epsilon());
         } else {
             open += 1;
-            assert!(m.bw <= 0.0 && m.epsilon == 0.0);
-            assert_eq!(m.bw, -m.distance);
+            assert!(m.bw() <= 0.0 && m.epsilon() == 0.0);
+            assert_eq!(m.bw(), -m.distance());
         }
     }
     assert!(closed > 20 && open > 20, "closed {closed}, open {open}");
@@ -132,7 +132,7 @@ fn bw_is_continuous_across_the_force_closure_boundary() {
         let phi = 240.0 - 110.0 * i as f64 / steps as f64;
         let grasp = [at(0.0), at(120.0), at(phi)];
         let m = evaluate_contacts(&grasp, &model, &MetricsOptions::without_volume()).unwrap();
-        values.push(m.bw);
+        values.push(m.bw());
     }
     assert!(values[0] > 0.1, "starts in force closure: {}", values[0]);
     assert!(
@@ -162,7 +162,7 @@ fn bw_is_continuous_across_the_force_closure_boundary() {
         let moved: Vec<Wrench> = grasp.wrenches().iter().map(|w| w + dir * t).collect();
         let bw = evaluate_wrenches(&moved, &MetricsOptions::without_volume())
             .unwrap()
-            .bw;
+            .bw();
         if let Some(prev) = last {
             // Moving the hull by dt changes both epsilon and the distance by at most dt.
             assert!((bw - prev) <= 1.5 / 200.0 + 1e-9 && (prev - bw) <= 1.5 / 200.0 + 1e-9);

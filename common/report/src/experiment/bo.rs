@@ -4,10 +4,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_bayesopt::{InitialDesign, Method, Settings};
 use graspopt_experiment::bo_study::{
-    BoStudy, ModelCapChoice, ONE_D_FIGURES, Part, THESIS_TABLE_4_1, summary,
+    BoStudy, ModelCapChoice, ONE_D_FIGURES, OneD, Part, THESIS_TABLE_4_1, TwoD, summary,
 };
 use graspopt_experiment::{Comparison, MethodSummary, Snapshot, TARGET_FRACTIONS};
 use graspopt_pictures::chart;
@@ -112,7 +112,10 @@ pub fn write_bo_study(
         started.elapsed().as_secs_f64()
     );
     let path = dir.join("report.md");
-    std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
     Ok(path)
 }
 
@@ -128,61 +131,11 @@ fn one_d(dir: &Path, study: &BoStudy, report: &mut String) -> Result<()> {
     );
     for (fig, object) in ONE_D_FIGURES {
         let one = study.one_d(object)?;
-        let (trace, snaps) = (&one.trace, &one.snaps);
-        let mut csv = String::from("trials,approach,mean,sd,ei\n");
-        for s in snaps {
-            for i in 0..s.grid.len() {
-                let _ = writeln!(
-                    csv,
-                    "{},{},{},{},{}",
-                    s.trials, s.grid[i], s.mean[i], s.sd[i], s.ei[i]
-                );
-            }
-        }
-        let mut files = vec![write(dir, &format!("fig{fig}-{object}-model.csv"), &csv)?];
-        let mut samples_csv = String::from("trial,approach,score,ei_when_chosen\n");
-        for (i, (p, y)) in trace.params.iter().zip(&trace.scores).enumerate() {
-            let ei = snaps
-                .iter()
-                .find(|s| s.trials == i)
-                .map_or(String::new(), |s| s.next_ei.to_string());
-            let _ = writeln!(samples_csv, "{},{},{y},{ei}", i + 1, p[0]);
-        }
-        files.push(write(
-            dir,
-            &format!("fig{fig}-{object}-samples.csv"),
-            &samples_csv,
-        )?);
-        let truth_scores: Vec<f64> = one.truth.iter().map(touched_score).collect();
-        for snap in pick_four(snaps) {
-            let samples: Vec<(f64, f64)> = trace.params[..snap.trials]
-                .iter()
-                .zip(&trace.scores)
-                .map(|(p, y)| (p[0], *y))
-                .collect();
-            let title = format!(
-                "Fig. {fig}: {}, model after {} trials",
-                display(object),
-                snap.trials
-            );
-            files.push(write(
-                dir,
-                &format!("fig{fig}-{object}-after-{:02}.svg", snap.trials),
-                &chart::model_plot(&chart::ModelPlot {
-                    title: &title,
-                    xlabel: "approach offset (m)",
-                    xs: &snap.grid,
-                    mean: &snap.mean,
-                    sd: &snap.sd,
-                    ei: &snap.ei,
-                    truth: Some(&truth_scores),
-                    samples: &samples,
-                    next: Some(snap.next),
-                }),
-            )?);
-        }
+        let mut files = one_d_csvs(dir, fig, object, &one)?;
+        files.extend(one_d_figures(dir, fig, object, &one)?);
+        let trace = &one.trace;
         let best = trace.best().map_or(f64::NAN, |b| b.1);
-        let top = graspopt_experiment::scans::argmax(&one.truth).context("empty scan")?;
+        let top = graspopt_experiment::scans::argmax(&one.truth).ok_or(ReportError::EmptyScan)?;
         let _ = writeln!(
             report,
             "| {} | {}{} | {best:.4} | {:.4} at {:.3} m | {} |",
@@ -199,6 +152,72 @@ fn one_d(dir: &Path, study: &BoStudy, report: &mut String) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The CSVs of a 1D run: each model's mean, sd and EI along the grid, and the samples with
+/// the EI at which each was chosen.
+fn one_d_csvs(dir: &Path, fig: &str, object: &str, one: &OneD) -> Result<Vec<String>> {
+    let (trace, snaps) = (&one.trace, &one.snaps);
+    let mut csv = String::from("trials,approach,mean,sd,ei\n");
+    for s in snaps {
+        for i in 0..s.grid.len() {
+            let _ = writeln!(
+                csv,
+                "{},{},{},{},{}",
+                s.trials, s.grid[i], s.mean[i], s.sd[i], s.ei[i]
+            );
+        }
+    }
+    let mut files = vec![write(dir, &format!("fig{fig}-{object}-model.csv"), &csv)?];
+    let mut samples_csv = String::from("trial,approach,score,ei_when_chosen\n");
+    for (i, (p, y)) in trace.params.iter().zip(&trace.scores).enumerate() {
+        let ei = snaps
+            .iter()
+            .find(|s| s.trials == i)
+            .map_or(String::new(), |s| s.next_ei.to_string());
+        let _ = writeln!(samples_csv, "{},{},{y},{ei}", i + 1, p[0]);
+    }
+    files.push(write(
+        dir,
+        &format!("fig{fig}-{object}-samples.csv"),
+        &samples_csv,
+    )?);
+    Ok(files)
+}
+
+/// Four of a 1D run's models drawn (see [`pick_four`]).
+fn one_d_figures(dir: &Path, fig: &str, object: &str, one: &OneD) -> Result<Vec<String>> {
+    let (trace, snaps) = (&one.trace, &one.snaps);
+    let mut files = Vec::new();
+    let truth_scores: Vec<f64> = one.truth.iter().map(touched_score).collect();
+    for snap in pick_four(snaps) {
+        let samples: Vec<(f64, f64)> = trace.params[..snap.trials]
+            .iter()
+            .zip(&trace.scores)
+            .map(|(p, y)| (p[0], *y))
+            .collect();
+        let title = format!(
+            "Fig. {fig}: {}, model after {} trials",
+            display(object),
+            snap.trials
+        );
+        files.push(write(
+            dir,
+            &format!("fig{fig}-{object}-after-{:02}.svg", snap.trials),
+            &chart::model_plot(&chart::ModelPlot {
+                title: &title,
+                xlabel: "approach offset (m)",
+                xs: &snap.grid,
+                mean: &snap.mean,
+                sd: &snap.sd,
+                ei: &snap.ei,
+                truth: Some(&truth_scores),
+                samples: &samples,
+                next: Some(snap.next),
+            }),
+        )?);
+    }
+    Ok(files)
 }
 
 /// Four snapshots like the thesis's panels: the first model, two steps later, halfway, last.
@@ -306,7 +325,6 @@ fn two_d(
     done: &mut dyn FnMut(Part, &str),
 ) -> Result<()> {
     let seeds = &study.seeds;
-    let grid_size = study.steps[0] * study.steps[1];
     let mut table = format!(
         "\n## Table 4.1: grid size versus BO trials (approach x vertical, medians over {} seeds)\n\n\
          BO total: trials until the engine's stopping rule (EI vanished) fired, the seeds where it fired within the \
@@ -335,59 +353,8 @@ fn two_d(
         let cmp = &two.cmp;
         let bo = summary(cmp, Method::Bo(study.engine))?;
         let random = summary(cmp, Method::Random)?;
-        let cells = |m: &MethodSummary| -> Vec<String> {
-            (0..TARGET_FRACTIONS.len())
-                .map(|k| fmt_median(m.median_trials_to[k], m.reached[k], seeds.len()))
-                .collect()
-        };
-        let (b, r) = (cells(bo), cells(random));
-        let thesis = THESIS_TABLE_4_1
-            .iter()
-            .find(|(o, _)| o == object)
-            .map_or("-".to_string(), |(_, v)| {
-                format!("{} / {} / {} / {}", v[0], v[1], v[2], v[3])
-            });
-        let _ = writeln!(
-            table,
-            "| {name} | {grid_size} | {:.4} | {} ({}/{}) | {} | {} | {} | {} | {} | {} | {:.4} | {thesis} |",
-            two.reference,
-            two.median_total,
-            two.stopped,
-            seeds.len(),
-            b[0],
-            b[1],
-            b[2],
-            r[0],
-            r[1],
-            r[2],
-            two.median_best
-        );
-        let first = bo.traces.first().context("no BO run")?;
-        let shown = first.ei_stop_at.unwrap_or(first.scores.len());
-        let samples: Vec<(f64, f64, f64)> = first.params[..shown]
-            .iter()
-            .zip(&first.scores)
-            .map(|(p, y)| (p[0], p[1], *y))
-            .collect();
-        let axes = &two.scan.axes;
-        let map = write(
-            dir,
-            &format!("fig4.18-4.24-{object}-samples.svg"),
-            &chart::samples_map(
-                &format!(
-                    "BO samples on the {name} (seed {}, {shown} trials)",
-                    first.seed
-                ),
-                ("approach offset (m)", "vertical offset (m)", "BW"),
-                (&axes[0], &axes[1], &touched_grid(axes, &two.scan.points)),
-                &samples,
-            ),
-        )?;
-        let top = samples
-            .iter()
-            .map(|s| s.2)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let _ = writeln!(maps, "| {name} | {shown} | {top:.4} | {map} |");
+        table.push_str(&table_row(study, object, &two, bo, random));
+        maps.push_str(&samples_row(dir, object, &two, bo)?);
         let files = comparison_files(
             dir,
             &format!("fig4.25-4.27-{object}-bo-vs-random"),
@@ -405,6 +372,80 @@ fn two_d(
     report.push_str(&maps);
     report.push_str(&curves);
     Ok(())
+}
+
+/// The row of Table 4.1 for `object`: the grid, BO's and random search's trials to each
+/// target, and the thesis's numbers.
+fn table_row(
+    study: &BoStudy,
+    object: &str,
+    two: &TwoD,
+    bo: &MethodSummary,
+    random: &MethodSummary,
+) -> String {
+    let (seeds, name) = (&study.seeds, display(object));
+    let grid_size = study.steps[0] * study.steps[1];
+    let cells = |m: &MethodSummary| -> Vec<String> {
+        (0..TARGET_FRACTIONS.len())
+            .map(|k| fmt_median(m.median_trials_to[k], m.reached[k], seeds.len()))
+            .collect()
+    };
+    let (b, r) = (cells(bo), cells(random));
+    let thesis = THESIS_TABLE_4_1
+        .iter()
+        .find(|(o, _)| *o == object)
+        .map_or("-".to_string(), |(_, v)| {
+            format!("{} / {} / {} / {}", v[0], v[1], v[2], v[3])
+        });
+    let mut table = String::new();
+    let _ = writeln!(
+        table,
+        "| {name} | {grid_size} | {:.4} | {} ({}/{}) | {} | {} | {} | {} | {} | {} | {:.4} | {thesis} |",
+        two.reference,
+        two.median_total,
+        two.stopped,
+        seeds.len(),
+        b[0],
+        b[1],
+        b[2],
+        r[0],
+        r[1],
+        r[2],
+        two.median_best
+    );
+    table
+}
+
+/// The row of figures 4.18-4.24 for `object`: the first seed's BO samples over the grid
+/// scan, drawn into their SVG.
+fn samples_row(dir: &Path, object: &str, two: &TwoD, bo: &MethodSummary) -> Result<String> {
+    let name = display(object);
+    let first = bo.traces.first().ok_or(ReportError::NoBoRun)?;
+    let shown = first.ei_stop_at.unwrap_or(first.scores.len());
+    let samples: Vec<(f64, f64, f64)> = first.params[..shown]
+        .iter()
+        .zip(&first.scores)
+        .map(|(p, y)| (p[0], p[1], *y))
+        .collect();
+    let axes = &two.scan.axes;
+    let map = write(
+        dir,
+        &format!("fig4.18-4.24-{object}-samples.svg"),
+        &chart::samples_map(
+            &format!(
+                "BO samples on the {name} (seed {}, {shown} trials)",
+                first.seed
+            ),
+            ("approach offset (m)", "vertical offset (m)", "BW"),
+            (&axes[0], &axes[1], &touched_grid(axes, &two.scan.points)),
+            &samples,
+        ),
+    )?;
+    let top = samples
+        .iter()
+        .map(|s| s.2)
+        .fold(f64::NEG_INFINITY, f64::max);
+    Ok(format!("| {name} | {shown} | {top:.4} | {map} |\n"))
 }
 
 /// BO versus random in the 6D pose space (three offsets, three rotations) on every object.

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{ReportError, Result};
 use graspopt_experiment::metric_study::{
     APPROACH_FIGURES, CONTACT_MODEL_OBJECTS, Map, MetricStudy, SPHERE_MAP_MODELS, Variant,
 };
@@ -42,7 +42,20 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
     );
 
     approach_section(dir, study, &mut report)?;
+    contact_models_section(dir, study, &mut report)?;
+    sphere_maps_section(dir, study, &mut report)?;
+    frames_section(dir, study, &mut report)?;
+    object_maps_section(dir, study, &mut report)?;
+    let path = dir.join("report.md");
+    std::fs::write(&path, &report).map_err(|source| ReportError::Write {
+        path: path.clone(),
+        source,
+    })?;
+    Ok(path)
+}
 
+/// Figure 4.6: BW along the approach axis under each contact model.
+fn contact_models_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.6: contact models.
     report.push_str("\n## Figure 4.6: BW with different contact models (approach axis)\n");
     for object in CONTACT_MODEL_OBJECTS {
@@ -66,7 +79,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         }
         let _ = writeln!(report, "\nFile: {file}\n");
     }
+    Ok(())
+}
 
+/// Figure 4.7: 2D BW maps of the sphere, mean point and surface model.
+fn sphere_maps_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.7: 2D sphere maps, mean point vs surface model.
     report.push_str("\n## Figure 4.7: 2D BW maps of the sphere, mean point and surface model\n\n");
     report.push_str(MAP_TABLE);
@@ -79,7 +96,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
             &map,
         )?);
     }
+    Ok(())
+}
 
+/// Figure 4.8: the reference frames, the torque scale fixed.
+fn frames_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.8: reference frames with the torque scale fixed.
     report.push_str("\n## Figure 4.8: reference-frame independence (sphere, approach axis, torque scale 0.05 m)\n\n| frame | BW max | at approach |\n|---|---|---|\n");
     let variants = study.frames()?;
@@ -98,7 +119,11 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
         );
     }
     let _ = writeln!(report, "\nFile: {file}");
+    Ok(())
+}
 
+/// Figures 4.9-4.15: 2D BW maps of the seven objects.
+fn object_maps_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Result<()> {
     // 4.9-4.15: 2D maps of the seven objects.
     report.push_str("\n## Figures 4.9-4.15: 2D BW maps (approach x vertical, surface model)\n\n");
     report.push_str(MAP_TABLE);
@@ -112,9 +137,7 @@ pub fn write_metric_study(dir: &Path, study: &MetricStudy) -> Result<PathBuf> {
             &map,
         )?);
     }
-    let path = dir.join("report.md");
-    std::fs::write(&path, &report).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(path)
+    Ok(())
 }
 
 /// Figures 4.3-4.5: LS, GWV and BW along the approach axis of three objects, a CSV and three
@@ -130,7 +153,7 @@ fn approach_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Res
         let xs = &m.scan.axes[0];
         let mut csv = String::from("approach,ls,gwv,bw,force_closure,contacts\n");
         for (p, ((l, g), b)) in m.scan.points.iter().zip(m.ls.iter().zip(&m.gwv).zip(&m.bw)) {
-            let fc = p.score.metrics.is_some_and(|m| m.force_closure);
+            let fc = p.score.metrics.is_some_and(|m| m.force_closure());
             let _ = writeln!(csv, "{},{l},{g},{b},{fc},{}", p.params[0], p.score.contacts);
         }
         let mut files = vec![write(dir, &format!("fig{fig}-{object}.csv"), &csv)?];
@@ -159,7 +182,7 @@ fn approach_section(dir: &Path, study: &MetricStudy, report: &mut String) -> Res
 
 /// The best point of a variant's scan.
 fn best(v: &Variant) -> Result<&graspopt_trial::ScanPoint> {
-    v.scan.argmax().context("empty scan")
+    v.scan.argmax().ok_or(ReportError::EmptyScan)
 }
 
 /// Plots the BW of every variant along the approach axis together into `dir/file` (grasps
@@ -183,7 +206,7 @@ fn map_row(dir: &Path, stem: &str, title: &str, map: &Map) -> Result<String> {
     let axes = &map.scan.axes;
     let mut csv = String::from("approach,vertical,bw,force_closure,contacts\n");
     for p in points {
-        let fc = p.score.metrics.is_some_and(|m| m.force_closure);
+        let fc = p.score.metrics.is_some_and(|m| m.force_closure());
         let _ = writeln!(
             csv,
             "{},{},{},{fc},{}",
@@ -217,7 +240,8 @@ fn map_row(dir: &Path, stem: &str, title: &str, map: &Map) -> Result<String> {
         missing: chart::MISSING_LABEL,
         cell: 8,
     })
-    .save_png(&dir.join(format!("{stem}.png")))?;
+    .save_png(&dir.join(format!("{stem}.png")))
+    .map_err(ReportError::picture)?;
     let best = map.best()?;
     Ok(format!(
         "| {} | {:.4} | ({:.3}, {:.3}) | {}/{} | {file} |\n",

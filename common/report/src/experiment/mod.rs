@@ -5,7 +5,7 @@
 pub mod bo;
 pub mod metrics;
 
-use anyhow::Result;
+use crate::error::Result;
 use graspopt_experiment::ExperimentError;
 
 /// The hand of a study (`--hand`, a built-in name or a URDF file) as its report names it:

@@ -20,7 +20,7 @@ fn scan(object: &str, two_d: bool, steps: &[usize], resolution: f64) -> Vec<Scan
 }
 
 fn closure(p: &ScanPoint) -> bool {
-    p.score.metrics.is_some_and(|m| m.force_closure)
+    p.score.metrics.is_some_and(|m| m.force_closure())
 }
 
 #[test]

@@ -121,8 +121,8 @@ fn sample(ev: &Evaluator, e: &Evaluation) -> Sample {
     Sample {
         x: e.params[0],
         bw: e.score.score,
-        ls: m.map_or(0.0, |m| m.epsilon),
-        fc: m.is_some_and(|m| m.force_closure),
+        ls: m.map_or(0.0, |m| m.epsilon()),
+        fc: m.is_some_and(|m| m.force_closure()),
         touched: m.is_some(),
         palm: e.outcome.palm.touches(),
         links: e.outcome.grasp.link_touching.clone(),

@@ -41,7 +41,7 @@ fn no_contact_scores_below_every_touching_grasp_and_improves_nearer() {
             &ev.score,
         )
         .unwrap();
-        assert!(m.bw >= -wrench_norm_bound(&ev.object, &model));
+        assert!(m.bw() >= -wrench_norm_bound(&ev.object, &model));
         assert!(p.score.score.is_finite());
     }
     // Farther away scores no better than nearer (monotone in the gap, capped at 1 rho).
@@ -58,11 +58,11 @@ fn bw_equals_epsilon_in_force_closure_and_scores_follow_the_metric() {
     let x = [0.01];
     let bw = ev.evaluate(&x).unwrap().score;
     let m = bw.metrics.unwrap();
-    assert!(m.force_closure, "{m:?}");
-    assert_eq!(bw.score, m.epsilon);
+    assert!(m.force_closure(), "{m:?}");
+    assert_eq!(bw.score, m.epsilon());
     assert_eq!(bw.fingers_in_contact, 3);
     ev.score.metric = Metric::Epsilon;
-    assert_eq!(ev.score(&x).unwrap(), m.epsilon);
+    assert_eq!(ev.score(&x).unwrap(), m.epsilon());
     ev.score.metric = Metric::Volume;
     assert!(ev.score(&x).unwrap() > 0.0);
     assert!(Metric::parse("gwv").is_ok() && Metric::parse("area").is_err());
@@ -81,8 +81,8 @@ fn world_and_palm_frames_change_values_not_closure() {
     ] {
         ev.score.frame = frame;
         let m = ev.evaluate(&x).unwrap().score.metrics.unwrap();
-        assert_eq!(m.force_closure, object.force_closure, "{frame:?}");
-        assert_eq!(m.rank, object.rank);
+        assert_eq!(m.force_closure(), object.force_closure(), "{frame:?}");
+        assert_eq!(m.rank(), object.rank());
     }
 }
 
@@ -156,13 +156,13 @@ fn a_full_rank_grasp_whose_hull_needs_a_joggle_has_a_volume() {
             .evaluate(&[])
             .unwrap_or_else(|err| panic!("{contacts}: {err}"));
         let m = e.score.metrics.unwrap();
-        assert_eq!(m.rank, 6, "{contacts}");
-        let volume = m.volume.expect("a volume");
+        assert_eq!(m.rank(), 6, "{contacts}");
+        let volume = m.volume().expect("a volume");
         assert!(volume.is_finite() && volume > 0.0, "{contacts}: {volume}");
         assert_eq!(e.score.score, volume);
-        if m.force_closure {
+        if m.force_closure() {
             // The 6-ball of radius epsilon lies inside the hull: pi^3 / 6 r^6.
-            let ball = std::f64::consts::PI.powi(3) / 6.0 * m.epsilon.powi(6);
+            let ball = std::f64::consts::PI.powi(3) / 6.0 * m.epsilon().powi(6);
             assert!(volume > ball, "{contacts}: {volume} <= {ball}");
         }
     }

@@ -86,5 +86,5 @@ fn a_urdf_hand_written_here_loads_and_grasps_the_cylinder_with_force_closure() {
     assert!((j[1] - (0.5 * j[0] + 0.2)).abs() < 1e-12 && (j[3] - (0.5 * j[2] + 0.2)).abs() < 1e-12);
     assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0));
     let m = e.score.metrics.expect("contacts");
-    assert!(m.force_closure && m.epsilon > 0.0, "{m:?}");
+    assert!(m.force_closure() && m.epsilon() > 0.0, "{m:?}");
 }

@@ -1,5 +1,6 @@
 //! Metrics of a grasp's wrench set (thesis sections 2.5-2.6, conventions in
-//! `docs/metric-conventions.md`):
+//! `docs/metric-conventions.md`). Which metrics there are, and how each is named, stored,
+//! printed and computed, is the [`table`]: **to add a metric, add its entry there**.
 //!
 //! - `rank`: affine rank of the wrenches; below 6 there is no force closure.
 //! - `distance`: distance from the origin to the wrench hull (0 when inside).
@@ -12,6 +13,12 @@
 //!
 //! Every metric returned is finite: a NaN or infinite value is reported as
 //! [`QualityError::NotFiniteMetric`] instead. Inputs are bounded by [`crate::limits`].
+
+pub mod table;
+mod values;
+
+pub use table::{COUNT, Kind, Metric, MetricDef, TABLE, Value, WrenchSet, objective_names};
+pub use values::Metrics;
 
 use serde::{Deserialize, Serialize};
 
@@ -63,18 +70,14 @@ impl MetricsOptions {
             ..Self::default()
         }
     }
-}
 
-/// The metrics of one wrench set.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Metrics {
-    pub rank: usize,
-    pub force_closure: bool,
-    pub epsilon: f64,
-    /// `None` when not asked for.
-    pub volume: Option<f64>,
-    pub distance: f64,
-    pub bw: f64,
+    /// What scoring by `metric` needs: the volume only when it is the score.
+    pub fn for_score(metric: Metric) -> Self {
+        Self {
+            volume: metric == Metric::Volume,
+            ..Self::default()
+        }
+    }
 }
 
 /// All metrics of a grasp map.
@@ -93,7 +96,24 @@ pub fn evaluate_contacts(
 
 /// All metrics of a wrench set; errors on an empty set, a non-finite or out-of-range
 /// wrench, too many wrenches (see [`crate::limits`]), or a metric that is not finite.
+///
+/// What several metrics share (the rank, the distance, the Largest Sphere and force
+/// closure) is computed first, then each entry of the [`TABLE`] in order.
 pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metrics, QualityError> {
+    let set = shared(w, options)?;
+    let mut values = [None; COUNT];
+    for (value, def) in values.iter_mut().zip(&TABLE) {
+        *value = match (def.compute)(&set)? {
+            Some(Value::Real(x)) => Some(Value::Real(positive_zero(finite(def.key, x)?))),
+            other => other,
+        };
+    }
+    Ok(Metrics::from_values(values))
+}
+
+/// The quantities several metrics share: the rank, the distance (finite), the Largest
+/// Sphere radius (finite, 0 without force closure) and force closure.
+fn shared<'a>(w: &'a [Wrench], options: &'a MetricsOptions) -> Result<WrenchSet<'a>, QualityError> {
     check_wrenches(w)?;
     let basis = affine::affine_basis(w);
     let rank = basis.rank;
@@ -110,20 +130,14 @@ pub fn evaluate_wrenches(w: &[Wrench], options: &MetricsOptions) -> Result<Metri
         0.0
     };
     let force_closure = epsilon > FORCE_CLOSURE_MARGIN;
-    let epsilon = if force_closure { epsilon } else { 0.0 };
-    let volume = if options.volume {
-        Some(finite("volume", grasp_wrench_volume(w)?)?)
-    } else {
-        None
-    };
-    let epsilon = finite("epsilon", epsilon)?;
-    Ok(Metrics {
+    let epsilon = finite("epsilon", if force_closure { epsilon } else { 0.0 })?;
+    Ok(WrenchSet {
+        wrenches: w,
+        options,
         rank,
+        distance,
         force_closure,
-        epsilon: positive_zero(epsilon),
-        volume: volume.map(positive_zero),
-        distance: positive_zero(distance),
-        bw: positive_zero(if force_closure { epsilon } else { -distance }),
+        epsilon,
     })
 }
 
@@ -167,10 +181,10 @@ pub fn grasp_wrench_volume(w: &[Wrench]) -> Result<f64, QualityError> {
 
 /// The Largest Sphere radius (0 without force closure).
 pub fn largest_sphere(w: &[Wrench]) -> Result<f64, QualityError> {
-    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.epsilon)
+    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.epsilon())
 }
 
 /// The Bimodal Wrench metric.
 pub fn bimodal_wrench(w: &[Wrench]) -> Result<f64, QualityError> {
-    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.bw)
+    Ok(evaluate_wrenches(w, &MetricsOptions::without_volume())?.bw())
 }
