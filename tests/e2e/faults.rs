@@ -7,7 +7,7 @@ use crate::support::{
     Cluster, assert_nothing_lost, check_journal, lost_and_recorded_twice, report, signal,
 };
 use graspopt_bus::{Bus, CongestionControl};
-use graspopt_journal::{Journal, TrialState};
+use graspopt_journal::{Journal, StoredTrialPhase};
 use graspopt_protocol::keys::{CLOUDS, COMMAND, OBJECT, RESULT, Runs, WRENCHES};
 use graspopt_protocol::{
     CloudPoint, ContactClouds, Encoding, FingerCloud, Pose, RunId, TrialResult, encode,
@@ -48,10 +48,10 @@ fn a_trial_survives_its_killed_worker() {
     let coordinator = c.coordinator("cuboid", "8", "3", &["--set", "lease_ms=120000"]);
     // hand-1 has completed a trial and holds another one: kill it.
     wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
-        t.worker == "hand-1" && t.state == TrialState::Completed
+        t.worker == "hand-1" && t.state == StoredTrialPhase::Completed
     });
     let held = wait_for_trial(&journal, "killed", Duration::from_secs(60), |t| {
-        t.worker == "hand-1" && t.state == TrialState::Running
+        t.worker == "hand-1" && t.state == StoredTrialPhase::Running
     });
     let killed_at = Instant::now();
     hands[0].kill();
@@ -92,12 +92,12 @@ fn a_hung_worker_loses_its_trial_when_the_lease_expires() {
     let hands = c.hands(2, &["--set", "trial_cost_ms=300"]);
     let coordinator = c.coordinator("sphere", "14", "1", &["--set", "lease_ms=1500"]);
     let held = wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
-        t.worker == "hand-1" && t.state == TrialState::Running
+        t.worker == "hand-1" && t.state == StoredTrialPhase::Running
     });
     signal(&hands[0], "STOP");
     // The lease (1.5 s) expires; hand-2 completes the trial.
     wait_for_trial(&journal, "hung", Duration::from_secs(60), |t| {
-        t.trial_id == held && t.state == TrialState::Completed
+        t.trial_id == held && t.state == StoredTrialPhase::Completed
     });
     signal(&hands[0], "CONT");
     let status = c.final_status(coordinator, Duration::from_secs(120));
@@ -227,7 +227,7 @@ fn bad_input_on_every_topic_is_counted_and_changes_nothing() {
             Journal::open(&journal)
                 .ok()
                 .and_then(|j| j.trial("bad", first.trial_id).ok().flatten())
-                .is_some_and(|t| t.state == TrialState::Completed)
+                .is_some_and(|t| t.state == StoredTrialPhase::Completed)
         };
         let waited = Instant::now();
         while !recorded() {

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use graspopt_bus::Bus;
 use graspopt_hand::replay::RecordedTrial;
 use graspopt_hand::{HandConfig, HandDriver, HandError, HandReading, Sensing, SimulatedHand};
-use graspopt_journal::{Journal, TrialRow, TrialState};
+use graspopt_journal::{Journal, StoredTrialPhase, TrialRow};
 use graspopt_protocol::{FingertipSurface, ObjectEstimate, RunId, TrialCommand};
 use graspopt_sensing::SensorNoise;
 use graspopt_sim::ParamKind;
@@ -427,15 +427,17 @@ fn bad_fingertip_readings_fail_their_trial_and_the_run_goes_on() {
         let e = t.error.clone().unwrap_or_default();
         match t.trial_id {
             2 => assert!(
-                t.state == TrialState::Failed && e.contains("fingertips[0].force[1] is not finite"),
+                t.state == StoredTrialPhase::Failed
+                    && e.contains("fingertips[0].force[1] is not finite"),
                 "{t:?}"
             ),
             3 => assert!(
-                t.state == TrialState::Failed && e.contains("fingertips[0].surface: radius is 0"),
+                t.state == StoredTrialPhase::Failed
+                    && e.contains("fingertips[0].surface: radius is 0"),
                 "{t:?}"
             ),
             _ => assert!(
-                t.state == TrialState::Completed && t.forces.is_some(),
+                t.state == StoredTrialPhase::Completed && t.forces.is_some(),
                 "{t:?}"
             ),
         }

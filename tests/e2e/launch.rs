@@ -9,7 +9,7 @@ use crate::support::{
     check_journal, completed_now, free_port, graspopt_bin, journal_best, repo_root, tempdir,
     wait_until,
 };
-use graspopt_journal::{Journal, RunLifecycle, TrialState};
+use graspopt_journal::{Journal, StoredRunPhase, StoredTrialPhase};
 
 #[test]
 fn the_local_launch_file_runs_a_whole_run_and_stops_everything() {
@@ -138,7 +138,7 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--set",
         .trials("lr")
         .unwrap()
         .into_iter()
-        .filter(|t| t.state == TrialState::Completed)
+        .filter(|t| t.state == StoredTrialPhase::Completed)
         .collect();
     assert!(
         (3..12).contains(&before.len()),
@@ -148,7 +148,10 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--set",
     let log = std::fs::read_to_string(dir.join("logs/lr/coordinator.log")).unwrap();
     assert!(!log.contains("lost with trial"), "{log}");
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("lr").unwrap().unwrap().status, RunLifecycle::Stopped);
+    assert_eq!(
+        j.run("lr").unwrap().unwrap().status,
+        StoredRunPhase::Stopped
+    );
     drop(j);
 
     // Launched again as it was: the coordinator refuses, naming the way to resume.
@@ -178,5 +181,8 @@ args = ["--object", "cylinder", "--trials", "12", "--method", "random", "--set",
         );
     }
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("lr").unwrap().unwrap().status, RunLifecycle::Finished);
+    assert_eq!(
+        j.run("lr").unwrap().unwrap().status,
+        StoredRunPhase::Finished
+    );
 }

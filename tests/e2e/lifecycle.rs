@@ -7,7 +7,7 @@ use std::time::Duration;
 use crate::support::{
     Cluster, Proc, check_journal, completed_now, graspopt, signal, tempdir, wait_until,
 };
-use graspopt_journal::{Journal, RunLifecycle, TrialState};
+use graspopt_journal::{Journal, StoredRunPhase, StoredTrialPhase};
 
 fn text(o: &std::process::Output) -> String {
     format!(
@@ -50,7 +50,7 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
     assert_eq!(j.trials("run").unwrap().len(), 12);
     assert_eq!(
         j.run("run").unwrap().unwrap().status,
-        RunLifecycle::Finished
+        StoredRunPhase::Finished
     );
     drop(j);
 
@@ -73,7 +73,7 @@ fn a_resumed_run_keeps_its_recorded_settings_and_refuses_contradicting_flags() {
     }
     let j = Journal::open(&journal).unwrap();
     let record = j.run("run").unwrap().unwrap();
-    assert_eq!(record.status, RunLifecycle::Finished);
+    assert_eq!(record.status, StoredRunPhase::Finished);
     let spec: serde_json::Value = serde_json::from_str(&record.config_json).unwrap();
     assert_eq!(spec["object"], "sphere");
     assert_eq!(spec["trials"], 18);
@@ -188,12 +188,15 @@ fn ctrl_c_stops_a_run_that_resume_then_finishes() {
         "{stdout}"
     );
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("run").unwrap().unwrap().status, RunLifecycle::Stopped);
+    assert_eq!(
+        j.run("run").unwrap().unwrap().status,
+        StoredRunPhase::Stopped
+    );
     let done = j
         .trials("run")
         .unwrap()
         .iter()
-        .filter(|t| t.state == TrialState::Completed)
+        .filter(|t| t.state == StoredTrialPhase::Completed)
         .count();
     assert!((5..60).contains(&done), "{done} trials completed");
     drop(j);
@@ -206,7 +209,7 @@ fn ctrl_c_stops_a_run_that_resume_then_finishes() {
     let j = Journal::open(&journal).unwrap();
     assert_eq!(
         j.run("run").unwrap().unwrap().status,
-        RunLifecycle::Finished
+        StoredRunPhase::Finished
     );
 }
 

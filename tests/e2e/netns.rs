@@ -17,7 +17,7 @@ use crate::support::{
     Proc, assert_nothing_lost, check_journal, cloud_transport, col, completed_now, graspopt,
     graspopt_bin, read_csv, repo_root, report, tempdir, wait_until,
 };
-use graspopt_journal::{Journal, TrialState, event_kind};
+use graspopt_journal::{Journal, StoredTrialPhase, event_kind};
 use serde_json::json;
 
 /// Prefix of the namespaces this test makes: `<prefix><pid>-<nonce>-<machine>`.
@@ -352,7 +352,7 @@ fn a_run_across_three_network_namespaces_survives_a_router_restart() {
             .and_then(|j| j.trials(run))
             .map(|ts| {
                 ts.iter()
-                    .filter(|t| t.state == TrialState::Running && on_c(&t.worker))
+                    .filter(|t| t.state == StoredTrialPhase::Running && on_c(&t.worker))
                     .map(|t| t.trial_id)
                     .collect()
             })

@@ -11,7 +11,7 @@ use crate::support::{
     wait_until,
 };
 use graspopt_bus::Bus;
-use graspopt_journal::{Journal, TrialRow, TrialState};
+use graspopt_journal::{Journal, StoredTrialPhase, TrialRow};
 use graspopt_protocol::keys::{CLOUDS, COMMAND, Runs};
 use graspopt_protocol::{
     AgentKind, CloudPoint, ContactClouds, Encoding, FingerCloud, RunId, TrialCommand,
@@ -23,7 +23,7 @@ type Completed = BTreeMap<u64, (Vec<f64>, Option<f64>, Option<u32>)>;
 
 fn completed(rows: &[TrialRow]) -> Completed {
     rows.iter()
-        .filter(|t| t.state == TrialState::Completed)
+        .filter(|t| t.state == StoredTrialPhase::Completed)
         .map(|t| (t.trial_id, (t.params.clone(), t.score, t.result_attempt)))
         .collect()
 }
@@ -240,7 +240,9 @@ fn running_now(path: &std::path::Path, run: &str) -> usize {
     Journal::open(path)
         .and_then(|j| j.trials(run))
         .map_or(0, |t| {
-            t.iter().filter(|t| t.state == TrialState::Running).count()
+            t.iter()
+                .filter(|t| t.state == StoredTrialPhase::Running)
+                .count()
         })
 }
 
@@ -410,10 +412,10 @@ fn degenerate_contacts_never_leave_a_trial_stuck() {
     for (id, complete, what) in &expected {
         let t = j.trial("dg", *id).unwrap().unwrap();
         if *complete {
-            assert_eq!(t.state, TrialState::Completed, "{what}: {t:?}");
+            assert_eq!(t.state, StoredTrialPhase::Completed, "{what}: {t:?}");
             assert!(t.score.unwrap().is_finite(), "{what}");
         } else {
-            assert_eq!(t.state, TrialState::Failed, "{what}: {t:?}");
+            assert_eq!(t.state, StoredTrialPhase::Failed, "{what}: {t:?}");
             let e = t.error.clone().unwrap_or_default();
             let named = match *what {
                 "a zero normal" => e.contains("not a unit normal"),

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use crate::support::{
     Cluster, Proc, check_journal, completed_now, graspopt, signal, tempdir, wait_until,
 };
-use graspopt_journal::{Journal, RunLifecycle, TrialState};
+use graspopt_journal::{Journal, StoredRunPhase, StoredTrialPhase};
 
 const TRIALS: usize = 20;
 
@@ -50,9 +50,9 @@ fn a_killed_run_resumes_from_its_journal_and_loses_nothing() {
         {
             let done = trials
                 .iter()
-                .filter(|t| t.state == TrialState::Completed)
+                .filter(|t| t.state == StoredTrialPhase::Completed)
                 .count();
-            if done >= 6 && trials.iter().any(|t| t.state == TrialState::Running) {
+            if done >= 6 && trials.iter().any(|t| t.state == StoredTrialPhase::Running) {
                 first.kill();
                 break Journal::open(&journal).unwrap().trials("run").unwrap();
             }
@@ -66,7 +66,7 @@ fn a_killed_run_resumes_from_its_journal_and_loses_nothing() {
     assert!(Journal::open(&journal).unwrap().integrity_check().unwrap());
     let completed_before: Vec<_> = before
         .iter()
-        .filter(|t| t.state == TrialState::Completed)
+        .filter(|t| t.state == StoredTrialPhase::Completed)
         .cloned()
         .collect();
     assert!(completed_before.len() < TRIALS);
@@ -92,7 +92,7 @@ fn a_killed_run_resumes_from_its_journal_and_loses_nothing() {
     // A trial running at the kill was issued again and completed once.
     let running_before: Vec<u64> = before
         .iter()
-        .filter(|t| t.state == TrialState::Running)
+        .filter(|t| t.state == StoredTrialPhase::Running)
         .map(|t| t.trial_id)
         .collect();
     assert!(!running_before.is_empty());
@@ -186,7 +186,7 @@ fn a_stopped_run_resumes_with_the_command_it_prints() {
     // A second run in the same journal: which one to resume must be said.
     let mut j = Journal::open(&journal).unwrap();
     let record = j.run("stopme").unwrap().unwrap();
-    j.create_run(&graspopt_journal::RunRecord {
+    j.create_run(&graspopt_journal::RunRow {
         run_id: "other".into(),
         ..record
     })
@@ -232,7 +232,7 @@ fn a_run_stopped_before_its_first_trial_starts_afresh_with_the_same_command() {
         c.log("coordinator")
     );
     let j = Journal::open(&journal).unwrap();
-    assert_eq!(j.run("q").unwrap().unwrap().status, RunLifecycle::Stopped);
+    assert_eq!(j.run("q").unwrap().unwrap().status, StoredRunPhase::Stopped);
     assert!(j.trials("q").unwrap().is_empty());
     drop(j);
 
@@ -303,7 +303,7 @@ fn a_run_stopped_mid_trial_and_resumed_proposes_what_the_uninterrupted_run_does(
             .trials("run")
             .unwrap()
             .iter()
-            .filter(|t| t.state == TrialState::Running)
+            .filter(|t| t.state == StoredTrialPhase::Running)
             .map(|t| t.trial_id)
             .collect()
     };

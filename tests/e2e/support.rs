@@ -389,7 +389,7 @@ pub fn check_journal(path: &Path, run: &str, n: usize) -> Vec<graspopt_journal::
         assert_eq!(t.trial_id, i as u64 + 1);
         assert_eq!(
             t.state,
-            graspopt_journal::TrialState::Completed,
+            graspopt_journal::StoredTrialPhase::Completed,
             "trial {}",
             t.trial_id
         );
@@ -520,7 +520,7 @@ pub fn lost_and_recorded_twice(path: &Path, run: &str, n: u64) -> (u64, u64) {
         .trials(run)
         .unwrap()
         .iter()
-        .filter(|t| t.state == graspopt_journal::TrialState::Completed)
+        .filter(|t| t.state == graspopt_journal::StoredTrialPhase::Completed)
         .map(|t| t.trial_id)
         .collect();
     let lost = (1..=n).filter(|id| !completed.contains(id)).count() as u64;

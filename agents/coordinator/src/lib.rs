@@ -27,10 +27,10 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::core::{Action, Coordinator, Event, Write};
 pub use crate::error::CoordinatorError;
-pub use crate::run::{record, run, run_until, split_writes};
+pub use crate::run::{run, run_until, split_writes, write_journal};
 pub use crate::spec::{
-    Conflicts, MAX_TRIALS, RunSpec, bounds_of, check_trials, open_run, param_names, quoted_runs,
-    range_conflicts, reconcile, recorded_runs, recorded_spec, resume_conflicts, sole_run,
+    Conflicts, MAX_TRIALS, RunSpec, bounds_of, check_trials, journaled_runs, journaled_spec,
+    open_run, param_names, quoted_runs, range_conflicts, reconcile, resume_conflicts, sole_run,
     standalone_run, trial_space,
 };
 

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use graspopt_bus::{AliveWatch, Bus, BusError, Inbox, Received, Server, Subscription, now_ms};
-use graspopt_journal::{Journal, ResultOutcome, RunLifecycle, Written};
+use graspopt_journal::{Journal, ResultOutcome, StoredRunPhase, Written};
 use graspopt_protocol::keys::{COMMAND, OBJECT, RESULT, STATE, STATUS, SUGGEST, alive_key};
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, RunId, RunPhase, RunStatus, SuggestReply, TrialResult,
@@ -216,11 +216,11 @@ impl<'a> Io<'a> {
         // The journal first, in one transaction: each write comes at most earlier than
         // the core listed it, so no command goes out before its issue is committed.
         let (writes, rest) = split_writes(actions);
-        record(self.journal, self.run, &writes)?;
+        write_journal(self.journal, self.run, &writes)?;
         for action in rest {
             match action {
                 // Committed above.
-                Action::Record(_) => {}
+                Action::Write(_) => {}
                 Action::Send {
                     worker,
                     encoding,
@@ -255,7 +255,7 @@ impl<'a> Io<'a> {
     async fn finished(mut self, core: &Coordinator) -> Result<RunStatus, CoordinatorError> {
         let run = self.run.as_str();
         self.journal
-            .set_run_status(run, RunLifecycle::Finished, now_ms())?;
+            .set_run_phase(run, StoredRunPhase::Finished, now_ms())?;
         let s = core.status_at(RunPhase::Finished, now_ms());
         self.last_status(&s).await;
         Ok(s)
@@ -281,7 +281,7 @@ impl<'a> Io<'a> {
     ) -> Result<RunStatus, CoordinatorError> {
         let run = self.run;
         self.journal
-            .set_run_status(run.as_str(), RunLifecycle::Stopped, now_ms())?;
+            .set_run_phase(run.as_str(), StoredRunPhase::Stopped, now_ms())?;
         let s = core.status_at(RunPhase::Stopped, now_ms());
         self.last_status(&s).await;
         let waiting = if s.waiting.is_empty() {
@@ -320,7 +320,7 @@ pub fn split_writes(actions: Vec<Action>) -> (Vec<Write>, Vec<Action>) {
     let mut rest = Vec::with_capacity(actions.len());
     for action in actions {
         match action {
-            Action::Record(write) => writes.push(write),
+            Action::Write(write) => writes.push(write),
             other => rest.push(other),
         }
     }
@@ -333,7 +333,7 @@ pub fn split_writes(actions: Vec<Action>) -> (Vec<Write>, Vec<Action>) {
 /// (a duplicate, say) is logged; a planner state that cannot be kept is only logged (see
 /// [`Write::PlannerState`]); any other refusal, or a transaction that cannot commit, is an
 /// error, returned before any command of these writes is sent.
-pub fn record(
+pub fn write_journal(
     journal: &mut Journal,
     run: &RunId,
     writes: &[Write],
@@ -342,7 +342,7 @@ pub fn record(
         return Ok(());
     }
     let outcomes = journal
-        .record(run.as_str(), writes)
+        .write(run.as_str(), writes)
         .map_err(CoordinatorError::Commit)?;
     for (write, outcome) in writes.iter().zip(outcomes) {
         match (write, outcome) {
@@ -429,7 +429,7 @@ mod tests {
             );
             let journal = Journal::open(&config.journal).unwrap();
             let record = journal.run(run_id.as_str()).unwrap().expect("the run");
-            assert_eq!(record.status, RunLifecycle::Running);
+            assert_eq!(record.status, StoredRunPhase::Running);
             drop(journal);
             let _ = bus.close().await;
             let _ = hub.close().await;

@@ -7,7 +7,7 @@ use graspopt_convert::{TrialTag, clouds_from_outcome, fingertip_wrench, isometry
 use graspopt_protocol::{ObjectEstimate, TrialCommand};
 use graspopt_sim::{ContactModelSettings, Hand, Object, hand_by_name, run_trial};
 use graspopt_trial::ScoreSettings;
-use graspopt_trial::fingertips::{fingertips, simulate_readings};
+use graspopt_trial::fingertips::{fingertips, simulate_wrenches};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -86,7 +86,7 @@ impl SimulatedHand {
         }
         let mut rng =
             ChaCha8Rng::seed_from_u64(command.trial_id ^ (u64::from(command.attempt) << 48));
-        let tips = simulate_readings(
+        let tips = simulate_wrenches(
             &outcome,
             self.hand.as_ref(),
             world,

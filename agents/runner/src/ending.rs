@@ -153,7 +153,7 @@ fn failure_lines(failures: &[FailureReason]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use graspopt_journal::{RunLifecycle, RunRecord, TrialIssue};
+    use graspopt_journal::{RunRow, StoredRunPhase, TrialIssue};
     use graspopt_protocol::{BestTrial, RunId};
 
     fn status(completed: u64, failed: u64, phase: RunPhase) -> RunStatus {
@@ -180,16 +180,16 @@ mod tests {
     fn journal(dir: &Path, n: u64, reason: impl Fn(u64) -> String) -> std::path::PathBuf {
         let path = dir.join("journal.sqlite");
         let mut j = Journal::open(&path).unwrap();
-        j.create_run(&RunRecord {
+        j.create_run(&RunRow {
             run_id: "run".into(),
             created_ms: 0,
             config_json: "{}".into(),
             param_names: vec!["x".into(), "y".into()],
-            status: RunLifecycle::Running,
+            status: StoredRunPhase::Running,
         })
         .unwrap();
         for id in 1..=n {
-            j.record_issue(&TrialIssue {
+            j.write_issue(&TrialIssue {
                 run_id: "run".into(),
                 trial_id: id,
                 attempt: 1,
@@ -200,7 +200,7 @@ mod tests {
                 reason: None,
             })
             .unwrap();
-            j.record_failure("run", id, 1, &reason(id), 2).unwrap();
+            j.write_failure("run", id, 1, &reason(id), 2).unwrap();
         }
         path
     }

@@ -21,7 +21,7 @@ use graspopt_protocol::{FingertipWrenches, RunId};
 use graspopt_sim::{TrialOutcome, run_trial};
 use graspopt_trial::Evaluator;
 use graspopt_trial::fingertips::{
-    FingertipSettings, fingertip_score, fingertips, simulate_readings,
+    FingertipSettings, fingertip_score, fingertips, simulate_wrenches,
 };
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
@@ -155,7 +155,7 @@ pub fn fingertip_trial(
     let pose = ev.space.palm_pose(&params)?;
     let outcome = run_trial(&ev.object, ev.hand.as_ref(), &pose, &ev.contacts)?;
     let tag = tag()?;
-    let simulated = simulate_readings(
+    let simulated = simulate_wrenches(
         &outcome,
         ev.hand.as_ref(),
         &ev.object,

@@ -79,7 +79,7 @@ impl Default for RunSettings {
 /// perception's noise), recorded in the run's spec so that a resumed run restores them.
 /// The stored layout is unchanged since the first recorded runs: names, not enums.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct RecordedSettings {
+struct JournaledSettings {
     mesh: Option<PathBuf>,
     /// Runs recorded before `--mesh-scale` existed used their meshes in metres.
     #[serde(default = "unit_scale")]
@@ -118,9 +118,9 @@ fn canonical(path: &Path) -> PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
 }
 
-impl RecordedSettings {
-    fn of(s: &RunSettings) -> RecordedSettings {
-        RecordedSettings {
+impl JournaledSettings {
+    fn of(s: &RunSettings) -> JournaledSettings {
+        JournaledSettings {
             mesh: s.trial.mesh.as_deref().map(canonical),
             mesh_scale: s.trial.mesh_scale,
             contacts: s.trial.contacts.name().into(),
@@ -143,7 +143,7 @@ impl RecordedSettings {
     /// Notes the settings given explicitly that contradict the record.
     fn conflicts(
         &self,
-        given: &RecordedSettings,
+        given: &JournaledSettings,
         c: &mut Conflicts,
         explicit: &dyn Fn(&str) -> bool,
     ) {
@@ -254,7 +254,7 @@ impl RunSettings {
             seed: self.seed,
             method: self.method,
             initial: self.initial,
-            settings: Some(serde_json::to_value(RecordedSettings::of(self))?),
+            settings: Some(serde_json::to_value(JournaledSettings::of(self))?),
         })
     }
 
@@ -374,9 +374,10 @@ impl RunSettings {
             return Err(RunnerError::NoJournal { journal });
         }
         let recorded =
-            graspopt_coordinator::recorded_spec(&journal, run).map_err(RunnerError::agent)?;
+            graspopt_coordinator::journaled_spec(&journal, run).map_err(RunnerError::agent)?;
         let Some(recorded) = recorded else {
-            let runs = graspopt_coordinator::recorded_runs(&journal).map_err(RunnerError::agent)?;
+            let runs =
+                graspopt_coordinator::journaled_runs(&journal).map_err(RunnerError::agent)?;
             let run = run.clone();
             if runs.is_empty() {
                 return Err(RunnerError::NotRecorded { run, journal });
@@ -391,9 +392,9 @@ impl RunSettings {
         let recorded_settings = recorded
             .settings
             .as_ref()
-            .and_then(|v| serde_json::from_value::<RecordedSettings>(v.clone()).ok());
+            .and_then(|v| serde_json::from_value::<JournaledSettings>(v.clone()).ok());
         if let Some(r) = &recorded_settings {
-            r.conflicts(&RecordedSettings::of(self), &mut conflicts, explicit);
+            r.conflicts(&JournaledSettings::of(self), &mut conflicts, explicit);
         }
         if explicit("range") {
             let contrary = graspopt_coordinator::range_conflicts(&recorded, &self.trial.ranges);
@@ -431,7 +432,7 @@ impl RunSettings {
 /// Refuses a new run in a results folder whose journal holds other runs: their
 /// `trials.csv`, `trials.json` and `best.svg` would be overwritten.
 fn check_folder_is_free(out: &Path, run: &RunId) -> Result<()> {
-    let others: Vec<String> = graspopt_coordinator::recorded_runs(&out.join("journal.sqlite"))
+    let others: Vec<String> = graspopt_coordinator::journaled_runs(&out.join("journal.sqlite"))
         .map_err(RunnerError::agent)?
         .into_iter()
         .filter(|id| id != run.as_str())

@@ -9,11 +9,10 @@ use graspopt_protocol::{
 };
 use graspopt_quality::forces::Resisting;
 use graspopt_quality::metrics::{Metrics, Value};
-use graspopt_sensing::Reading;
 use graspopt_sim::{ContactPoint, Object, SimError, TrialOutcome, TriangleMesh};
 use graspopt_trial::fingertips::SensorReading;
 use graspopt_trial::forces::GraspForces;
-use graspopt_trial::measured::{MeasuredFinger, MeasuredTrial};
+use graspopt_trial::measured::{self, MeasuredTrial};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// A wire pose as an isometry (the quaternion is renormalised).
@@ -120,7 +119,7 @@ pub fn measured_from_clouds(clouds: &ContactClouds) -> MeasuredTrial {
         fingers: clouds
             .fingers
             .iter()
-            .map(|f| MeasuredFinger {
+            .map(|f| measured::FingerCloud {
                 finger: f.finger.map(|i| i as usize),
                 links: f.links.clone(),
                 points: f.points.iter().map(contact_point).collect(),
@@ -137,7 +136,7 @@ pub fn sensor_reading(w: &FingertipWrench) -> SensorReading {
         link: w.link.clone(),
         sensor_pose: isometry(&w.sensor_pose),
         surface: w.surface,
-        reading: Reading {
+        reading: graspopt_sensing::FingertipWrench {
             force: Vector3::from(w.force),
             torque: Vector3::from(w.torque),
         },
@@ -246,7 +245,7 @@ mod tests {
                 radius: 0.012,
                 base_z: None,
             },
-            reading: Reading {
+            reading: graspopt_sensing::FingertipWrench {
                 force: Vector3::new(0.5, -1.0, -2.0),
                 torque: Vector3::new(1e-3, 2e-3, 0.0),
             },

@@ -15,7 +15,7 @@ use graspopt_sim::ContactModelSettings;
 use graspopt_sim::{Object, ParamKind};
 use graspopt_trial::ScoreSettings;
 use graspopt_trial::fingertips::{
-    FingertipContact, FingertipSettings, fingertip_score, sense, simulate_readings,
+    FingertipContact, FingertipSettings, fingertip_score, sense, simulate_wrenches,
 };
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
@@ -142,7 +142,7 @@ pub fn round_trip(
             let u: Vec<f64> = (0..ev.space.dim()).map(|_| rng.random::<f64>()).collect();
             let params = ev.space.from_unit(&u)?;
             let e = ev.evaluate(&params)?;
-            let tips = simulate_readings(
+            let tips = simulate_wrenches(
                 &e.outcome,
                 ev.hand.as_ref(),
                 &ev.object,

@@ -18,24 +18,24 @@ use rusqlite::Connection;
 
 use crate::error::Result;
 use crate::journal::Journal;
-use crate::types::{ResultOutcome, TrialIssue, TrialResultRecord};
+use crate::types::{ResultOutcome, ResultRow, TrialIssue};
 use crate::writes::{failure_in, issue_in, planner_state_in, result_in};
 
 /// One write of a run's journal (the run is given to [`Journal::record`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Write {
-    /// A trial attempt leased to a worker ([`Journal::record_issue`]).
+    /// A trial attempt leased to a worker ([`Journal::write_issue`]).
     Issue(TrialIssue),
-    /// A trial attempt that failed ([`Journal::record_failure`]).
+    /// A trial attempt that failed ([`Journal::write_failure`]).
     Failure {
         trial_id: u64,
         attempt: u32,
         error: String,
         at_ms: i64,
     },
-    /// A trial's result ([`Journal::record_result`]), boxed: it is larger than the other
+    /// A trial's result ([`Journal::write_result`]), boxed: it is larger than the other
     /// writes (its force analysis) by far.
-    Result(Box<TrialResultRecord>),
+    Result(Box<ResultRow>),
     /// The planner's engine after its last reply ([`Journal::set_planner_state`]).
     PlannerState { engine: Vec<u8>, at_ms: i64 },
 }
@@ -55,7 +55,7 @@ impl Journal {
     /// is the transaction's own (it could not start or commit): then nothing was written.
     /// Otherwise each write has its outcome, in order; a write refused (its error) left
     /// nothing, and the others are committed.
-    pub fn record(&mut self, run_id: &str, writes: &[Write]) -> Result<Vec<Result<Written>>> {
+    pub fn write(&mut self, run_id: &str, writes: &[Write]) -> Result<Vec<Result<Written>>> {
         let mut tx = self.write_tx()?;
         let mut outcomes = Vec::with_capacity(writes.len());
         for write in writes {

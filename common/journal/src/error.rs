@@ -1,6 +1,6 @@
 //! The journal's error type.
 
-use crate::types::TrialState;
+use crate::types::StoredTrialPhase;
 
 /// Everything that can go wrong in the journal. Each variant names the run,
 /// trial or field concerned so that a log line is enough to find the cause.
@@ -53,7 +53,7 @@ pub enum JournalError {
     /// An operation that requires an issued trial named one the run does not know.
     #[error("run {run_id:?} has no trial {trial_id}")]
     UnknownTrial { run_id: String, trial_id: u64 },
-    /// `record_issue` with an attempt number that is not the next one.
+    /// `write_issue` with an attempt number that is not the next one.
     #[error("run {run_id:?} trial {trial_id}: attempt {found} issued, expected attempt {expected}")]
     AttemptMismatch {
         run_id: String,
@@ -61,12 +61,12 @@ pub enum JournalError {
         expected: u32,
         found: u32,
     },
-    /// `record_issue` for a trial that already reached a final state.
+    /// `write_issue` for a trial that already reached a final state.
     #[error("run {run_id:?} trial {trial_id} is already {state:?} and cannot be re-issued")]
     TrialClosed {
         run_id: String,
         trial_id: u64,
-        state: TrialState,
+        state: StoredTrialPhase,
     },
     /// A re-issue whose parameters differ from the trial's stored ones.
     #[error("run {run_id:?} trial {trial_id} re-issued with different parameters")]

@@ -67,7 +67,7 @@ pub fn write_csv(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result
     Ok(())
 }
 
-/// Writes `{"run": RunRecord, "trials": [TrialRow, ...]}` as pretty JSON
+/// Writes `{"run": RunRow, "trials": [TrialRow, ...]}` as pretty JSON
 /// (a [`crate::RunExport`]); an unknown run is [`crate::JournalError::UnknownRun`].
 pub fn write_json(journal: &Journal, run_id: &str, out: &mut dyn Write) -> Result<()> {
     let export = journal.export(run_id)?;

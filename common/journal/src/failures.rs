@@ -44,7 +44,7 @@ impl Journal {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{RunLifecycle, RunRecord, TrialIssue};
+    use crate::{RunRow, StoredRunPhase, TrialIssue};
 
     fn issue(trial_id: u64) -> TrialIssue {
         TrialIssue {
@@ -62,12 +62,12 @@ mod tests {
     #[test]
     fn reasons_are_counted_most_frequent_first() {
         let mut j = Journal::open_in_memory().unwrap();
-        j.create_run(&RunRecord {
+        j.create_run(&RunRow {
             run_id: "r".into(),
             created_ms: 0,
             config_json: "{}".into(),
             param_names: vec!["x".into()],
-            status: RunLifecycle::Running,
+            status: StoredRunPhase::Running,
         })
         .unwrap();
         assert_eq!(j.failure_reasons("r").unwrap(), []);
@@ -75,10 +75,10 @@ mod tests {
         let reasons = ["a", "a", "b", "a", "a hand"];
         for (i, reason) in reasons.iter().enumerate() {
             let id = i as u64 + 1;
-            j.record_issue(&issue(id)).unwrap();
-            assert!(j.record_failure("r", id, 1, reason, 20).unwrap());
+            j.write_issue(&issue(id)).unwrap();
+            assert!(j.write_failure("r", id, 1, reason, 20).unwrap());
         }
-        j.record_issue(&issue(6)).unwrap();
+        j.write_issue(&issue(6)).unwrap();
         let got = j.failure_reasons("r").unwrap();
         let want = [("a", 3), ("a hand", 1), ("b", 1)].map(|(reason, trials)| FailureReason {
             reason: reason.into(),

@@ -9,8 +9,8 @@ use crate::error::{JournalError, Result};
 use crate::rows::{run_from_row, trial_from_row, u64_col};
 use crate::schema;
 use crate::types::{
-    EventRow, ResultOutcome, RunExport, RunLifecycle, RunRecord, StateCounts, TrialIssue,
-    TrialResultRecord, TrialRow, TrialState,
+    EventRow, ResultOutcome, ResultRow, RunExport, RunRow, StateCounts, StoredRunPhase,
+    StoredTrialPhase, TrialIssue, TrialRow,
 };
 use crate::writes::{db_id, failure_in, issue_in, parse_state, planner_state_in, result_in};
 
@@ -143,7 +143,7 @@ impl Journal {
     /// Records a new run. Idempotent when the same run id exists with the same
     /// config (equal text, or equal JSON values) and parameter names; otherwise
     /// [`JournalError::ConfigMismatch`] naming the run, and nothing changes.
-    pub fn create_run(&mut self, run: &RunRecord) -> Result<()> {
+    pub fn create_run(&mut self, run: &RunRow) -> Result<()> {
         let names_json = serde_json::to_string(&run.param_names)?;
         let tx = self.write_tx()?;
         let existing: Option<(String, String)> = tx
@@ -183,7 +183,7 @@ impl Journal {
     }
 
     /// The run, if the journal has it.
-    pub fn run(&self, run_id: &str) -> Result<Option<RunRecord>> {
+    pub fn run(&self, run_id: &str) -> Result<Option<RunRow>> {
         let mut stmt = self.conn.prepare_cached(
             "SELECT run_id, created_ms, config_json, param_names, status FROM runs WHERE run_id = ?1",
         )?;
@@ -191,7 +191,7 @@ impl Journal {
     }
 
     /// All runs, oldest first (ties in insertion order).
-    pub fn runs(&self) -> Result<Vec<RunRecord>> {
+    pub fn runs(&self) -> Result<Vec<RunRow>> {
         let mut stmt = self.conn.prepare_cached(
             "SELECT run_id, created_ms, config_json, param_names, status FROM runs
              ORDER BY created_ms, rowid",
@@ -203,7 +203,12 @@ impl Journal {
     }
 
     /// Sets a run's status; [`JournalError::UnknownRun`] if there is no such run.
-    pub fn set_run_status(&mut self, run_id: &str, status: RunLifecycle, at_ms: i64) -> Result<()> {
+    pub fn set_run_phase(
+        &mut self,
+        run_id: &str,
+        status: StoredRunPhase,
+        at_ms: i64,
+    ) -> Result<()> {
         let tx = self.write_tx()?;
         let n = tx.execute(
             "UPDATE runs SET status = ?2, status_ms = ?3 WHERE run_id = ?1",
@@ -285,7 +290,7 @@ impl Journal {
     /// differs from the run's parameter names; a non-finite parameter; an
     /// attempt that is not the next one; re-issuing a completed or failed
     /// trial; re-issuing with different parameters.
-    pub fn record_issue(&mut self, issue: &TrialIssue) -> Result<()> {
+    pub fn write_issue(&mut self, issue: &TrialIssue) -> Result<()> {
         let tx = self.write_tx()?;
         issue_in(&tx, issue)?;
         tx.commit()?;
@@ -303,7 +308,7 @@ impl Journal {
     ///
     /// A NaN or infinite score or metric is an error naming the field, and
     /// nothing is written.
-    pub fn record_result(&mut self, result: &TrialResultRecord) -> Result<ResultOutcome> {
+    pub fn write_result(&mut self, result: &ResultRow) -> Result<ResultOutcome> {
         let tx = self.write_tx()?;
         let outcome = result_in(&tx, result)?;
         tx.commit()?;
@@ -314,7 +319,7 @@ impl Journal {
     /// `failed`, note = message, worker = the trial's latest worker).
     /// Returns false, writing nothing, when the trial is already completed or
     /// failed, or when the run or trial is unknown.
-    pub fn record_failure(
+    pub fn write_failure(
         &mut self,
         run_id: &str,
         trial_id: u64,
@@ -404,9 +409,9 @@ impl Journal {
         for (state, n) in rows {
             let n = usize::try_from(n).unwrap_or(0);
             match parse_state(&state)? {
-                TrialState::Running => counts.running = n,
-                TrialState::Completed => counts.completed = n,
-                TrialState::Failed => counts.failed = n,
+                StoredTrialPhase::Running => counts.running = n,
+                StoredTrialPhase::Completed => counts.completed = n,
+                StoredTrialPhase::Failed => counts.failed = n,
             }
         }
         Ok(counts)

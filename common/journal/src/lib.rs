@@ -33,6 +33,6 @@ pub use failures::{FailureReason, NO_REASON};
 pub use journal::Journal;
 pub use schema::SCHEMA_VERSION;
 pub use types::{
-    EventRow, ForceAnalysis, MetricValue, MetricValues, ResultOutcome, RunExport, RunLifecycle,
-    RunRecord, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState, event_kind,
+    EventRow, ForceAnalysis, MetricValue, MetricValues, ResultOutcome, ResultRow, RunExport,
+    RunRow, StateCounts, StoredRunPhase, StoredTrialPhase, TrialIssue, TrialRow, event_kind,
 };

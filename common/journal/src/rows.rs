@@ -3,7 +3,7 @@
 use rusqlite::Row;
 use rusqlite::types::Type;
 
-use crate::types::{RunLifecycle, RunRecord, TrialRow, TrialState};
+use crate::types::{RunRow, StoredRunPhase, StoredTrialPhase, TrialRow};
 
 pub(crate) fn conversion_error(
     idx: usize,
@@ -18,14 +18,14 @@ pub(crate) fn u64_col(r: &Row<'_>, idx: usize) -> rusqlite::Result<u64> {
     u64::try_from(v).map_err(|e| conversion_error(idx, Type::Integer, e))
 }
 
-pub(crate) fn run_from_row(r: &Row<'_>) -> rusqlite::Result<RunRecord> {
+pub(crate) fn run_from_row(r: &Row<'_>) -> rusqlite::Result<RunRow> {
     let names: String = r.get(3)?;
     let param_names: Vec<String> =
         serde_json::from_str(&names).map_err(|e| conversion_error(3, Type::Text, e))?;
     let status: String = r.get(4)?;
-    let status = RunLifecycle::parse(&status)
+    let status = StoredRunPhase::parse(&status)
         .ok_or_else(|| conversion_error(4, Type::Text, format!("unknown run status {status:?}")))?;
-    Ok(RunRecord {
+    Ok(RunRow {
         run_id: r.get(0)?,
         created_ms: r.get(1)?,
         config_json: r.get(2)?,
@@ -43,7 +43,7 @@ pub(crate) fn index(r: &Row<'_>, name: &str) -> usize {
 pub(crate) fn trial_from_row(r: &Row<'_>) -> rusqlite::Result<TrialRow> {
     let at = |name| index(r, name);
     let state: String = r.get("state")?;
-    let state = TrialState::parse(&state).ok_or_else(|| {
+    let state = StoredTrialPhase::parse(&state).ok_or_else(|| {
         conversion_error(
             at("state"),
             Type::Text,

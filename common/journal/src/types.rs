@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// One optimisation run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RunRecord {
+pub struct RunRow {
     pub run_id: String,
     /// Creation time, milliseconds since the Unix epoch (the caller's clock).
     pub created_ms: i64,
@@ -12,34 +12,34 @@ pub struct RunRecord {
     pub config_json: String,
     /// Names of the search-space dimensions, in the order of `TrialIssue::params`.
     pub param_names: Vec<String>,
-    pub status: RunLifecycle,
+    pub status: StoredRunPhase,
 }
 
 /// Lifecycle of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum RunLifecycle {
+pub enum StoredRunPhase {
     Running,
     Finished,
     Stopped,
 }
 
-impl RunLifecycle {
+impl StoredRunPhase {
     /// The text stored in the database (the serde name).
     pub fn as_str(self) -> &'static str {
         match self {
-            RunLifecycle::Running => "running",
-            RunLifecycle::Finished => "finished",
-            RunLifecycle::Stopped => "stopped",
+            StoredRunPhase::Running => "running",
+            StoredRunPhase::Finished => "finished",
+            StoredRunPhase::Stopped => "stopped",
         }
     }
 
-    /// Inverse of [`RunLifecycle::as_str`].
-    pub fn parse(s: &str) -> Option<RunLifecycle> {
+    /// Inverse of [`StoredRunPhase::as_str`].
+    pub fn parse(s: &str) -> Option<StoredRunPhase> {
         match s {
-            "running" => Some(RunLifecycle::Running),
-            "finished" => Some(RunLifecycle::Finished),
-            "stopped" => Some(RunLifecycle::Stopped),
+            "running" => Some(StoredRunPhase::Running),
+            "finished" => Some(StoredRunPhase::Finished),
+            "stopped" => Some(StoredRunPhase::Stopped),
             _ => None,
         }
     }
@@ -62,7 +62,7 @@ pub struct TrialIssue {
 
 /// A worker's result for one attempt of a trial.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrialResultRecord {
+pub struct ResultRow {
     pub run_id: String,
     pub trial_id: u64,
     pub attempt: u32,
@@ -86,7 +86,7 @@ pub use graspopt_protocol::{MetricValue, MetricValues};
 /// A trial's contact-force analysis: the result message's own type, stored as JSON.
 pub use graspopt_protocol::ForceAnalysis;
 
-/// What `record_result` did with a result.
+/// What `write_result` did with a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ResultOutcome {
@@ -102,28 +102,28 @@ pub enum ResultOutcome {
 /// State of a trial, stored as its snake_case name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum TrialState {
+pub enum StoredTrialPhase {
     Running,
     Completed,
     Failed,
 }
 
-impl TrialState {
+impl StoredTrialPhase {
     /// The text stored in the database (the serde name).
     pub fn as_str(self) -> &'static str {
         match self {
-            TrialState::Running => "running",
-            TrialState::Completed => "completed",
-            TrialState::Failed => "failed",
+            StoredTrialPhase::Running => "running",
+            StoredTrialPhase::Completed => "completed",
+            StoredTrialPhase::Failed => "failed",
         }
     }
 
-    /// Inverse of [`TrialState::as_str`].
-    pub fn parse(s: &str) -> Option<TrialState> {
+    /// Inverse of [`StoredTrialPhase::as_str`].
+    pub fn parse(s: &str) -> Option<StoredTrialPhase> {
         match s {
-            "running" => Some(TrialState::Running),
-            "completed" => Some(TrialState::Completed),
-            "failed" => Some(TrialState::Failed),
+            "running" => Some(StoredTrialPhase::Running),
+            "completed" => Some(StoredTrialPhase::Completed),
+            "failed" => Some(StoredTrialPhase::Failed),
             _ => None,
         }
     }
@@ -134,7 +134,7 @@ impl TrialState {
 pub struct TrialRow {
     pub run_id: String,
     pub trial_id: u64,
-    pub state: TrialState,
+    pub state: StoredTrialPhase,
     /// Number of times the trial was issued (1 + re-issues).
     pub attempts: u32,
     pub params: Vec<f64>,
@@ -202,6 +202,6 @@ pub struct StateCounts {
 /// A whole run as exported by [`crate::export::write_json`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunExport {
-    pub run: RunRecord,
+    pub run: RunRow,
     pub trials: Vec<TrialRow>,
 }

@@ -5,7 +5,7 @@ use rusqlite::types::Value as Sql;
 use rusqlite::{Connection, OptionalExtension, params};
 
 use crate::error::{JournalError, Result};
-use crate::types::{ResultOutcome, TrialIssue, TrialResultRecord, TrialState, event_kind};
+use crate::types::{ResultOutcome, ResultRow, StoredTrialPhase, TrialIssue, event_kind};
 
 /// Completes a trial with its result: the fixed columns, then every metric's column
 /// ([`crate::metrics::assignments`]) from parameter 12 on.
@@ -118,7 +118,7 @@ fn reissue(
     stored_params: &str,
 ) -> Result<()> {
     let state = parse_state(state)?;
-    if state != TrialState::Running {
+    if state != StoredTrialPhase::Running {
         return Err(JournalError::TrialClosed {
             run_id: issue.run_id.clone(),
             trial_id: issue.trial_id,
@@ -169,7 +169,7 @@ fn issue_event(tx: &Connection, issue: &TrialIssue, id: i64, kind: &str) -> Resu
     )
 }
 
-pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<ResultOutcome> {
+pub(crate) fn result_in(tx: &Connection, result: &ResultRow) -> Result<ResultOutcome> {
     check_finite(|| "score".to_string(), result.score)?;
     if let Some(m) = &result.metrics {
         crate::metrics::check_finite(m)?;
@@ -194,7 +194,7 @@ pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<R
         return Ok(ResultOutcome::UnknownTrial);
     };
     match parse_state(&state)? {
-        TrialState::Completed | TrialState::Failed => {
+        StoredTrialPhase::Completed | StoredTrialPhase::Failed => {
             let note = match result_attempt {
                 Some(a) => format!("trial already completed by attempt {a}"),
                 None => "trial already failed".to_string(),
@@ -202,7 +202,7 @@ pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<R
             result_event(tx, result, id, event_kind::DUPLICATE, Some(&note))?;
             Ok(ResultOutcome::Duplicate)
         }
-        TrialState::Running => {
+        StoredTrialPhase::Running => {
             complete(tx, result, id, attempts)?;
             Ok(ResultOutcome::Accepted)
         }
@@ -211,7 +211,7 @@ pub(crate) fn result_in(tx: &Connection, result: &TrialResultRecord) -> Result<R
 
 /// Completes a running trial with `result` (its latest attempt is `attempts`): the result's
 /// columns and the `result` event, whose note says when the attempt is not the latest.
-fn complete(tx: &Connection, result: &TrialResultRecord, id: i64, attempts: u32) -> Result<()> {
+fn complete(tx: &Connection, result: &ResultRow, id: i64, attempts: u32) -> Result<()> {
     let note = if result.attempt < attempts {
         Some(format!(
             "late result from attempt {} (latest attempt {attempts})",
@@ -251,7 +251,7 @@ fn complete(tx: &Connection, result: &TrialResultRecord, id: i64, attempts: u32)
 /// The `result` or `duplicate` event of `result`.
 fn result_event(
     tx: &Connection,
-    result: &TrialResultRecord,
+    result: &ResultRow,
     id: i64,
     kind: &str,
     note: Option<&str>,
@@ -286,7 +286,7 @@ pub(crate) fn failure_in(
     let Some((state, worker)) = existing else {
         return Ok(false);
     };
-    if parse_state(&state)? != TrialState::Running {
+    if parse_state(&state)? != StoredTrialPhase::Running {
         return Ok(false);
     }
     tx.prepare_cached(
@@ -322,8 +322,8 @@ fn same_bits(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
-pub(crate) fn parse_state(s: &str) -> Result<TrialState> {
-    TrialState::parse(s)
+pub(crate) fn parse_state(s: &str) -> Result<StoredTrialPhase> {
+    StoredTrialPhase::parse(s)
         .ok_or_else(|| JournalError::Schema(format!("unknown trial state {s:?} in the database")))
 }
 

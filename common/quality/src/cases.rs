@@ -51,7 +51,7 @@ pub struct Case {
 /// The contact model of a case's contacts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum ModelName {
+pub enum FrictionModelName {
     Frictionless,
     PointFriction,
     SoftFinger,
@@ -62,7 +62,7 @@ pub enum ModelName {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CaseParams {
-    pub model: ModelName,
+    pub model: FrictionModelName,
     pub mu: Option<f64>,
     pub edges: Option<usize>,
     pub gamma: Option<f64>,
@@ -97,19 +97,19 @@ impl CaseParams {
     /// The grasp model these parameters describe, validated.
     pub fn model(&self) -> Result<GraspModel, CaseError> {
         let name = match self.model {
-            ModelName::Frictionless => "frictionless",
-            ModelName::PointFriction => "point_friction",
-            ModelName::SoftFinger => "soft_finger",
+            FrictionModelName::Frictionless => "frictionless",
+            FrictionModelName::PointFriction => "point_friction",
+            FrictionModelName::SoftFinger => "soft_finger",
         };
         let need = |v: Option<f64>, key| v.ok_or(CaseError::Missing(key, name));
         let edges = || self.edges.ok_or(CaseError::Missing("edges", name));
         let contact = match self.model {
-            ModelName::Frictionless => FrictionModel::Frictionless,
-            ModelName::PointFriction => FrictionModel::PointFriction {
+            FrictionModelName::Frictionless => FrictionModel::Frictionless,
+            FrictionModelName::PointFriction => FrictionModel::PointFriction {
                 mu: need(self.mu, "mu")?,
                 edges: edges()?,
             },
-            ModelName::SoftFinger => FrictionModel::SoftFinger {
+            FrictionModelName::SoftFinger => FrictionModel::SoftFinger {
                 mu: need(self.mu, "mu")?,
                 edges: edges()?,
                 gamma: need(self.gamma, "gamma")?,

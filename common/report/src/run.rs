@@ -128,13 +128,13 @@ fn best_title(run: &str, best: &TrialRow, params: &[ParamKind]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use graspopt_journal::{MetricValue, MetricValues, TrialState};
+    use graspopt_journal::{MetricValue, MetricValues, StoredTrialPhase};
 
     fn trial(trial_id: u64, score: f64) -> TrialRow {
         TrialRow {
             run_id: "run".into(),
             trial_id,
-            state: TrialState::Completed,
+            state: StoredTrialPhase::Completed,
             attempts: 1,
             params: vec![0.01, -0.02],
             worker: "hand-1".into(),

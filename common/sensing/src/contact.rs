@@ -1,5 +1,5 @@
 //! Readings, settings, sensed contacts and the solver: [`locate`] (a reading to a contact)
-//! and [`reading_of`] (a contact to a reading).
+//! and [`wrench_of`] (a contact to a reading).
 
 use nalgebra::{Point3, Unit, Vector3};
 use serde::{Deserialize, Serialize};
@@ -11,14 +11,14 @@ use crate::surface::{Domain, FingertipSurface, Piece};
 /// What the sensor measures: the wrench the object applies to the fingertip, in the sensor
 /// frame, the torque taken about the sensor frame's origin (N, N m).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Reading {
+pub struct FingertipWrench {
     pub force: Vector3<f64>,
     pub torque: Vector3<f64>,
 }
 
 /// The largest force (N) or torque (N m) component a reading may have: far beyond any
 /// fingertip sensor's range, far below overflow.
-pub const MAX_READING: f64 = 1.0e6;
+pub const MAX_WRENCH: f64 = 1.0e6;
 
 /// The smallest force (N) taken as a contact whatever the threshold: below it the
 /// force's direction is noise.
@@ -27,15 +27,15 @@ pub const MIN_FORCE: f64 = 1.0e-9;
 const FORCE: [&str; 3] = ["force[0]", "force[1]", "force[2]"];
 const TORQUE: [&str; 3] = ["torque[0]", "torque[1]", "torque[2]"];
 
-impl Reading {
-    /// Checks that every component is finite and at most [`MAX_READING`] in absolute
+impl FingertipWrench {
+    /// Checks that every component is finite and at most [`MAX_WRENCH`] in absolute
     /// value; the error names it.
     pub fn validate(&self) -> Result<(), SensingError> {
         let names = FORCE.iter().chain(TORQUE.iter());
         let values = self.force.iter().chain(self.torque.iter());
         for (name, value) in names.zip(values) {
             check(name, *value, "at most 1e6 in absolute value", |v| {
-                v.abs() <= MAX_READING
+                v.abs() <= MAX_WRENCH
             })?;
         }
         Ok(())
@@ -233,15 +233,15 @@ struct Candidate {
 /// The reading produced by the fingertip applying `force` and the moment `torsion` about
 /// the outward normal at surface point `point` (the forward model: the sensor measures the
 /// opposite wrench, force -`force` and torque `point` x (-`force`) - `torsion` n).
-pub fn reading_of(
+pub fn wrench_of(
     surface: &FingertipSurface,
     point: &Point3<f64>,
     force: &Vector3<f64>,
     torsion: f64,
-) -> Reading {
+) -> FingertipWrench {
     let n = surface.outward_normal(point);
     let on_tip = -force;
-    Reading {
+    FingertipWrench {
         force: on_tip,
         torque: point.coords.cross(&on_tip) - n.into_inner() * torsion,
     }
@@ -251,7 +251,7 @@ pub fn reading_of(
 /// documentation for the method.
 pub fn locate(
     surface: &FingertipSurface,
-    reading: &Reading,
+    reading: &FingertipWrench,
     settings: &SensingSettings,
 ) -> Result<SensedContact, NoContact> {
     let contact = solve(surface, reading, settings)?;
@@ -271,7 +271,7 @@ pub fn locate(
 /// [`locate`] but for the torsion limit.
 fn solve(
     surface: &FingertipSurface,
-    reading: &Reading,
+    reading: &FingertipWrench,
     settings: &SensingSettings,
 ) -> Result<SensedContact, NoContact> {
     surface.validate()?;
@@ -319,7 +319,7 @@ fn usable(base: Option<f64>, tol: f64, p: &Vector3<f64>) -> bool {
 /// The reading's force and the torque to explain: above the force threshold; for a point
 /// contact, with no more torsion than the pitch tolerance allows, and that torsion removed.
 fn applied_wrench(
-    reading: &Reading,
+    reading: &FingertipWrench,
     settings: &SensingSettings,
 ) -> Result<(Vector3<f64>, Vector3<f64>), NoContact> {
     let f = reading.force;

@@ -2,7 +2,7 @@
 //! from the wrench its force/torque sensor measures (A. Bicchi, J. K. Salisbury and D. L.
 //! Brock, "Contact sensing from force measurements", The International Journal of
 //! Robotics Research 12(3), 1993). No bus, no files: [`locate`] turns one reading into a
-//! [`SensedContact`] or a [`NoContact`] that says why there is none; [`reading_of`] is the
+//! [`SensedContact`] or a [`NoContact`] that says why there is none; [`wrench_of`] is the
 //! forward model; [`SensorNoise`] simulates a Nano17's resolution.
 //!
 //! # Conventions
@@ -10,7 +10,7 @@
 //! - Everything is in the **sensor frame**, in metres, newtons and newton metres. The
 //!   fingertip's [`FingertipSurface`] is given in that frame; moving the contact into the
 //!   world with the sensor's pose is the caller's business.
-//! - A [`Reading`] is the wrench **the object applies to the fingertip**: force F, and
+//! - A [`FingertipWrench`] is the wrench **the object applies to the fingertip**: force F, and
 //!   torque τ about the sensor frame's origin. (A driver whose sensor reports the
 //!   opposite wrench negates both.)
 //! - A contact at surface point p has the fingertip's **outward** normal n(p), which
@@ -97,8 +97,8 @@ mod noise;
 mod surface;
 
 pub use contact::{
-    ContactKind, MAX_READING, MIN_FORCE, NoContact, Reading, SensedContact, SensingSettings,
-    locate, reading_of,
+    ContactKind, FingertipWrench, MAX_WRENCH, MIN_FORCE, NoContact, SensedContact, SensingSettings,
+    locate, wrench_of,
 };
 pub use error::SensingError;
 pub use noise::SensorNoise;

@@ -5,7 +5,7 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
-use crate::contact::Reading;
+use crate::contact::FingertipWrench;
 use crate::error::{SensingError, check};
 
 /// Force/torque sensor noise: each component gets a zero-mean Gaussian error whose
@@ -64,8 +64,12 @@ impl SensorNoise {
     /// then torque x, y, z) and becomes q * round((x + q e) / q). A component whose
     /// resolution is 0 (or not a finite positive number) is returned unchanged and draws
     /// nothing.
-    pub fn apply<R: rand::Rng + ?Sized>(&self, r: &Reading, rng: &mut R) -> Reading {
-        Reading {
+    pub fn apply<R: rand::Rng + ?Sized>(
+        &self,
+        r: &FingertipWrench,
+        rng: &mut R,
+    ) -> FingertipWrench {
+        FingertipWrench {
             force: perturb(&r.force, self.force_resolution, rng),
             torque: perturb(&r.torque, self.torque_resolution, rng),
         }

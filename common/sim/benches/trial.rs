@@ -5,11 +5,11 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use graspopt_sim::pose::reference_pose;
-use graspopt_sim::{BarrettHand, ContactModelSettings, Object, run_trial};
+use graspopt_sim::{BarrettOracle, ContactModelSettings, Object, run_trial};
 
 fn trial(c: &mut Criterion) {
     let mug = Object::by_name("mug").expect("built-in mug");
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let pose = reference_pose(&mug);
     let settings = ContactModelSettings::default();
     let check = run_trial(&mug, &hand, &pose, &settings).expect("trial");

@@ -15,11 +15,11 @@
 //!
 //! Typical use:
 //! ```
-//! use graspopt_sim::{BarrettHand, ContactModel, ContactModelSettings, Object, TrialSpace, run_trial};
+//! use graspopt_sim::{BarrettOracle, ContactModel, ContactModelSettings, Object, TrialSpace, run_trial};
 //! let mug = Object::by_name("mug")?;
 //! let space = TrialSpace::approach_vertical_2d(&mug);
 //! let palm = space.palm_pose(&[0.0, 0.0])?;
-//! let out = run_trial(&mug, &BarrettHand::default(), &palm, &ContactModelSettings::default())?;
+//! let out = run_trial(&mug, &BarrettOracle::default(), &palm, &ContactModelSettings::default())?;
 //! assert_eq!(out.fingers_in_contact(), 3);
 //! let contacts = out.contacts(ContactModel::Surface, true); // positions + inward unit normals
 //! assert!(!contacts.is_empty());
@@ -44,8 +44,8 @@ pub mod trial;
 pub use contact::{ContactCloud, ContactModel, ContactModelSettings, ContactPoint, NoiseSettings};
 pub use error::{HullError, SimError};
 pub use hand::{
-    BarrettHand, BuiltinHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec,
-    ParallelJawGripper, UrdfHand, builtin_hand, builtin_hands, hand_by_name, hand_name, hand_names,
+    BarrettOracle, BuiltinHand, CONTACT_TOLERANCE, Grasp, Hand, LinkShape, LinkSpec,
+    ParallelJawOracle, UrdfHand, builtin_hand, builtin_hands, hand_by_name, hand_name, hand_names,
     same_hand,
 };
 pub use mesh::TriangleMesh;

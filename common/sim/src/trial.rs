@@ -166,8 +166,8 @@ mod tests {
     fn trial_types_can_be_shared_across_threads() {
         fn check<T: Send + Sync>() {}
         check::<Object>();
-        check::<crate::hand::BarrettHand>();
-        check::<crate::hand::ParallelJawGripper>();
+        check::<crate::hand::BarrettOracle>();
+        check::<crate::hand::ParallelJawOracle>();
         check::<Box<dyn Hand>>();
         check::<TrialOutcome>();
         check::<ContactModelSettings>();

@@ -3,7 +3,7 @@
 //! graspopt-trial's tests, where its grasp is scored).
 
 use graspopt_sim::hand::urdf::{HandDescription, HandSettings};
-use graspopt_sim::hand::{BarrettHand, Hand, ParallelJawGripper, UrdfHand};
+use graspopt_sim::hand::{BarrettOracle, Hand, ParallelJawOracle, UrdfHand};
 use graspopt_sim::pose::{TrialSpace, reference_pose};
 use graspopt_sim::{ContactModel, ContactModelSettings, Object, SimError, TrialOutcome, run_trial};
 use nalgebra::Isometry3;
@@ -93,7 +93,7 @@ fn assert_same_trial(
 
 #[test]
 fn the_bh8_urdf_gives_the_oracle_s_trials_on_the_seven_objects() {
-    let (oracle, urdf) = (BarrettHand::default(), bh8());
+    let (oracle, urdf) = (BarrettOracle::default(), bh8());
     assert_eq!(urdf.name(), "barrett");
     assert_eq!(urdf.finger_count(), 3);
     let names: Vec<String> = urdf.links().iter().map(|l| l.name.clone()).collect();
@@ -114,7 +114,7 @@ fn the_bh8_urdf_gives_the_oracle_s_trials_on_the_seven_objects() {
 
 #[test]
 fn the_parallel_jaw_urdf_gives_the_oracle_s_trials() {
-    let oracle = ParallelJawGripper::default();
+    let oracle = ParallelJawOracle::default();
     let urdf = UrdfHand::from_strs("parallel_jaw.urdf", JAW_URDF, None, None).unwrap();
     assert_eq!(urdf.finger_count(), 2);
     for name in OBJECTS {

@@ -45,7 +45,7 @@ fn bench(c: &mut Criterion) {
     let object = Object::by_name("mug").expect("mug");
     let oracle = Evaluator::new(
         object,
-        Box::new(graspopt_sim::BarrettHand::default()),
+        Box::new(graspopt_sim::BarrettOracle::default()),
         space,
     );
     c.bench_function(

@@ -11,7 +11,7 @@
 //! force closure changes from one point to the next.
 
 use graspopt_sim::contact::DEFAULT_RESOLUTION;
-use graspopt_sim::{BarrettHand, Object, TrialSpace};
+use graspopt_sim::{BarrettOracle, Object, TrialSpace};
 use graspopt_trial::Evaluator;
 use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid};
 
@@ -22,7 +22,7 @@ fn scan(object: &str, space_2d: bool, steps: &[usize], resolution: f64) -> Vec<S
     } else {
         TrialSpace::approach_1d(&object)
     };
-    let mut ev = Evaluator::new(object, Box::new(BarrettHand::default()), space);
+    let mut ev = Evaluator::new(object, Box::new(BarrettOracle::default()), space);
     ev.contacts.cloud.resolution = resolution;
     let axes = grid_axes(&ev.space.bounds(), steps);
     scan_grid(&ev, &axes, 0, &|_| {}).expect("the scan runs")

@@ -24,8 +24,8 @@
 use graspopt_quality::forces::{ContactForces, Resisting};
 use graspopt_quality::{Contact, FrictionModel};
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, NoContact, Reading, SensingSettings, SensorNoise, locate,
-    reading_of,
+    ContactKind, FingertipSurface, FingertipWrench, NoContact, SensingSettings, SensorNoise,
+    locate, wrench_of,
 };
 use graspopt_sim::{ContactModel, Hand, LinkShape, Object, TrialOutcome};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -151,7 +151,7 @@ pub struct SensorReading {
     /// The fingertip surface in the sensor frame.
     pub surface: FingertipSurface,
     /// The wrench on the fingertip, sensor frame.
-    pub reading: Reading,
+    pub reading: FingertipWrench,
 }
 
 /// A simulated fingertip: its sensor reading and the contact it was made from.
@@ -243,7 +243,7 @@ fn with_grip(
 
 /// The sensor readings of the touching fingertips of a simulated trial (see the module
 /// documentation), with noise from `rng`.
-pub fn simulate_readings<R: rand::Rng + ?Sized>(
+pub fn simulate_wrenches<R: rand::Rng + ?Sized>(
     outcome: &TrialOutcome,
     hand: &dyn Hand,
     object: &Object,
@@ -388,7 +388,7 @@ fn sensed<R: rand::Rng + ?Sized>(
         base_z: None,
     };
     let inverse = sensor_pose.inverse();
-    let exact = reading_of(
+    let exact = wrench_of(
         &surface,
         &(inverse * point),
         &(inverse * truth.force),
@@ -410,12 +410,12 @@ fn sensed<R: rand::Rng + ?Sized>(
 /// The mean of `samples` noisy samples of `exact` (one sample when `samples` is 0 or 1).
 fn sample_mean<R: rand::Rng + ?Sized>(
     noise: &SensorNoise,
-    exact: &Reading,
+    exact: &FingertipWrench,
     samples: u32,
     rng: &mut R,
-) -> Reading {
+) -> FingertipWrench {
     let n = samples.max(1);
-    let mut sum = Reading {
+    let mut sum = FingertipWrench {
         force: Vector3::zeros(),
         torque: Vector3::zeros(),
     };
@@ -424,7 +424,7 @@ fn sample_mean<R: rand::Rng + ?Sized>(
         sum.force += r.force;
         sum.torque += r.torque;
     }
-    Reading {
+    FingertipWrench {
         force: sum.force / f64::from(n),
         torque: sum.torque / f64::from(n),
     }

@@ -14,7 +14,7 @@ use crate::score::{ScoreSettings, TrialScore, closest_gap, score_outcome};
 
 /// One finger's raw cloud as measured (`finger: None` for the palm).
 #[derive(Debug, Clone, PartialEq)]
-pub struct MeasuredFinger {
+pub struct FingerCloud {
     pub finger: Option<usize>,
     pub links: Vec<String>,
     pub points: Vec<ContactPoint>,
@@ -27,7 +27,7 @@ pub struct MeasuredTrial {
     /// The palm pose reached (world).
     pub palm_pose: Isometry3<f64>,
     /// Fingers in order, then the palm.
-    pub fingers: Vec<MeasuredFinger>,
+    pub fingers: Vec<FingerCloud>,
     /// Smallest link-object distance when nothing touches.
     pub min_gap: Option<f64>,
 }
@@ -35,7 +35,7 @@ pub struct MeasuredTrial {
 impl MeasuredTrial {
     /// The measurement of a simulated trial (its raw clouds only).
     pub fn from_outcome(outcome: &TrialOutcome) -> MeasuredTrial {
-        let finger = |f: &FingerOutcome| MeasuredFinger {
+        let finger = |f: &FingerOutcome| FingerCloud {
             finger: f.finger,
             links: f.links.clone(),
             points: f.cloud.points.clone(),
@@ -66,7 +66,7 @@ impl MeasuredTrial {
             palm_pose,
             fingers: contacts
                 .iter()
-                .map(|(finger, link, c)| MeasuredFinger {
+                .map(|(finger, link, c)| FingerCloud {
                     finger: Some(*finger),
                     links: vec![link.clone()],
                     points: vec![ContactPoint {
@@ -82,7 +82,7 @@ impl MeasuredTrial {
 
     /// Rebuilds a trial outcome on `object`: contact models from the raw clouds.
     pub fn to_outcome(&self, object: &Object, settings: &ContactModelSettings) -> TrialOutcome {
-        let model = |m: &MeasuredFinger| {
+        let model = |m: &FingerCloud| {
             let cloud = ContactCloud {
                 points: m.points.clone(),
             };

@@ -41,7 +41,7 @@ pub use graspopt_journal::Write;
 /// only ever comes earlier, never a command before its issue.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action {
-    Record(Write),
+    Write(Write),
     /// Sends a trial command to a worker, in the encoding it asked for.
     Send {
         worker: String,

@@ -130,7 +130,7 @@ impl Coordinator {
             return false;
         }
         if let Some(engine) = reply.engine_state {
-            out.push(Action::Record(Write::PlannerState {
+            out.push(Action::Write(Write::PlannerState {
                 engine: engine.clone(),
                 at_ms: now,
             }));

@@ -106,7 +106,7 @@ fn asked(actions: &[Action]) -> SuggestRequest {
 fn issued(actions: &[Action]) -> Vec<(u64, u32, String, Option<String>)> {
     let mut out = Vec::new();
     for (i, a) in actions.iter().enumerate() {
-        if let Action::Record(Write::Issue(issue)) = a {
+        if let Action::Write(Write::Issue(issue)) = a {
             let Some(Action::Send {
                 worker, command, ..
             }) = actions.get(i + 1)
@@ -135,7 +135,7 @@ fn records(actions: &[Action]) -> Vec<&Write> {
     actions
         .iter()
         .filter_map(|a| match a {
-            Action::Record(w) => Some(w),
+            Action::Write(w) => Some(w),
             _ => None,
         })
         .collect()
@@ -149,7 +149,7 @@ fn an_expired_lease_re_issues_the_trial_once_the_silent_worker_is_freed() {
     let actions = on_reply(&mut c, Ok(reply(&request, vec![vec![0.01]])), 10);
     assert_eq!(
         actions[0],
-        Action::Record(Write::PlannerState {
+        Action::Write(Write::PlannerState {
             engine: vec![7],
             at_ms: 10
         })
@@ -201,7 +201,7 @@ fn a_reply_s_issues_are_one_batch_before_its_commands() {
         })
         .collect();
     assert_eq!(sent, issues);
-    assert!(!rest.iter().any(|a| matches!(a, Action::Record(_))));
+    assert!(!rest.iter().any(|a| matches!(a, Action::Write(_))));
 }
 
 /// A planner's point outside the trial space (or not finite) is counted and left out;

@@ -1,7 +1,7 @@
 //! The core's trials: leasing queued trials to idle workers, expiring leases, and
 //! accepting each trial's result once.
 
-use graspopt_journal::{TrialIssue, TrialResultRecord};
+use graspopt_journal::{ResultRow, TrialIssue};
 use graspopt_protocol::{Encoding, RunPhase, TrialCommand, TrialResult};
 use graspopt_sim::TrialSpace;
 
@@ -38,7 +38,7 @@ impl Coordinator {
                 reason,
             };
             let send = self.command(space, &issue)?;
-            out.push(Action::Record(Write::Issue(issue)));
+            out.push(Action::Write(Write::Issue(issue)));
             out.push(send);
         }
         Ok(out)
@@ -94,7 +94,7 @@ impl Coordinator {
                 )
             });
         if first {
-            out.push(Action::Record(match &result.error {
+            out.push(Action::Write(match &result.error {
                 Some(error) => Write::Failure {
                     trial_id: result.trial_id,
                     attempt: result.attempt,
@@ -132,8 +132,8 @@ fn log_disposition(result: &TrialResult, disposition: Disposition) {
 }
 
 /// A result as the journal records it.
-pub(crate) fn journal_result(r: &TrialResult, at_ms: i64) -> TrialResultRecord {
-    TrialResultRecord {
+pub(crate) fn journal_result(r: &TrialResult, at_ms: i64) -> ResultRow {
+    ResultRow {
         run_id: r.run_id.as_str().to_string(),
         trial_id: r.trial_id,
         attempt: r.attempt,

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use graspopt_bus::now_ms;
-use graspopt_journal::{Journal, RunLifecycle, RunRecord, TrialState, event_kind};
+use graspopt_journal::{Journal, RunRow, StoredRunPhase, StoredTrialPhase, event_kind};
 use graspopt_protocol::RunId;
 
 use super::resume::read_spec;
@@ -53,12 +53,12 @@ pub fn open_run(
                     "coordinator: run {run:?} is not in {place} yet: --resume starts it"
                 );
             }
-            journal.create_run(&RunRecord {
+            journal.create_run(&RunRow {
                 run_id: run.as_str().to_string(),
                 created_ms: now_ms(),
                 config_json: serde_json::to_string(spec)?,
                 param_names: param_names(spec),
-                status: RunLifecycle::Running,
+                status: StoredRunPhase::Running,
             })?;
             spec.clone()
         }
@@ -73,7 +73,7 @@ fn continue_run(
     journal: &mut Journal,
     run: &RunId,
     spec: &RunSpec,
-    record: &RunRecord,
+    record: &RunRow,
 ) -> Result<RunSpec, CoordinatorError> {
     let recorded = read_spec(run, record)?;
     // A resumed run keeps its record; only its budget may grow (see `reconcile`).
@@ -92,8 +92,8 @@ fn continue_run(
     } else {
         recorded
     };
-    if record.status != RunLifecycle::Running {
-        journal.set_run_status(run.as_str(), RunLifecycle::Running, now_ms())?;
+    if record.status != StoredRunPhase::Running {
+        journal.set_run_phase(run.as_str(), StoredRunPhase::Running, now_ms())?;
     }
     Ok(spec)
 }
@@ -133,13 +133,13 @@ fn rebuild_state(
     });
     for row in &rows {
         let phase = match row.state {
-            TrialState::Completed => TrialPhase::Completed {
+            StoredTrialPhase::Completed => TrialPhase::Completed {
                 score: row.score.unwrap_or(f64::NAN),
             },
-            TrialState::Failed => TrialPhase::Failed {
+            StoredTrialPhase::Failed => TrialPhase::Failed {
                 error: row.error.clone().unwrap_or_default(),
             },
-            TrialState::Running => TrialPhase::Queued {
+            StoredTrialPhase::Running => TrialPhase::Queued {
                 reason: Some("coordinator restarted".into()),
             },
         };
@@ -150,7 +150,7 @@ fn rebuild_state(
             phase,
         };
         state.restore_trial(row.trial_id, trial);
-        if let (TrialState::Completed, Some(score)) = (&row.state, row.score) {
+        if let (StoredTrialPhase::Completed, Some(score)) = (&row.state, row.score) {
             state.observe(
                 row.trial_id,
                 row.params.clone(),

@@ -18,7 +18,7 @@ mod standalone;
 pub use journal::open_run;
 pub(crate) use resume::open_journal;
 pub use resume::{
-    Conflicts, quoted_runs, range_conflicts, reconcile, recorded_runs, recorded_spec,
+    Conflicts, journaled_runs, journaled_spec, quoted_runs, range_conflicts, reconcile,
     resume_conflicts, sole_run,
 };
 pub use standalone::{MAX_TRIALS, check_trials, standalone_run};

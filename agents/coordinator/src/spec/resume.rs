@@ -1,7 +1,7 @@
 //! Resuming a run: its recorded spec and runs, the flags given again that contradict the
 //! record, and the budget a resumed run may raise.
 
-use graspopt_journal::{Journal, RunRecord};
+use graspopt_journal::{Journal, RunRow};
 use graspopt_protocol::RunId;
 use graspopt_sim::ParamSpec;
 
@@ -43,7 +43,7 @@ pub fn range_conflicts(recorded: &RunSpec, ranges: &[ParamSpec]) -> Vec<String> 
 }
 
 /// The run's recorded spec in the journal at `path`, if the file and the run exist.
-pub fn recorded_spec(
+pub fn journaled_spec(
     path: &std::path::Path,
     run: &RunId,
 ) -> Result<Option<RunSpec>, CoordinatorError> {
@@ -66,7 +66,7 @@ pub(crate) fn open_journal(path: &std::path::Path) -> Result<Journal, Coordinato
 }
 
 /// The spec recorded with the run of `record`.
-pub(super) fn read_spec(run: &RunId, record: &RunRecord) -> Result<RunSpec, CoordinatorError> {
+pub(super) fn read_spec(run: &RunId, record: &RunRow) -> Result<RunSpec, CoordinatorError> {
     serde_json::from_str::<RunSpec>(&record.config_json).map_err(|source| {
         CoordinatorError::UnreadableSpec {
             run: run.clone(),
@@ -76,7 +76,7 @@ pub(super) fn read_spec(run: &RunId, record: &RunRecord) -> Result<RunSpec, Coor
 }
 
 /// The run ids the journal at `path` holds, oldest first (none if there is no such file).
-pub fn recorded_runs(path: &std::path::Path) -> Result<Vec<String>, CoordinatorError> {
+pub fn journaled_runs(path: &std::path::Path) -> Result<Vec<String>, CoordinatorError> {
     if !path.exists() {
         return Ok(Vec::new());
     }
@@ -96,7 +96,7 @@ pub fn quoted_runs(ids: &[String]) -> String {
 /// (`None` when there is no such file or it holds no run). A journal of several runs is an
 /// error that lists them.
 pub fn sole_run(path: &std::path::Path) -> Result<Option<RunId>, CoordinatorError> {
-    let runs = recorded_runs(path)?;
+    let runs = journaled_runs(path)?;
     match runs.as_slice() {
         [] => Ok(None),
         [one] => Ok(Some(RunId::new(one)?)),

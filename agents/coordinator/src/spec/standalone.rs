@@ -4,7 +4,7 @@
 use graspopt_protocol::RunId;
 use graspopt_sim::{Object, ParamSpec, TrialSpace};
 
-use super::resume::{range_conflicts, reconcile, recorded_spec, resume_conflicts, sole_run};
+use super::resume::{journaled_spec, range_conflicts, reconcile, resume_conflicts, sole_run};
 use super::{RunSpec, bounds_of};
 use crate::error::CoordinatorError;
 
@@ -36,7 +36,7 @@ pub fn standalone_run(
     }
     let journal = config.journal_path(&run_id);
     let recorded = if resume {
-        recorded_spec(&journal, &run_id)?
+        journaled_spec(&journal, &run_id)?
     } else {
         None
     };

@@ -1,4 +1,4 @@
-use graspopt_journal::{Journal, RunLifecycle, TrialIssue};
+use graspopt_journal::{Journal, StoredRunPhase, TrialIssue};
 use graspopt_protocol::{RunId, TrialResult};
 use graspopt_sim::Object;
 
@@ -65,13 +65,13 @@ fn open_run_raises_a_finished_runs_budget() {
     let (started, _) = open_run(&mut journal, &run, &spec(5), true).unwrap();
     assert_eq!(started.trials, 5);
     journal
-        .set_run_status("r", RunLifecycle::Finished, 10)
+        .set_run_phase("r", StoredRunPhase::Finished, 10)
         .unwrap();
     let (resumed, state) = open_run(&mut journal, &run, &spec(8), true).unwrap();
     assert_eq!(resumed.trials, 8);
     assert!(!state.finished());
     let record = journal.run("r").unwrap().unwrap();
-    assert_eq!(record.status, RunLifecycle::Running);
+    assert_eq!(record.status, StoredRunPhase::Running);
     let stored: RunSpec = serde_json::from_str(&record.config_json).unwrap();
     assert_eq!(stored.trials, 8);
     // The same budget again (or less) leaves the record as it is.
@@ -89,7 +89,7 @@ fn a_resumed_run_keeps_the_order_results_were_recorded_in() {
     open_run(&mut journal, &run, &spec, false).unwrap();
     for id in 1..=4 {
         journal
-            .record_issue(&TrialIssue {
+            .write_issue(&TrialIssue {
                 params: vec![0.01 * id as f64],
                 ..issue(id)
             })
@@ -99,7 +99,7 @@ fn a_resumed_run_keeps_the_order_results_were_recorded_in() {
     for id in [3, 1, 4, 2] {
         let r = crate::state::tests::result(id, "a", 0.1 * id as f64);
         journal
-            .record_result(&crate::core::journal_result(&r, 50))
+            .write_result(&crate::core::journal_result(&r, 50))
             .unwrap();
     }
     let (_, state) = open_run(&mut journal, &run, &spec, true).unwrap();
@@ -193,19 +193,19 @@ fn a_run_without_trials_starts_afresh_and_one_with_trials_must_be_resumed() {
     open_run(&mut journal, &run, &spec(5), false).unwrap();
     journal.set_planner_state("r", &[1, 2, 3], 5).unwrap();
     journal
-        .set_run_status("r", RunLifecycle::Stopped, 10)
+        .set_run_phase("r", StoredRunPhase::Stopped, 10)
         .unwrap();
     let (again, state) = open_run(&mut journal, &run, &spec(7), false).unwrap();
     assert_eq!(again, spec(7));
     assert_eq!(state.trial_count(), 0);
     let record = journal.run("r").unwrap().unwrap();
-    assert_eq!(record.status, RunLifecycle::Running);
+    assert_eq!(record.status, StoredRunPhase::Running);
     assert_eq!(
         serde_json::from_str::<RunSpec>(&record.config_json).unwrap(),
         spec(7)
     );
     assert_eq!(journal.planner_state("r").unwrap(), None);
-    journal.record_issue(&issue(1)).unwrap();
+    journal.write_issue(&issue(1)).unwrap();
     let e = open_run(&mut journal, &run, &spec(7), false).unwrap_err();
     let e = e.to_string();
     assert!(
@@ -226,7 +226,7 @@ fn a_resumed_run_accepts_results_of_attempts_issued_before_the_restart() {
     open_run(&mut journal, &run, &spec, false).unwrap();
     for (attempt, worker) in [(1, "a"), (2, "b")] {
         journal
-            .record_issue(&TrialIssue {
+            .write_issue(&TrialIssue {
                 attempt,
                 worker: worker.into(),
                 at_ms: 10 * attempt as i64,

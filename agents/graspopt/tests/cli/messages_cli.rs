@@ -2,7 +2,7 @@
 //! counts and the exit status of a run without a completed trial, the rounding of what a
 //! person reads, and the accepted range of every count flag.
 
-use graspopt_journal::{Journal, RunLifecycle, TrialIssue};
+use graspopt_journal::{Journal, StoredRunPhase, TrialIssue};
 
 use crate::support::{graspopt, graspopt_ok, tempdir};
 
@@ -34,8 +34,8 @@ fn a_run_without_a_completed_trial_says_why_and_exits_3() {
     let failed = dir.join("failed");
     std::fs::create_dir(&failed).unwrap();
     let mut j = Journal::open(&failed.join("journal.sqlite")).unwrap();
-    j.create_run(&graspopt_journal::RunRecord {
-        status: RunLifecycle::Stopped,
+    j.create_run(&graspopt_journal::RunRow {
+        status: StoredRunPhase::Stopped,
         ..record
     })
     .unwrap();
@@ -44,7 +44,7 @@ fn a_run_without_a_completed_trial_says_why_and_exits_3() {
         (2, "no cloud"),
         (3, "the hand broke"),
     ] {
-        j.record_issue(&TrialIssue {
+        j.write_issue(&TrialIssue {
             run_id: "af".into(),
             trial_id: id,
             attempt: 1,
@@ -55,7 +55,7 @@ fn a_run_without_a_completed_trial_says_why_and_exits_3() {
             reason: None,
         })
         .unwrap();
-        j.record_failure("af", id, 1, why, 3).unwrap();
+        j.write_failure("af", id, 1, why, 3).unwrap();
     }
     drop(j);
     let out = graspopt(&[

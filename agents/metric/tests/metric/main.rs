@@ -10,7 +10,7 @@ use graspopt_sensing::SensorNoise;
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{ContactModelSettings, Object, ParamKind, TrialSpace};
 use graspopt_trial::fingertips::{
-    FingertipSettings, SimulatedFingertip, fingertip_score, simulate_readings,
+    FingertipSettings, SimulatedFingertip, fingertip_score, simulate_wrenches,
 };
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::measured::{MeasuredTrial, score_measured};
@@ -36,7 +36,7 @@ fn three_tip_trial() -> (Evaluator, Evaluation, Vec<SimulatedFingertip>) {
             let x = lo.0 + (lo.1 - lo.0) * f64::from(i) / 39.0;
             let y = hi.0 + (hi.1 - hi.0) * f64::from(j) / 9.0;
             let e = ev.evaluate(&[x, y]).unwrap();
-            let tips = simulate_readings(
+            let tips = simulate_wrenches(
                 &e.outcome,
                 ev.hand.as_ref(),
                 &ev.object,

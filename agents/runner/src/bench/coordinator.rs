@@ -6,7 +6,7 @@
 //! Each worker count is measured on two paths:
 //!
 //! - [`BenchPath::Core`]: the coordinator's I/O-free core ([`Coordinator`]) driven directly,
-//!   its journal writes carried out by [`graspopt_coordinator::record`] as the loop does.
+//!   its journal writes carried out by [`graspopt_coordinator::write_journal`] as the loop does.
 //!   One thread: every command is answered by its result at once, the results arriving
 //!   together as they do from workers that answer at once (the loop takes them as one
 //!   event), and a question to the planner is answered at once. Each event's journal
@@ -44,7 +44,7 @@ use graspopt_bus::{AliveEvent, Bus, BusConfig, now_ms};
 use graspopt_coordinator::{
     Action, Coordinator, CoordinatorConfig, Event, RunSpec, Write, open_run,
 };
-use graspopt_journal::{Journal, TrialState, event_kind};
+use graspopt_journal::{Journal, StoredTrialPhase, event_kind};
 use graspopt_protocol::keys::{AliveKey, COMMAND, OBJECT, RESULT, SUGGEST};
 use graspopt_protocol::{
     AgentKind, Encoding, ObjectEstimate, PlannerMethod, Pose, RunId, SuggestReply, SuggestRequest,
@@ -241,7 +241,7 @@ fn check_journal(journal: &Journal, run: &RunId, trials: u64) -> Result<u64> {
     );
     for r in &rows {
         ensure!(
-            r.state == TrialState::Completed && r.attempts == 1,
+            r.state == StoredTrialPhase::Completed && r.attempts == 1,
             "trial {} is {:?} after {} attempts",
             r.trial_id,
             r.state,
@@ -358,7 +358,7 @@ fn carry_out(
         // As the loop: the writes of one event in one transaction, then the rest.
         let (writes, rest) = graspopt_coordinator::split_writes(std::mem::take(&mut todo));
         let start = Instant::now();
-        graspopt_coordinator::record(journal, run, &writes)?;
+        graspopt_coordinator::write_journal(journal, run, &writes)?;
         let end = Instant::now();
         clock.journal += end - start;
         clock.commits += u64::from(!writes.is_empty());
@@ -379,7 +379,7 @@ fn carry_out(
         }
         for action in rest {
             match action {
-                Action::Record(_) => {}
+                Action::Write(_) => {}
                 Action::Send { command, .. } => line.push_back(command),
                 // Answered at once; what the reply leads to is the next event.
                 Action::Ask(request) => {

@@ -7,7 +7,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use graspopt_journal::{
-    Journal, JournalError, ResultOutcome, TrialState, Write, Written, event_kind,
+    Journal, JournalError, ResultOutcome, StoredTrialPhase, Write, Written, event_kind,
 };
 
 use super::{
@@ -48,7 +48,7 @@ fn mixed_batch() -> Vec<Write> {
 #[test]
 fn a_batch_refuses_a_write_alone_and_commits_the_rest() {
     let mut j = journal_with_run();
-    let outcomes = j.record(RUN, &mixed_batch()).unwrap();
+    let outcomes = j.write(RUN, &mixed_batch()).unwrap();
     assert_eq!(outcomes.len(), 8);
     assert!(matches!(outcomes[0], Ok(Written::Issue)));
     assert!(
@@ -70,10 +70,14 @@ fn a_batch_refuses_a_write_alone_and_commits_the_rest() {
     assert!(matches!(outcomes[7], Ok(Written::PlannerState)));
 
     let trials = j.trials(RUN).unwrap();
-    let states: Vec<(u64, TrialState)> = trials.iter().map(|t| (t.trial_id, t.state)).collect();
+    let states: Vec<(u64, StoredTrialPhase)> =
+        trials.iter().map(|t| (t.trial_id, t.state)).collect();
     assert_eq!(
         states,
-        [(1, TrialState::Completed), (3, TrialState::Failed)],
+        [
+            (1, StoredTrialPhase::Completed),
+            (3, StoredTrialPhase::Failed)
+        ],
         "trial 2 was refused and left nothing"
     );
     assert_eq!(j.planner_state(RUN).unwrap(), Some(vec![1, 2, 3]));
@@ -93,19 +97,19 @@ fn a_batch_refuses_a_write_alone_and_commits_the_rest() {
 #[test]
 fn a_batch_leaves_the_journal_its_writes_one_by_one_leave() {
     let mut batched = journal_with_run();
-    batched.record(RUN, &mixed_batch()).unwrap();
+    batched.write(RUN, &mixed_batch()).unwrap();
     let mut single = journal_with_run();
     for write in mixed_batch() {
         let _ = match write {
-            Write::Issue(i) => single.record_issue(&i).map(|_| ()),
-            Write::Result(r) => single.record_result(&r).map(|_| ()),
+            Write::Issue(i) => single.write_issue(&i).map(|_| ()),
+            Write::Result(r) => single.write_result(&r).map(|_| ()),
             Write::Failure {
                 trial_id,
                 attempt,
                 error,
                 at_ms,
             } => single
-                .record_failure(RUN, trial_id, attempt, &error, at_ms)
+                .write_failure(RUN, trial_id, attempt, &error, at_ms)
                 .map(|_| ()),
             Write::PlannerState { engine, at_ms } => single.set_planner_state(RUN, &engine, at_ms),
         };
@@ -122,7 +126,7 @@ fn a_batch_leaves_the_journal_its_writes_one_by_one_leave() {
 fn a_batch_of_an_unknown_run_writes_nothing() {
     let mut j = journal_with_run();
     let outcomes = j
-        .record("nobody", &[Write::Issue(issue("nobody", 1, 1, "w", 0))])
+        .write("nobody", &[Write::Issue(issue("nobody", 1, 1, "w", 0))])
         .unwrap();
     assert!(matches!(&outcomes[0], Err(JournalError::UnknownRun(r)) if r == "nobody"));
     assert!(j.trials(RUN).unwrap().is_empty());
@@ -149,7 +153,7 @@ fn batch_child_writer() {
         .trials(BATCH_RUN)
         .unwrap()
         .iter()
-        .filter(|t| t.state == TrialState::Running)
+        .filter(|t| t.state == StoredTrialPhase::Running)
         .map(|t| t.trial_id)
         .collect();
     let mut out = std::io::stdout();
@@ -169,7 +173,7 @@ fn batch_child_writer() {
                 .iter()
                 .map(|&t| Write::Issue(issue(BATCH_RUN, t, 1, "child", 0))),
         );
-        let outcomes = j.record(BATCH_RUN, &batch).unwrap();
+        let outcomes = j.write(BATCH_RUN, &batch).unwrap();
         assert_eq!(outcomes.iter().filter(|o| o.is_err()).count(), 1);
         issued += WIDTH;
         writeln!(out, "sent {issued}").unwrap();
@@ -233,12 +237,12 @@ fn kill9_mid_batch_leaves_whole_batches() {
             assert_eq!(t.trial_id, id);
             assert_eq!(bits(&t.params), bits(&params_for(id)));
             let expected = if id + WIDTH > n {
-                TrialState::Running
+                StoredTrialPhase::Running
             } else {
-                TrialState::Completed
+                StoredTrialPhase::Completed
             };
             assert_eq!(t.state, expected, "round {round}: trial {id} of {n}");
-            if expected == TrialState::Completed {
+            if expected == StoredTrialPhase::Completed {
                 assert_eq!(t.score.map(f64::to_bits), Some(score_for(id).to_bits()));
             }
         }

@@ -12,17 +12,17 @@ use super::{
 #[test]
 fn csv_export_fields() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
         .unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w,2", 300)).unwrap();
+    j.write_issue(&issue(RUN, 2, 1, "w,2", 300)).unwrap();
     let message = "hand error: finger 2, \"jammed\" at 3 N";
-    assert!(j.record_failure(RUN, 2, 1, message, 400).unwrap());
-    j.record_issue(&issue(RUN, 3, 1, "w3", 500)).unwrap();
+    assert!(j.write_failure(RUN, 2, 1, message, 400).unwrap());
+    j.write_issue(&issue(RUN, 3, 1, "w3", 500)).unwrap();
     let mut r3 = result(RUN, 3, 1, "w3", 600, 1.0);
     r3.metrics = None;
-    j.record_result(&r3).unwrap();
-    j.record_issue(&issue(RUN, 4, 1, "w4", 700)).unwrap();
+    j.write_result(&r3).unwrap();
+    j.write_issue(&issue(RUN, 4, 1, "w4", 700)).unwrap();
 
     let mut out = Vec::new();
     write_csv(&j, RUN, &mut out).unwrap();
@@ -132,11 +132,11 @@ fn csv_export_fields() {
 fn csv_export_leaves_out_a_volume_no_trial_has() {
     // Runs not scored by the volume never compute it: no always-empty column.
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let mut r1 = result(RUN, 1, 1, "w1", 250, 0.5);
     r1.metrics.as_mut().unwrap().set("volume", None);
-    j.record_result(&r1).unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+    j.write_result(&r1).unwrap();
+    j.write_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
     let mut out = Vec::new();
     write_csv(&j, RUN, &mut out).unwrap();
     let text = String::from_utf8(out).unwrap();
@@ -167,11 +167,11 @@ fn csv_export_leaves_out_a_volume_no_trial_has() {
 #[test]
 fn json_export_parses_back() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    j.record_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_result(&result(RUN, 1, 1, "w1", 250, 0.1 + 0.2))
         .unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
-    j.record_failure(RUN, 2, 1, "hand error, \"jammed\"", 400)
+    j.write_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+    j.write_failure(RUN, 2, 1, "hand error, \"jammed\"", 400)
         .unwrap();
 
     let mut out = Vec::new();

@@ -25,11 +25,11 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
     let mut j = Journal::open_in_memory().unwrap();
     j.create_run(&run_record(RUN)).unwrap();
     for t in 1..=3 {
-        j.record_issue(&issue(RUN, t, 1, "w1", 100)).unwrap();
+        j.write_issue(&issue(RUN, t, 1, "w1", 100)).unwrap();
     }
     let mut with = result(RUN, 1, 1, "w1", 200, 0.5);
     with.forces = Some(analysis());
-    j.record_result(&with).unwrap();
+    j.write_result(&with).unwrap();
     let mut cannot = result(RUN, 2, 1, "w1", 300, -0.25);
     cannot.forces = Some(ForceAnalysis {
         resisting_norm: None,
@@ -38,7 +38,7 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
         slip_margins: Vec::new(),
         ..analysis()
     });
-    j.record_result(&cannot).unwrap();
+    j.write_result(&cannot).unwrap();
     // The least forces unknown: the score stands, the measured forces too.
     let unknown = ForceAnalysis {
         resisting_norm: None,
@@ -48,7 +48,7 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
     };
     let mut unavailable = result(RUN, 3, 1, "w1", 400, 0.125);
     unavailable.forces = Some(unknown.clone());
-    j.record_result(&unavailable).unwrap();
+    j.write_result(&unavailable).unwrap();
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap().forces, Some(analysis()));
     assert_eq!(j.trial(RUN, 3).unwrap().unwrap().forces, Some(unknown));
     assert_eq!(j.trial(RUN, 3).unwrap().unwrap().score, Some(0.125));
@@ -104,13 +104,13 @@ fn a_result_keeps_its_force_analysis_and_the_csv_shows_it() {
 fn a_non_finite_force_is_refused_and_nothing_is_written() {
     let mut j = Journal::open_in_memory().unwrap();
     j.create_run(&run_record(RUN)).unwrap();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let mut bad = result(RUN, 1, 1, "w1", 200, 0.5);
     bad.forces = Some(ForceAnalysis {
         slip_margins: vec![1.0, f64::NAN],
         ..analysis()
     });
-    let err = j.record_result(&bad).unwrap_err();
+    let err = j.write_result(&bad).unwrap_err();
     assert!(matches!(err, JournalError::Invalid(_)), "{err}");
     assert!(err.to_string().contains("forces.slip_margins[1]"), "{err}");
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap().score, None);
@@ -123,9 +123,9 @@ fn a_version_2_journal_is_upgraded_and_its_trials_have_no_forces() {
     {
         let mut j = Journal::open(&db).unwrap();
         j.create_run(&run_record(RUN)).unwrap();
-        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
-        j.record_issue(&issue(RUN, 2, 1, "w1", 100)).unwrap();
+        j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.write_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+        j.write_issue(&issue(RUN, 2, 1, "w1", 100)).unwrap();
     }
     // Version 2 is version 3 without the forces column.
     {
@@ -143,7 +143,7 @@ fn a_version_2_journal_is_upgraded_and_its_trials_have_no_forces() {
     assert_eq!((first.score, first.forces), (Some(0.5), None));
     let mut with = result(RUN, 2, 1, "w1", 300, 0.75);
     with.forces = Some(analysis());
-    j.record_result(&with).unwrap();
+    j.write_result(&with).unwrap();
     drop(j);
     let j = Journal::open(&db).unwrap();
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().forces, Some(analysis()));

@@ -8,10 +8,10 @@ fn issue_result_round_trip() {
     let mut j = journal_with_run();
     let mut iss = issue(RUN, 1, 1, "worker-1", 2_000);
     iss.params = vec![0.1 + 0.2, 5e-324, -0.0];
-    j.record_issue(&iss).unwrap();
+    j.write_issue(&iss).unwrap();
 
     let running = j.trial(RUN, 1).unwrap().unwrap();
-    assert_eq!(running.state, TrialState::Running);
+    assert_eq!(running.state, StoredTrialPhase::Running);
     assert_eq!(running.attempts, 1);
     assert_eq!(running.worker, "worker-1");
     assert_eq!(running.issued_ms, 2_000);
@@ -23,13 +23,13 @@ fn issue_result_round_trip() {
     assert!(running.params[2].is_sign_negative());
 
     let res = result(RUN, 1, 1, "worker-1", 2_500, 0.734_251_998_123_456_7);
-    assert_eq!(j.record_result(&res).unwrap(), ResultOutcome::Accepted);
+    assert_eq!(j.write_result(&res).unwrap(), ResultOutcome::Accepted);
 
     let row = j.trial(RUN, 1).unwrap().unwrap();
     let expected = TrialRow {
         run_id: RUN.to_string(),
         trial_id: 1,
-        state: TrialState::Completed,
+        state: StoredTrialPhase::Completed,
         attempts: 1,
         params: iss.params.clone(),
         worker: "worker-1".to_string(),
@@ -64,16 +64,14 @@ fn issue_result_round_trip() {
     );
 
     // Metrics absent, and metrics with no volume, read back as such.
-    j.record_issue(&issue(RUN, 2, 1, "worker-2", 3_000))
-        .unwrap();
+    j.write_issue(&issue(RUN, 2, 1, "worker-2", 3_000)).unwrap();
     let mut r2 = result(RUN, 2, 1, "worker-2", 3_100, -1.5);
     r2.metrics = None;
-    j.record_result(&r2).unwrap();
-    j.record_issue(&issue(RUN, 3, 1, "worker-2", 3_200))
-        .unwrap();
+    j.write_result(&r2).unwrap();
+    j.write_issue(&issue(RUN, 3, 1, "worker-2", 3_200)).unwrap();
     let mut r3 = result(RUN, 3, 1, "worker-2", 3_300, f64::MAX);
     r3.metrics.as_mut().unwrap().set("volume", None);
-    j.record_result(&r3).unwrap();
+    j.write_result(&r3).unwrap();
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().metrics, None);
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().score, Some(-1.5));
     assert_eq!(j.trial(RUN, 3).unwrap().unwrap().metrics, r3.metrics);
@@ -104,13 +102,13 @@ fn issue_result_round_trip() {
 #[test]
 fn exactly_once_duplicate_result() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let first = result(RUN, 1, 1, "w1", 200, 0.5);
     let mut second = result(RUN, 1, 1, "w1", 300, 0.9);
     second.contacts = 1;
-    assert_eq!(j.record_result(&first).unwrap(), ResultOutcome::Accepted);
+    assert_eq!(j.write_result(&first).unwrap(), ResultOutcome::Accepted);
     let after_first = j.trial(RUN, 1).unwrap().unwrap();
-    assert_eq!(j.record_result(&second).unwrap(), ResultOutcome::Duplicate);
+    assert_eq!(j.write_result(&second).unwrap(), ResultOutcome::Duplicate);
     let after_second = j.trial(RUN, 1).unwrap().unwrap();
     assert_eq!(after_second, after_first);
     assert_eq!(after_second.score, Some(0.5));
@@ -139,27 +137,26 @@ fn exactly_once_duplicate_result() {
 #[test]
 fn unknown_trial_writes_nothing() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let before_trials = j.trials(RUN).unwrap();
     let before_events = j.events(RUN).unwrap();
 
     assert_eq!(
-        j.record_result(&result(RUN, 99, 1, "w1", 200, 0.5))
+        j.write_result(&result(RUN, 99, 1, "w1", 200, 0.5)).unwrap(),
+        ResultOutcome::UnknownTrial
+    );
+    assert_eq!(
+        j.write_result(&result("no-such-run", 1, 1, "w1", 200, 0.5))
             .unwrap(),
         ResultOutcome::UnknownTrial
     );
     assert_eq!(
-        j.record_result(&result("no-such-run", 1, 1, "w1", 200, 0.5))
+        j.write_result(&result(RUN, u64::MAX, 1, "w1", 200, 0.5))
             .unwrap(),
         ResultOutcome::UnknownTrial
     );
-    assert_eq!(
-        j.record_result(&result(RUN, u64::MAX, 1, "w1", 200, 0.5))
-            .unwrap(),
-        ResultOutcome::UnknownTrial
-    );
-    assert!(!j.record_failure(RUN, 99, 1, "boom", 300).unwrap());
-    assert!(!j.record_failure("no-such-run", 1, 1, "boom", 300).unwrap());
+    assert!(!j.write_failure(RUN, 99, 1, "boom", 300).unwrap());
+    assert!(!j.write_failure("no-such-run", 1, 1, "boom", 300).unwrap());
 
     assert_eq!(j.trials(RUN).unwrap(), before_trials);
     assert_eq!(j.events(RUN).unwrap(), before_events);
@@ -171,13 +168,13 @@ fn unknown_trial_writes_nothing() {
 #[test]
 fn reissue_then_late_result_accepted_once() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let mut re = issue(RUN, 1, 2, "w2", 40_000);
     re.reason = Some("lease expired (w1 silent)".to_string());
-    j.record_issue(&re).unwrap();
+    j.write_issue(&re).unwrap();
 
     let row = j.trial(RUN, 1).unwrap().unwrap();
-    assert_eq!(row.state, TrialState::Running);
+    assert_eq!(row.state, StoredTrialPhase::Running);
     assert_eq!(row.attempts, 2);
     assert_eq!(row.worker, "w2");
     assert_eq!(row.issued_ms, 100, "issued_ms is the first issue");
@@ -192,9 +189,9 @@ fn reissue_then_late_result_accepted_once() {
 
     // The late result of attempt 1 arrives: the work was done, accept it.
     let late = result(RUN, 1, 1, "w1", 41_000, 0.25);
-    assert_eq!(j.record_result(&late).unwrap(), ResultOutcome::Accepted);
+    assert_eq!(j.write_result(&late).unwrap(), ResultOutcome::Accepted);
     let done = j.trial(RUN, 1).unwrap().unwrap();
-    assert_eq!(done.state, TrialState::Completed);
+    assert_eq!(done.state, StoredTrialPhase::Completed);
     assert_eq!(done.attempts, 2);
     assert_eq!(done.result_attempt, Some(1));
     assert_eq!(done.worker, "w1");
@@ -202,8 +199,8 @@ fn reissue_then_late_result_accepted_once() {
 
     // Attempt 2's result, and a repeat of attempt 1's, are duplicates.
     let current = result(RUN, 1, 2, "w2", 42_000, 0.75);
-    assert_eq!(j.record_result(&current).unwrap(), ResultOutcome::Duplicate);
-    assert_eq!(j.record_result(&late).unwrap(), ResultOutcome::Duplicate);
+    assert_eq!(j.write_result(&current).unwrap(), ResultOutcome::Duplicate);
+    assert_eq!(j.write_result(&late).unwrap(), ResultOutcome::Duplicate);
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), done);
 
     let events = j.events(RUN).unwrap();
@@ -216,13 +213,13 @@ fn reissue_then_late_result_accepted_once() {
     assert_eq!(events[3].worker, "w2");
 
     // A completed trial cannot be re-issued.
-    let err = j.record_issue(&issue(RUN, 1, 3, "w3", 50_000)).unwrap_err();
+    let err = j.write_issue(&issue(RUN, 1, 3, "w3", 50_000)).unwrap_err();
     assert!(
         matches!(
             err,
             JournalError::TrialClosed {
                 trial_id: 1,
-                state: TrialState::Completed,
+                state: StoredTrialPhase::Completed,
                 ..
             }
         ),
@@ -234,7 +231,7 @@ fn reissue_then_late_result_accepted_once() {
 fn issue_validation() {
     let mut j = journal_with_run();
     // First issue must be attempt 1.
-    let err = j.record_issue(&issue(RUN, 1, 2, "w1", 100)).unwrap_err();
+    let err = j.write_issue(&issue(RUN, 1, 2, "w1", 100)).unwrap_err();
     assert!(
         matches!(
             err,
@@ -246,9 +243,9 @@ fn issue_validation() {
         ),
         "{err}"
     );
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     // Re-issue must be the next attempt.
-    let err = j.record_issue(&issue(RUN, 1, 3, "w2", 200)).unwrap_err();
+    let err = j.write_issue(&issue(RUN, 1, 3, "w2", 200)).unwrap_err();
     assert!(
         matches!(
             err,
@@ -260,12 +257,12 @@ fn issue_validation() {
         ),
         "{err}"
     );
-    let err = j.record_issue(&issue(RUN, 1, 1, "w2", 200)).unwrap_err();
+    let err = j.write_issue(&issue(RUN, 1, 1, "w2", 200)).unwrap_err();
     assert!(matches!(err, JournalError::AttemptMismatch { .. }), "{err}");
     // Re-issue with other parameters.
     let mut other = issue(RUN, 1, 2, "w2", 200);
     other.params[0] += 1e-12;
-    let err = j.record_issue(&other).unwrap_err();
+    let err = j.write_issue(&other).unwrap_err();
     assert!(
         matches!(err, JournalError::ParamsMismatch { trial_id: 1, .. }),
         "{err}"
@@ -273,7 +270,7 @@ fn issue_validation() {
     // Wrong number of parameters for the run.
     let mut short = issue(RUN, 2, 1, "w1", 300);
     short.params.pop();
-    let err = j.record_issue(&short).unwrap_err();
+    let err = j.write_issue(&short).unwrap_err();
     assert!(
         matches!(
             err,
@@ -286,16 +283,14 @@ fn issue_validation() {
         "{err}"
     );
     // Unknown run.
-    let err = j
-        .record_issue(&issue("ghost", 1, 1, "w1", 300))
-        .unwrap_err();
+    let err = j.write_issue(&issue("ghost", 1, 1, "w1", 300)).unwrap_err();
     assert!(
         matches!(&err, JournalError::UnknownRun(r) if r == "ghost"),
         "{err}"
     );
     // Trial ids beyond i64 are refused.
     let err = j
-        .record_issue(&issue(RUN, u64::MAX, 1, "w1", 300))
+        .write_issue(&issue(RUN, u64::MAX, 1, "w1", 300))
         .unwrap_err();
     assert!(matches!(err, JournalError::TrialIdRange(u64::MAX)), "{err}");
 
@@ -310,43 +305,43 @@ fn issue_validation() {
 #[test]
 fn failure_is_final_and_once() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-    j.record_issue(&issue(RUN, 2, 1, "w2", 100)).unwrap();
-    j.record_result(&result(RUN, 2, 1, "w2", 200, 0.4)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 2, 1, "w2", 100)).unwrap();
+    j.write_result(&result(RUN, 2, 1, "w2", 200, 0.4)).unwrap();
 
     assert!(
-        j.record_failure(RUN, 1, 1, "hand fault: tendon 3", 300)
+        j.write_failure(RUN, 1, 1, "hand fault: tendon 3", 300)
             .unwrap()
     );
     let failed = j.trial(RUN, 1).unwrap().unwrap();
-    assert_eq!(failed.state, TrialState::Failed);
+    assert_eq!(failed.state, StoredTrialPhase::Failed);
     assert_eq!(failed.error.as_deref(), Some("hand fault: tendon 3"));
     assert_eq!(failed.score, None);
     assert_eq!(failed.completed_ms, None);
 
     // Failing again, or failing a completed trial, changes nothing.
-    assert!(!j.record_failure(RUN, 1, 1, "second message", 400).unwrap());
-    assert!(!j.record_failure(RUN, 2, 1, "too late", 400).unwrap());
+    assert!(!j.write_failure(RUN, 1, 1, "second message", 400).unwrap());
+    assert!(!j.write_failure(RUN, 2, 1, "too late", 400).unwrap());
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), failed);
     assert_eq!(
         j.trial(RUN, 2).unwrap().unwrap().state,
-        TrialState::Completed
+        StoredTrialPhase::Completed
     );
     assert_eq!(j.trial(RUN, 2).unwrap().unwrap().error, None);
 
     // A result after the failure is a duplicate: the trial already ended.
     assert_eq!(
-        j.record_result(&result(RUN, 1, 1, "w1", 500, 0.9)).unwrap(),
+        j.write_result(&result(RUN, 1, 1, "w1", 500, 0.9)).unwrap(),
         ResultOutcome::Duplicate
     );
     assert_eq!(j.trial(RUN, 1).unwrap().unwrap(), failed);
     // ... and it cannot be re-issued.
-    let err = j.record_issue(&issue(RUN, 1, 2, "w3", 600)).unwrap_err();
+    let err = j.write_issue(&issue(RUN, 1, 2, "w3", 600)).unwrap_err();
     assert!(
         matches!(
             err,
             JournalError::TrialClosed {
-                state: TrialState::Failed,
+                state: StoredTrialPhase::Failed,
                 ..
             }
         ),
@@ -371,9 +366,9 @@ fn durability_reopen_and_wal_reader() {
         let mut writer = Journal::open(&db).unwrap();
         assert_eq!(writer.path(), Some(db.as_path()));
         writer.create_run(&run_record(RUN)).unwrap();
-        writer.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        writer.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
         writer
-            .record_result(&result(RUN, 1, 1, "w1", 200, 0.5))
+            .write_result(&result(RUN, 1, 1, "w1", 200, 0.5))
             .unwrap();
 
         // A second connection while the first is open sees committed rows.
@@ -397,25 +392,25 @@ fn durability_reopen_and_wal_reader() {
         assert!(Path::new(&wal).exists());
 
         // Later writes by the first are seen by the open second.
-        writer.record_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
+        writer.write_issue(&issue(RUN, 2, 1, "w2", 300)).unwrap();
         assert_eq!(reader.trials(RUN).unwrap().len(), 2);
         assert_eq!(reader.counts(RUN).unwrap().running, 1);
         writer
-            .set_run_status(RUN, RunLifecycle::Finished, 900)
+            .set_run_phase(RUN, StoredRunPhase::Finished, 900)
             .unwrap();
         assert_eq!(
             reader.run(RUN).unwrap().unwrap().status,
-            RunLifecycle::Finished
+            StoredRunPhase::Finished
         );
     }
     let reopened = Journal::open(&db).unwrap();
     assert!(reopened.integrity_check().unwrap());
     let trials = reopened.trials(RUN).unwrap();
     assert_eq!(trials.len(), 2);
-    assert_eq!(trials[0].state, TrialState::Completed);
+    assert_eq!(trials[0].state, StoredTrialPhase::Completed);
     assert_eq!(trials[0].score, Some(0.5));
     assert_eq!(bits(&trials[0].params), bits(&params_for(1)));
-    assert_eq!(trials[1].state, TrialState::Running);
+    assert_eq!(trials[1].state, StoredTrialPhase::Running);
     assert_eq!(
         kinds(&reopened.events(RUN).unwrap()),
         ["issued", "result", "issued"]
@@ -423,8 +418,8 @@ fn durability_reopen_and_wal_reader() {
     let run = reopened.run(RUN).unwrap().unwrap();
     assert_eq!(
         run,
-        RunRecord {
-            status: RunLifecycle::Finished,
+        RunRow {
+            status: StoredRunPhase::Finished,
             ..run_record(RUN)
         }
     );

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 
 use graspopt_journal::export::{write_csv, write_json};
 use graspopt_journal::{
-    EventRow, Journal, JournalError, MetricValue, MetricValues, ResultOutcome, RunLifecycle,
-    RunRecord, SCHEMA_VERSION, StateCounts, TrialIssue, TrialResultRecord, TrialRow, TrialState,
+    EventRow, Journal, JournalError, MetricValue, MetricValues, ResultOutcome, ResultRow, RunRow,
+    SCHEMA_VERSION, StateCounts, StoredRunPhase, StoredTrialPhase, TrialIssue, TrialRow,
     event_kind,
 };
 
@@ -31,13 +31,13 @@ impl TempDir {
 
 const RUN: &str = "run-a";
 
-fn run_record(run_id: &str) -> RunRecord {
-    RunRecord {
+fn run_record(run_id: &str) -> RunRow {
+    RunRow {
         run_id: run_id.to_string(),
         created_ms: 1_000,
         config_json: r#"{"objective":"epsilon","budget":50,"hand":{"fingers":3}}"#.to_string(),
         param_names: vec!["approach_x".into(), "roll".into(), "aperture".into()],
-        status: RunLifecycle::Running,
+        status: StoredRunPhase::Running,
     }
 }
 
@@ -90,8 +90,8 @@ fn result(
     worker: &str,
     at_ms: i64,
     score: f64,
-) -> TrialResultRecord {
-    TrialResultRecord {
+) -> ResultRow {
+    ResultRow {
         run_id: run_id.to_string(),
         trial_id: trial,
         attempt,
@@ -177,7 +177,7 @@ fn journal_is_send() {
     std::thread::scope(|s| {
         s.spawn(|| {
             let mut j = j.lock().unwrap();
-            j.record_issue(&issue(RUN, 1, 1, "w1", 10)).unwrap();
+            j.write_issue(&issue(RUN, 1, 1, "w1", 10)).unwrap();
         });
     });
     assert_eq!(j.lock().unwrap().counts(RUN).unwrap().running, 1);
@@ -267,14 +267,14 @@ fn create_run_idempotent_and_config_mismatch() {
     let ids: Vec<String> = j.runs().unwrap().into_iter().map(|r| r.run_id).collect();
     assert_eq!(ids, ["z-early", RUN, "a-late"]);
 
-    j.set_run_status("a-late", RunLifecycle::Stopped, 6_000)
+    j.set_run_phase("a-late", StoredRunPhase::Stopped, 6_000)
         .unwrap();
     assert_eq!(
         j.run("a-late").unwrap().unwrap().status,
-        RunLifecycle::Stopped
+        StoredRunPhase::Stopped
     );
     let err = j
-        .set_run_status("ghost", RunLifecycle::Stopped, 6_000)
+        .set_run_phase("ghost", StoredRunPhase::Stopped, 6_000)
         .unwrap_err();
     assert!(
         matches!(&err, JournalError::UnknownRun(r) if r == "ghost"),
@@ -285,7 +285,7 @@ fn create_run_idempotent_and_config_mismatch() {
     j.set_run_config("a-late", r#"{"trials":90}"#).unwrap();
     let late = j.run("a-late").unwrap().unwrap();
     assert_eq!(late.config_json, r#"{"trials":90}"#);
-    assert_eq!(late.status, RunLifecycle::Stopped);
+    assert_eq!(late.status, StoredRunPhase::Stopped);
     assert!(matches!(
         j.set_run_config("ghost", "{}").unwrap_err(),
         JournalError::UnknownRun(r) if r == "ghost"
@@ -295,10 +295,10 @@ fn create_run_idempotent_and_config_mismatch() {
 #[test]
 fn non_finite_values_refused() {
     let mut j = journal_with_run();
-    j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
     let before = j.trial(RUN, 1).unwrap().unwrap();
 
-    let cases: Vec<(&str, TrialResultRecord)> = vec![
+    let cases: Vec<(&str, ResultRow)> = vec![
         ("score", result(RUN, 1, 1, "w1", 200, f64::NAN)),
         ("score", result(RUN, 1, 1, "w1", 200, f64::INFINITY)),
         ("metrics.epsilon", {
@@ -335,7 +335,7 @@ fn non_finite_values_refused() {
         }),
     ];
     for (field, r) in cases {
-        let err = j.record_result(&r).unwrap_err();
+        let err = j.write_result(&r).unwrap_err();
         assert!(
             matches!(&err, JournalError::NonFinite { field: f } if f == field),
             "{field}: {err}"
@@ -347,7 +347,7 @@ fn non_finite_values_refused() {
 
     let mut bad = issue(RUN, 2, 1, "w1", 100);
     bad.params[1] = f64::NAN;
-    let err = j.record_issue(&bad).unwrap_err();
+    let err = j.write_issue(&bad).unwrap_err();
     assert!(
         matches!(&err, JournalError::NonFinite { field } if field == "params[1]"),
         "{err}"
@@ -357,7 +357,7 @@ fn non_finite_values_refused() {
 
     // The valid result still goes through afterwards.
     assert_eq!(
-        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap(),
+        j.write_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap(),
         ResultOutcome::Accepted
     );
 }
@@ -368,14 +368,14 @@ fn best_and_counts() {
     assert_eq!(j.best(RUN).unwrap(), None);
     assert_eq!(j.counts(RUN).unwrap(), StateCounts::default());
     for t in 1..=6 {
-        j.record_issue(&issue(RUN, t, 1, "w", 100 + t as i64))
+        j.write_issue(&issue(RUN, t, 1, "w", 100 + t as i64))
             .unwrap();
     }
-    j.record_result(&result(RUN, 1, 1, "w", 200, 0.3)).unwrap();
-    j.record_result(&result(RUN, 2, 1, "w", 200, 0.8)).unwrap();
-    j.record_result(&result(RUN, 3, 1, "w", 200, -2.0)).unwrap();
-    j.record_result(&result(RUN, 4, 1, "w", 200, 0.8)).unwrap(); // tie with 2
-    j.record_failure(RUN, 5, 1, "hand error", 300).unwrap();
+    j.write_result(&result(RUN, 1, 1, "w", 200, 0.3)).unwrap();
+    j.write_result(&result(RUN, 2, 1, "w", 200, 0.8)).unwrap();
+    j.write_result(&result(RUN, 3, 1, "w", 200, -2.0)).unwrap();
+    j.write_result(&result(RUN, 4, 1, "w", 200, 0.8)).unwrap(); // tie with 2
+    j.write_failure(RUN, 5, 1, "hand error", 300).unwrap();
 
     let best = j.best(RUN).unwrap().unwrap();
     assert_eq!(best.trial_id, 2);
@@ -390,8 +390,8 @@ fn best_and_counts() {
     );
 
     // A better late result moves best; a duplicate that would be better does not.
-    j.record_result(&result(RUN, 6, 1, "w", 400, 0.95)).unwrap();
-    j.record_result(&result(RUN, 3, 1, "w", 500, 10.0)).unwrap();
+    j.write_result(&result(RUN, 6, 1, "w", 400, 0.95)).unwrap();
+    j.write_result(&result(RUN, 3, 1, "w", 500, 10.0)).unwrap();
     assert_eq!(j.best(RUN).unwrap().unwrap().trial_id, 6);
     assert_eq!(
         j.counts(RUN).unwrap(),
@@ -412,10 +412,10 @@ fn best_and_counts() {
 fn leases_and_max_trial_id() {
     let mut j = journal_with_run();
     assert_eq!(j.max_trial_id(RUN).unwrap(), None);
-    j.record_issue(&issue(RUN, 1, 1, "w1", 0)).unwrap(); // lease to 30_000
-    j.record_issue(&issue(RUN, 2, 1, "w2", 10_000)).unwrap(); // lease to 40_000
-    j.record_issue(&issue(RUN, 3, 1, "w3", 0)).unwrap();
-    j.record_result(&result(RUN, 3, 1, "w3", 100, 0.1)).unwrap();
+    j.write_issue(&issue(RUN, 1, 1, "w1", 0)).unwrap(); // lease to 30_000
+    j.write_issue(&issue(RUN, 2, 1, "w2", 10_000)).unwrap(); // lease to 40_000
+    j.write_issue(&issue(RUN, 3, 1, "w3", 0)).unwrap();
+    j.write_result(&result(RUN, 3, 1, "w3", 100, 0.1)).unwrap();
     assert_eq!(j.max_trial_id(RUN).unwrap(), Some(3));
     let ids = |rows: Vec<TrialRow>| rows.into_iter().map(|t| t.trial_id).collect::<Vec<_>>();
     assert_eq!(ids(j.expired_leases(RUN, 35_000).unwrap()), [1]);
@@ -465,17 +465,17 @@ fn child_writer() {
     j.create_run(&run_record(KILL_RUN)).unwrap();
     let mut next = j.max_trial_id(KILL_RUN).unwrap().unwrap_or(0);
     // A trial left running by the previous kill is finished first.
-    if next > 0 && j.trial(KILL_RUN, next).unwrap().unwrap().state == TrialState::Running {
-        j.record_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
+    if next > 0 && j.trial(KILL_RUN, next).unwrap().unwrap().state == StoredTrialPhase::Running {
+        j.write_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
             .unwrap();
     }
     println!("{READY}");
     let deadline = Instant::now() + Duration::from_secs(30);
     while Instant::now() < deadline {
         next += 1;
-        j.record_issue(&issue(KILL_RUN, next, 1, "child", 0))
+        j.write_issue(&issue(KILL_RUN, next, 1, "child", 0))
             .unwrap();
-        j.record_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
+        j.write_result(&result(KILL_RUN, next, 1, "child", 0, score_for(next)))
             .unwrap();
     }
     panic!("child writer was not killed within 30 s");
@@ -500,13 +500,13 @@ fn check_prefix(j: &Journal) -> usize {
         assert_eq!(bits(&t.params), bits(&params_for(id)), "trial {id}");
         let is_last = i + 1 == trials.len();
         match t.state {
-            TrialState::Completed => {
+            StoredTrialPhase::Completed => {
                 assert_eq!(t.score.map(f64::to_bits), Some(score_for(id).to_bits()));
                 assert_eq!(t.metrics, Some(metrics_for(id)));
                 assert_eq!(t.cloud_points, 4096);
                 assert_eq!(per_trial[&id], ["issued", "result"], "trial {id}");
             }
-            TrialState::Running => {
+            StoredTrialPhase::Running => {
                 assert!(
                     is_last,
                     "only the last trial may be unfinished (trial {id})"
@@ -514,7 +514,7 @@ fn check_prefix(j: &Journal) -> usize {
                 assert_eq!(t.score, None);
                 assert_eq!(per_trial[&id], ["issued"], "trial {id}");
             }
-            TrialState::Failed => panic!("trial {id} failed"),
+            StoredTrialPhase::Failed => panic!("trial {id} failed"),
         }
     }
     assert_eq!(per_trial.len(), trials.len(), "events for unknown trials");
@@ -603,7 +603,7 @@ fn only_a_run_without_trials_is_removed_for_a_fresh_start() {
     j.create_run(&run_record(RUN)).unwrap();
     j.create_run(&run_record("started")).unwrap();
     j.set_planner_state(RUN, &[1, 2], 10).unwrap();
-    j.record_issue(&issue("started", 1, 1, "w1", 100)).unwrap();
+    j.write_issue(&issue("started", 1, 1, "w1", 100)).unwrap();
     // A run with a trial, and one never recorded, stay as they are.
     assert!(!j.remove_unstarted_run("started").unwrap());
     assert!(!j.remove_unstarted_run("nobody").unwrap());
@@ -613,7 +613,7 @@ fn only_a_run_without_trials_is_removed_for_a_fresh_start() {
     assert!(j.remove_unstarted_run(RUN).unwrap());
     assert!(j.run(RUN).unwrap().is_none());
     assert_eq!(j.planner_state(RUN).unwrap(), None);
-    let other = RunRecord {
+    let other = RunRow {
         config_json: "{}".into(),
         param_names: vec!["x".into()],
         ..run_record(RUN)
@@ -630,8 +630,8 @@ fn a_version_1_journal_is_upgraded_in_place_with_its_trials() {
     {
         let mut j = Journal::open(&db).unwrap();
         j.create_run(&run_record(RUN)).unwrap();
-        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+        j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.write_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
     }
     // Version 1 is version 3 without the planner_state table and the forces column.
     {
@@ -667,8 +667,8 @@ fn a_journal_without_a_metric_column_gains_it_and_reads_the_metric_as_missing() 
     {
         let mut j = Journal::open(&db).unwrap();
         j.create_run(&run_record(RUN)).unwrap();
-        j.record_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
-        j.record_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
+        j.write_issue(&issue(RUN, 1, 1, "w1", 100)).unwrap();
+        j.write_result(&result(RUN, 1, 1, "w1", 200, 0.5)).unwrap();
     }
     {
         let raw = rusqlite::Connection::open(&db).unwrap();

@@ -1,8 +1,8 @@
 //! Contacts with known answers, readings written out by hand.
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, NoContact, Reading, SensedContact, SensingSettings, locate,
-    reading_of,
+    ContactKind, FingertipSurface, FingertipWrench, NoContact, SensedContact, SensingSettings,
+    locate, wrench_of,
 };
 use nalgebra::{Point3, Unit, Vector3};
 
@@ -18,14 +18,14 @@ fn sphere() -> FingertipSurface {
     }
 }
 
-fn reading(force: [f64; 3], torque: [f64; 3]) -> Reading {
-    Reading {
+fn reading(force: [f64; 3], torque: [f64; 3]) -> FingertipWrench {
+    FingertipWrench {
         force: Vector3::from(force),
         torque: Vector3::from(torque),
     }
 }
 
-fn point_contact(surface: &FingertipSurface, r: &Reading) -> SensedContact {
+fn point_contact(surface: &FingertipSurface, r: &FingertipWrench) -> SensedContact {
     match locate(surface, r, &SensingSettings::default()) {
         Ok(c) => c,
         Err(e) => panic!("no contact for {r:?}: {e}"),
@@ -33,7 +33,7 @@ fn point_contact(surface: &FingertipSurface, r: &Reading) -> SensedContact {
 }
 
 /// Asserts the contact is at `point` with outward normal `normal` and applies -force.
-fn assert_contact(c: &SensedContact, r: &Reading, point: [f64; 3], normal: [f64; 3]) {
+fn assert_contact(c: &SensedContact, r: &FingertipWrench, point: [f64; 3], normal: [f64; 3]) {
     let expected = Point3::from(point);
     assert!(
         (c.point - expected).norm() < 1e-12,
@@ -120,7 +120,7 @@ fn ellipsoid_contacts() {
     let n = Vector3::new(x / 1e-4, y / 3.6e-5, 0.0).normalize();
     let p = Vector3::new(x, y, 0.02);
     let f = -n * 2.5;
-    let r = Reading {
+    let r = FingertipWrench {
         force: f,
         torque: p.cross(&f),
     };
@@ -165,7 +165,7 @@ fn capsule_contacts_on_the_cylinder_and_each_cap() {
         ([0.006 * H, 0.0, 0.01 - 0.006 * H], [H, 0.0, -H]),
     ] {
         let f = -Vector3::from(n) * 2.0;
-        let r = Reading {
+        let r = FingertipWrench {
             force: f,
             torque: Vector3::from(p).cross(&f),
         };
@@ -175,7 +175,7 @@ fn capsule_contacts_on_the_cylinder_and_each_cap() {
     // the top cap's region.
     let p = Vector3::new(0.0, -0.006, 0.029);
     let f = Vector3::new(0.5, 2.0, -1.0);
-    let r = Reading {
+    let r = FingertipWrench {
         force: f,
         torque: p.cross(&f),
     };
@@ -193,11 +193,11 @@ fn soft_finger_recovers_a_known_torsion() {
     for t in [1.5e-3, -1.5e-3] {
         // The sensor measures the opposite of the wrench on the object.
         let force = -f;
-        let r = Reading {
+        let r = FingertipWrench {
             force,
             torque: p.cross(&force) - n * t,
         };
-        let model = reading_of(&s, &p.into(), &f, t);
+        let model = wrench_of(&s, &p.into(), &f, t);
         assert_eq!(model.force, r.force);
         assert!(
             (model.torque - r.torque).norm() < 1e-17,
@@ -261,7 +261,7 @@ fn soft_finger_torsion_on_an_ellipsoid_and_a_capsule() {
         // Normal 2 N, tangential 0.6 N along y; torsion 2 mN m.
         let f = nv * 2.0 + Vector3::new(0.0, 0.6, 0.0);
         let t = 2e-3;
-        let r = Reading {
+        let r = FingertipWrench {
             force: -f,
             torque: pv.cross(&-f) - nv * t,
         };

@@ -1,7 +1,7 @@
 //! Validation errors (each names its field), normals, and the serde forms.
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, Reading, SensedContact, SensingError, SensingSettings,
+    ContactKind, FingertipSurface, FingertipWrench, SensedContact, SensingError, SensingSettings,
     SensorNoise,
 };
 use nalgebra::{Point3, Vector3};
@@ -209,7 +209,7 @@ fn json_forms() {
     assert_eq!(settings.kind, ContactKind::SoftFinger);
     assert_eq!(settings.force_threshold, 0.05);
     assert_eq!(settings.surface_tolerance, 1e-4);
-    let r: Reading =
+    let r: FingertipWrench =
         serde_json::from_str(r#"{"force":[0,0,-2],"torque":[0.001,0,0]}"#).expect("reading");
     assert_eq!(r.force, Vector3::new(0.0, 0.0, -2.0));
     assert_eq!(r.torque, Vector3::new(0.001, 0.0, 0.0));

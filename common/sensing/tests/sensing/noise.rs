@@ -2,8 +2,8 @@
 //! 12 mm fingertip).
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, NoContact, Reading, SensingSettings, SensorNoise, locate,
-    reading_of,
+    ContactKind, FingertipSurface, FingertipWrench, NoContact, SensingSettings, SensorNoise,
+    locate, wrench_of,
 };
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -13,7 +13,7 @@ use crate::support::{angle, cone_force, surface_point};
 
 #[test]
 fn no_noise_changes_nothing() {
-    let r = Reading {
+    let r = FingertipWrench {
         force: Vector3::new(0.123456789, -1.0, 2.5),
         torque: Vector3::new(1e-7, 3e-3, -2e-5),
     };
@@ -25,7 +25,7 @@ fn no_noise_changes_nothing() {
 fn noise_is_quantised_and_of_the_resolution_size() {
     let noise = SensorNoise::default();
     let (qf, qt) = (noise.force_resolution, noise.torque_resolution);
-    let r = Reading {
+    let r = FingertipWrench {
         force: Vector3::new(1.23456, -0.5, 2.0),
         torque: Vector3::new(1.7e-3, -2.2e-4, 3e-5),
     };
@@ -72,7 +72,7 @@ fn noisy_errors(surface: &FingertipSurface, kind: ContactKind, count: usize) -> 
         let p = surface_point(surface, &mut rng);
         let n = surface.outward_normal(&p);
         let f = cone_force(&n, 0.5, 1.0, 5.0, &mut rng);
-        let r = noise.apply(&reading_of(surface, &p, &f, 0.0), &mut rng);
+        let r = noise.apply(&wrench_of(surface, &p, &f, 0.0), &mut rng);
         match locate(surface, &r, &settings) {
             Ok(c) => {
                 dp.push((c.point - p).norm());

@@ -2,7 +2,7 @@
 //! surface, above the base, and pushes.
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, NoContact, Reading, SensingSettings, locate, reading_of,
+    ContactKind, FingertipSurface, FingertipWrench, NoContact, SensingSettings, locate, wrench_of,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -50,7 +50,7 @@ fn every_contact_returned_explains_its_reading() {
                 if kind == ContactKind::Point && rng.random::<f64>() < 0.9 {
                     t -= f * (t.dot(&f) / f.norm_squared()) * (1.0 - 1e-3 * rng.random::<f64>());
                 }
-                let r = Reading {
+                let r = FingertipWrench {
                     force: f,
                     torque: t,
                 };
@@ -76,7 +76,7 @@ fn every_contact_returned_explains_its_reading() {
                 // The contact's own reading equals the measured one but for what the
                 // tolerances allow: a torque part along F up to the pitch tolerance, a
                 // grazing miss up to the surface tolerance.
-                let back = reading_of(&surface, &c.point, &c.force, c.torsion);
+                let back = wrench_of(&surface, &c.point, &c.force, c.torsion);
                 let allowed = (settings.pitch_tolerance + settings.surface_tolerance) * f.norm()
                     + 1e-12 * (1.0 + t.norm());
                 assert!(

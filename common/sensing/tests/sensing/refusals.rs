@@ -1,24 +1,24 @@
 //! Readings that admit no contact: each gives its named refusal, never a point.
 
 use graspopt_sensing::{
-    ContactKind, FingertipSurface, MIN_FORCE, NoContact, Reading, SensingError, SensingSettings,
-    locate,
+    ContactKind, FingertipSurface, FingertipWrench, MIN_FORCE, NoContact, SensingError,
+    SensingSettings, locate,
 };
 use nalgebra::{Point3, Vector3};
 
 use crate::support::angle;
 
-fn reading(force: [f64; 3], torque: [f64; 3]) -> Reading {
-    Reading {
+fn reading(force: [f64; 3], torque: [f64; 3]) -> FingertipWrench {
+    FingertipWrench {
         force: Vector3::from(force),
         torque: Vector3::from(torque),
     }
 }
 
 /// A reading of a pure force `force` whose line of action passes through `through`.
-fn force_through(force: [f64; 3], through: [f64; 3]) -> Reading {
+fn force_through(force: [f64; 3], through: [f64; 3]) -> FingertipWrench {
     let f = Vector3::from(force);
-    Reading {
+    FingertipWrench {
         force: f,
         torque: Vector3::from(through).cross(&f),
     }
@@ -91,7 +91,7 @@ fn point_contact_torsion_within_the_pitch_tolerance_is_noise_beyond_it_a_refusal
     let top = Vector3::new(0.0, 0.0, 0.018);
     let f = Vector3::new(0.0, 0.0, -2.0);
     // 0.1 mN m at 2 N: pitch 0.05 mm < 0.2 mm, taken as noise.
-    let r = Reading {
+    let r = FingertipWrench {
         force: f,
         torque: top.cross(&f) + Vector3::z() * 1e-4,
     };
@@ -99,7 +99,7 @@ fn point_contact_torsion_within_the_pitch_tolerance_is_noise_beyond_it_a_refusal
     assert!((c.point.coords - top).norm() < 1e-15, "{:?}", c.point);
     assert_eq!(c.torsion, 0.0);
     // 1 mN m at 2 N: pitch 0.5 mm, refused.
-    let r = Reading {
+    let r = FingertipWrench {
         force: f,
         torque: top.cross(&f) + Vector3::z() * 1e-3,
     };
@@ -129,7 +129,7 @@ fn a_soft_finger_torsion_beyond_the_limit_is_refused() {
     // normal force, 20 mN m is not.
     let top = Vector3::new(0.0, 0.0, 0.018);
     let f = Vector3::new(0.0, 0.0, -1.5);
-    let with_torsion = |t: f64| Reading {
+    let with_torsion = |t: f64| FingertipWrench {
         force: f,
         torque: top.cross(&f) - Vector3::z() * t,
     };

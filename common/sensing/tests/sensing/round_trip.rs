@@ -1,6 +1,6 @@
 //! Noise-free round trips: a contact through the forward model and back.
 
-use graspopt_sensing::{ContactKind, FingertipSurface, SensingSettings, locate, reading_of};
+use graspopt_sensing::{ContactKind, FingertipSurface, SensingSettings, locate, wrench_of};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -24,7 +24,7 @@ fn round_trips(surface: &FingertipSurface, kind: ContactKind, count: usize, seed
             ContactKind::Point => 0.0,
             ContactKind::SoftFinger => 2e-3 * (2.0 * rng.random::<f64>() - 1.0),
         };
-        let r = reading_of(surface, &p, &f, t);
+        let r = wrench_of(surface, &p, &f, t);
         let c = match locate(surface, &r, &settings) {
             Ok(c) => c,
             Err(e) => panic!("case {i}: point {p:?}, force {f:?}, torsion {t}: {e}"),

@@ -75,20 +75,20 @@ pub const SPREAD_MAX: f64 = std::f64::consts::PI;
 
 /// A Barrett BH8-style hand with a fixed spread angle.
 #[derive(Debug)]
-pub struct BarrettHand {
+pub struct BarrettOracle {
     spread: f64,
     links: Vec<LinkSpec>,
     geometry: LinkGeometry,
 }
 
-impl Default for BarrettHand {
+impl Default for BarrettOracle {
     /// Spread 0: F1 and F2 side by side facing F3.
     fn default() -> Self {
         Self::build(0.0)
     }
 }
 
-impl BarrettHand {
+impl BarrettOracle {
     /// A hand whose F1/F2 spread joint is at `spread` (radians, `[0, pi]`) during the grasp.
     pub fn new(spread: f64) -> Result<Self> {
         ensure_finite(&[spread], "Barrett spread angle")?;
@@ -202,7 +202,7 @@ fn turn(axis: Vector3<f64>, angle: f64) -> Isometry3<f64> {
     )
 }
 
-impl Hand for BarrettHand {
+impl Hand for BarrettOracle {
     fn name(&self) -> &str {
         "barrett"
     }

@@ -25,12 +25,12 @@ pub const MAX_TRAVEL: f64 = OPEN_HALF_WIDTH;
 
 /// A parallel-jaw gripper.
 #[derive(Debug)]
-pub struct ParallelJawGripper {
+pub struct ParallelJawOracle {
     links: Vec<LinkSpec>,
     geometry: LinkGeometry,
 }
 
-impl Default for ParallelJawGripper {
+impl Default for ParallelJawOracle {
     fn default() -> Self {
         let links = vec![
             LinkSpec {
@@ -60,7 +60,7 @@ impl Default for ParallelJawGripper {
     }
 }
 
-impl ParallelJawGripper {
+impl ParallelJawOracle {
     fn jaw(side: usize, travel: f64) -> Isometry3<f64> {
         let sign = if side == 0 { -1.0 } else { 1.0 };
         Isometry3::translation(
@@ -71,7 +71,7 @@ impl ParallelJawGripper {
     }
 }
 
-impl Hand for ParallelJawGripper {
+impl Hand for ParallelJawOracle {
     fn name(&self) -> &str {
         "parallel_jaw"
     }

@@ -4,7 +4,7 @@
 //! ([`builtin_hands`]: the Barrett BH8-280, a parallel-jaw gripper, the Franka hand) are URDF
 //! files in `common/sim/hands/`, embedded in the binary.
 //!
-//! [`BarrettHand`] and [`ParallelJawGripper`] are the same hands written in Rust; they stay as
+//! [`BarrettOracle`] and [`ParallelJawOracle`] are the same hands written in Rust; they stay as
 //! test oracles that the URDF versions must match. A hand can also be a new implementation of
 //! [`Hand`]; the public helpers here ([`LinkGeometry`], [`clear_hand`], [`advance_until_contact`],
 //! [`finish_grasp`]) do the collision work (see the `Pusher` hand in this crate's tests).
@@ -26,8 +26,8 @@ mod barrett;
 mod gripper;
 pub mod urdf;
 
-pub use barrett::BarrettHand;
-pub use gripper::ParallelJawGripper;
+pub use barrett::BarrettOracle;
+pub use gripper::ParallelJawOracle;
 pub use urdf::UrdfHand;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};

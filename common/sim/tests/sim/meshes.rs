@@ -2,7 +2,7 @@
 //! rounded apart, binary STL with a `solid` header, meshes in millimetres, and meshes with
 //! holes (a precise message, the same every time).
 
-use graspopt_sim::hand::BarrettHand;
+use graspopt_sim::hand::BarrettOracle;
 use graspopt_sim::mesh::{self, TriangleMesh};
 use graspopt_sim::pose::reference_pose;
 use graspopt_sim::{Object, SimError};
@@ -211,7 +211,7 @@ fn obj_and_stl_meshes_load_and_can_be_grasped() {
     std::fs::write(&bin_path, &bin).unwrap();
     std::fs::write(&ascii_path, &ascii).unwrap();
 
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     for path in [&obj_path, &bin_path, &ascii_path] {
         let o = Object::from_file(path).unwrap();
         let (lo, hi) = o.aabb();

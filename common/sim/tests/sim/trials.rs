@@ -3,7 +3,7 @@
 
 use graspopt_sim::contact::{ContactPoint, surface_model};
 use graspopt_sim::hand::{
-    BarrettHand, CONTACT_TOLERANCE, Hand, LinkGeometry, LinkShape, LinkSpec, ParallelJawGripper,
+    BarrettOracle, CONTACT_TOLERANCE, Hand, LinkGeometry, LinkShape, LinkSpec, ParallelJawOracle,
     advance_until_contact, clear_hand, finish_grasp, hand_by_name,
 };
 use graspopt_sim::mesh::{self, TriangleMesh};
@@ -48,7 +48,7 @@ fn point_box_distance(p: &Point3<f64>, link: &Isometry3<f64>, half: &Vector3<f64
 #[test]
 fn sphere_grasped_at_its_centre() {
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let pose = TrialSpace::approach_1d(&sphere)
         .palm_pose(&[-0.035])
         .unwrap();
@@ -124,7 +124,7 @@ fn coupled_distal(medial: f64) -> f64 {
 #[test]
 fn barrett_coupling_and_breakaway() {
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let space = TrialSpace::approach_1d(&sphere);
     // Fingertips: the sphere between the open fingertips, the distal link stops the finger
     // (coupled: medial / 3 plus the fixed 0.8727 rad bend). Farther, the open hand's bent
@@ -211,7 +211,7 @@ fn surface_model_on_a_flat_face_and_on_a_sphere() {
 #[test]
 fn parallel_jaw_on_the_cuboid_faces() {
     let cuboid = Object::by_name("cuboid").unwrap();
-    let hand = ParallelJawGripper::default();
+    let hand = ParallelJawOracle::default();
     let out = trial(&cuboid, &hand, &reference_pose(&cuboid));
     assert_eq!(out.fingers_in_contact(), 2);
     for (f, expect) in out.fingers.iter().zip([Vector3::y(), -Vector3::y()]) {
@@ -240,7 +240,7 @@ fn parallel_jaw_on_the_cuboid_faces() {
 
 #[test]
 fn every_object_is_touched_at_its_reference_pose() {
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     for name in Object::names() {
         let o = Object::by_name(name).unwrap();
         let out = trial(&o, &hand, &reference_pose(&o));
@@ -345,7 +345,7 @@ fn a_far_pose_touches_nothing() {
 #[test]
 fn a_hand_placed_inside_the_object_retreats() {
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let inside = reference_pose(&sphere) * Translation3::new(0.0, 0.0, 0.05);
     let out = trial(&sphere, &hand, &inside);
     assert!(out.grasp.retreat > 0.03, "retreat {}", out.grasp.retreat);
@@ -356,7 +356,7 @@ fn a_hand_placed_inside_the_object_retreats() {
 #[test]
 fn bad_input_gives_clear_errors() {
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let mut nan = reference_pose(&sphere);
     nan.translation.vector.x = f64::NAN;
     let e = run_trial(&sphere, &hand, &nan, &ContactModelSettings::default()).unwrap_err();
@@ -383,7 +383,7 @@ fn bad_input_gives_clear_errors() {
         ..Default::default()
     };
     assert!(run_trial(&sphere, &hand, &reference_pose(&sphere), &bad).is_err());
-    assert!(BarrettHand::new(4.0).is_err());
+    assert!(BarrettOracle::new(4.0).is_err());
     assert!(hand.link_poses(&[0.0; 3]).is_err());
     assert!(sphere.clone().with_pose(nan).is_err());
 }
@@ -419,7 +419,7 @@ fn a_non_convex_user_mesh_works_through_the_mesh_path() {
         m.triangles.push([i, n + j, n + i]);
     }
     let o = Object::from_mesh("l_prism", m).unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let out = trial(&o, &hand, &reference_pose(&o));
     assert!(out.fingers_in_contact() >= 2);
     assert!(out.grasp.link_distances.iter().all(|d| *d > 0.0));
@@ -428,7 +428,7 @@ fn a_non_convex_user_mesh_works_through_the_mesh_path() {
 #[test]
 fn noise_is_seeded_and_keeps_normals_unit() {
     let mug = Object::by_name("mug").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let pose = reference_pose(&mug);
     let noisy = |seed| ContactModelSettings {
         noise: Some(NoiseSettings {
@@ -465,7 +465,7 @@ fn each_contact_model_keeps_its_noise_stream() {
     // Finger f's model with noise key k draws from stream 3 (f + 1) + k, as before the models
     // were registered: the noisy outputs of earlier versions stay the same.
     let mug = Object::by_name("mug").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let pose = reference_pose(&mug);
     let noise = NoiseSettings {
         position_std: 5e-4,
@@ -494,7 +494,7 @@ fn each_contact_model_keeps_its_noise_stream() {
 #[test]
 fn scene_meshes_and_json() {
     let mug = Object::by_name("mug").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let out = trial(&mug, &hand, &reference_pose(&mug));
     let meshes = scene::scene_meshes(&mug, &hand, &out.grasp).unwrap();
     assert_eq!(meshes.len(), 1 + hand.links().len());
@@ -511,7 +511,7 @@ fn scene_meshes_and_json() {
 #[test]
 fn knuckle_posts_join_the_barrett_palm_to_each_finger() {
     let mug = Object::by_name("mug").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let out = trial(&mug, &hand, &reference_pose(&mug));
     let posts = scene::knuckle_posts(&hand, &out.grasp);
     // One post per finger, each a closed cylinder standing on the palm's top face.
@@ -548,7 +548,7 @@ fn knuckle_posts_join_the_barrett_palm_to_each_finger() {
 #[test]
 fn two_dimensional_space_covers_touching_and_empty_trials() {
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let space = TrialSpace::approach_vertical_2d(&sphere);
     let (lo, hi) = (space.params[1].lower, space.params[1].upper);
     let mut touched = 0;
@@ -676,7 +676,7 @@ fn a_new_hand_is_a_new_impl() {
 #[test]
 fn barrett_with_spread_closes_without_penetrating() {
     for spread in [std::f64::consts::FRAC_PI_2, std::f64::consts::PI] {
-        let hand = BarrettHand::new(spread).unwrap();
+        let hand = BarrettOracle::new(spread).unwrap();
         for name in ["cylinder", "sphere", "mug"] {
             let o = Object::by_name(name).unwrap();
             let out = trial(&o, &hand, &reference_pose(&o));
@@ -702,7 +702,7 @@ fn sphere_approach_scan_spans_empty_fingertip_and_wrapping_grasps() {
     // fingers close on the sphere from -0.04 on, once it lies inside the open fingertips: 60 mm
     // of the range on this 5 mm grid (more than 100 mm with straight fingers).
     let sphere = Object::by_name("sphere").unwrap();
-    let hand = BarrettHand::default();
+    let hand = BarrettOracle::default();
     let space = TrialSpace::approach_1d(&sphere);
     let (lo, hi) = (space.params[0].lower, space.params[0].upper);
     let n = 37;

@@ -2,7 +2,7 @@
 //! computation's one setting, and the star prism's approach scan has no period tied to it.
 
 use graspopt_sim::contact::DEFAULT_RESOLUTION;
-use graspopt_sim::{BarrettHand, Object, TrialSpace};
+use graspopt_sim::{BarrettOracle, Object, TrialSpace};
 use graspopt_trial::Evaluator;
 use graspopt_trial::scan::{ScanPoint, grid_axes, scan_grid};
 
@@ -13,7 +13,7 @@ fn scan(object: &str, two_d: bool, steps: &[usize], resolution: f64) -> Vec<Scan
     } else {
         TrialSpace::approach_1d(&object)
     };
-    let mut ev = Evaluator::new(object, Box::new(BarrettHand::default()), space);
+    let mut ev = Evaluator::new(object, Box::new(BarrettOracle::default()), space);
     ev.contacts.cloud.resolution = resolution;
     let axes = grid_axes(&ev.space.bounds(), steps);
     scan_grid(&ev, &axes, 0, &|_| {}).unwrap()

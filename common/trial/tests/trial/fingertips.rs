@@ -5,7 +5,7 @@ use graspopt_sensing::{SensingSettings, SensorNoise};
 use graspopt_sim::hand::hand_by_name;
 use graspopt_sim::{Object, TrialSpace};
 use graspopt_trial::fingertips::{
-    FingertipSettings, SimulatedFingertip, fingertips, sense, simulate_readings,
+    FingertipSettings, SimulatedFingertip, fingertips, sense, simulate_wrenches,
 };
 use graspopt_trial::forces::ForceSettings;
 use graspopt_trial::{Evaluation, Evaluator, ScoreSettings};
@@ -19,7 +19,7 @@ fn readings(
     settings: &FingertipSettings,
     rng: &mut ChaCha8Rng,
 ) -> Vec<SimulatedFingertip> {
-    simulate_readings(
+    simulate_wrenches(
         &e.outcome,
         ev.hand.as_ref(),
         &ev.object,
