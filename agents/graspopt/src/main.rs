@@ -24,7 +24,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Grasp-quality metrics (rank, force closure, epsilon, volume, distance, BW) of the
+    /// Grasp-quality metrics (rank, force closure, epsilon, volume, distance, BW, isotropy) of the
     /// cases in a JSON file.
     Quality(commands::quality::QualityArgs),
     /// Run one simulated trial and print its contacts and metrics.

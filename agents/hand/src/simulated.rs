@@ -41,7 +41,7 @@ impl SimulatedHand {
                 HandAgentError::Sensing { context, source }
             };
             fingertips(hand.as_ref())
-                .map_err(|e| sensing("hand agent with --sensing ft", e.into()))?;
+                .map_err(|e| sensing("hand agent with sensing = ft", e.into()))?;
             let noise = &config.fingertips.noise;
             noise
                 .validate()

@@ -69,6 +69,8 @@ pub struct AgentRow {
     /// Reads its settings as `run` would, to refuse them before anything starts (a launch
     /// file's processes).
     pub check: fn(&Standalone) -> Result<(), RunnerError>,
+    /// The keys of its settings (top level, as `--set` and its TOML file name them).
+    pub keys: fn() -> Vec<String>,
     pub run: for<'a> fn(&'a Standalone) -> Served<'a>,
 }
 
@@ -78,6 +80,7 @@ const fn row<A: Agent>(run: for<'a> fn(&'a Standalone) -> Served<'a>) -> AgentRo
         kind: A::KIND,
         about: A::ABOUT,
         check: |s| settings::<A>(s).map(drop),
+        keys: crate::config::keys::<A::Config>,
         run,
     }
 }
@@ -213,6 +216,6 @@ mod tests {
             "{e}"
         );
         assert!(err("sensing=sonar").contains("--set sensing=sonar: unknown variant"));
-        assert!(err("trial_cost_ms").contains("write it as key=value"));
+        assert!(err("trial_cost_ms").contains("\"trial_cost_ms\": write it as KEY=VALUE"));
     }
 }

@@ -59,6 +59,15 @@ pub fn load_with<T: DeserializeOwned + Serialize + Default>(
     Ok(serde_json::from_value(value)?)
 }
 
+/// The top-level keys of settings `T`, as its TOML file and `--set` name them (a table's
+/// keys are `table.key`).
+pub fn keys<T: Serialize + Default>() -> Vec<String> {
+    match serde_json::to_value(T::default()) {
+        Ok(serde_json::Value::Object(keys)) => keys.keys().cloned().collect(),
+        _ => Vec::new(),
+    }
+}
+
 /// `value` (the settings as JSON) with `set` (`key=value`) applied; checked against the
 /// settings' type.
 fn apply_set<T: DeserializeOwned>(
@@ -66,15 +75,14 @@ fn apply_set<T: DeserializeOwned>(
     known: &serde_json::Value,
     set: &str,
 ) -> Result<serde_json::Value> {
-    let (key, text) = set.split_once('=').unwrap_or((set, ""));
+    let Some((key, text)) = set.split_once('=') else {
+        return Err(RunnerError::SetWithoutValue(set.to_string()));
+    };
     let refused = |why: String| RunnerError::Set {
         key: key.to_string(),
         value: text.to_string(),
         why,
     };
-    if !set.contains('=') {
-        return Err(refused("write it as key=value".into()));
-    }
     let path: Vec<&str> = key.trim().split('.').collect();
     let mut table = known;
     for (i, part) in path.iter().enumerate() {

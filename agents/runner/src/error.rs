@@ -122,6 +122,9 @@ pub enum RunnerError {
         place: String,
         keys: String,
     },
+    /// A `--set` without `=`.
+    #[error("--set {0:?}: write it as KEY=VALUE (docs/agent-config.md)")]
+    SetWithoutValue(String),
     /// A `--set key=value` that does not fit the settings.
     #[error("--set {key}={value}: {why}")]
     Set {

@@ -38,7 +38,7 @@ pub struct Common {
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// One setting, over the settings file: KEY=VALUE, a dotted key for a key of a table
-    /// (`--set trial_cost_ms=200`, `--set forces.object_mass=0.3`); repeatable.
+    /// (`--set table.key=value`); repeatable. The keys are listed below.
     #[arg(long, value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Agent id (unique per run and kind).
@@ -57,7 +57,11 @@ impl Args for AgentArgs {
                 _ => sub,
             };
             // After the flags: a flattened struct's doc comment would be its description.
-            sub.about(row.about).long_about(None)
+            let keys = (row.keys)().join(", ");
+            let settings = format!(
+                "Settings (--set KEY=VALUE, or in --config FILE; docs/agent-config.md): {keys}"
+            );
+            sub.about(row.about).long_about(None).after_help(settings)
         });
         cmd.subcommands(kinds).subcommand_required(true)
     }

@@ -32,7 +32,7 @@ pub struct SimArgs {
     /// Contact model: surface (thesis 2.3), patch (circular patch) or mean (mean point).
     #[arg(long, default_value = "surface", value_parser = contact_model())]
     pub contacts: ContactModel,
-    /// Metric scored: bw, epsilon (ls) or volume (gwv).
+    /// Metric scored: bw, epsilon (ls), volume (gwv) or isotropy (docs/metric-conventions.md).
     #[arg(long, default_value = "bw", value_parser = metric())]
     pub metric: Metric,
     /// Reference point for torques: object (centre of mass), world or palm.
@@ -89,14 +89,11 @@ pub fn contact_model() -> impl TypedValueParser<Value = ContactModel> {
         .try_map(|s| ContactModel::parse(&s))
 }
 
-/// `--metric`: the scored metrics, with their short names as aliases.
+/// `--metric`: the metrics that may be the score (the metric table's objectives), with
+/// their short names as aliases.
 fn metric() -> impl TypedValueParser<Value = Metric> {
-    PossibleValuesParser::new([
-        PossibleValue::new("bw"),
-        PossibleValue::new("epsilon").alias("ls"),
-        PossibleValue::new("volume").alias("gwv"),
-    ])
-    .try_map(|s| Metric::parse(&s))
+    let values = Metric::objectives().map(|m| PossibleValue::new(m.key()).aliases(m.def().aliases));
+    PossibleValuesParser::new(values).try_map(|s| Metric::parse(&s))
 }
 
 /// `--frame`: the named reference frames.

@@ -29,6 +29,19 @@ fn trial_prints_contacts_and_metrics() {
     );
 }
 
+/// Every objective of the metric table is a `--metric` (the isotropy index was refused by the
+/// flag's own list while the metric agents scored by it).
+#[test]
+fn trial_scores_by_the_isotropy_index() {
+    let out = graspopt_ok(&[
+        "trial", "--object", "sphere", "--at", "x=0.01", "--metric", "isotropy", "--format", "json",
+    ]);
+    let e: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let isotropy = e["metrics"]["isotropy"].as_f64().unwrap();
+    assert!(isotropy > 0.0 && isotropy <= 1.0, "{e}");
+    assert_eq!(e["score"], e["metrics"]["isotropy"]);
+}
+
 #[test]
 fn trial_bad_input_is_named() {
     // Exit code 1: the value was parsed, and refused by the library; 2: a choice among names,
@@ -59,7 +72,7 @@ fn trial_bad_input_is_named() {
         (
             vec!["trial", "--metric", "area"],
             2,
-            "[possible values: bw, epsilon, volume]",
+            "[possible values: bw, epsilon, volume, isotropy]",
         ),
         (
             vec!["trial", "--contacts", "blob"],
