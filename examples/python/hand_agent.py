@@ -26,7 +26,7 @@ import time
 
 import zenoh
 
-WIRE_VERSION = 3  # every payload carries it; a mismatch is refused
+WIRE_VERSION = 4  # every payload carries it; a mismatch is refused
 
 
 def load_recording(path, check=None):

@@ -254,3 +254,22 @@ fn the_docs_count_the_message_types_of_the_key_table() {
         assert_eq!(n, types.len(), "{name} counts {n} message types: {types:?}");
     }
 }
+
+/// The Python hand agents (examples/python, outside cargo's reach) stamp every payload with
+/// the wire version: it must be the protocol's, or every message they send is refused (wire
+/// version 4 came with the metric table, and the Python hands were left at 3).
+#[test]
+fn the_python_hand_agents_speak_the_protocols_wire_version() {
+    let path = repo_root().join("examples/python/hand_agent.py");
+    let text = fs::read_to_string(&path).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("WIRE_VERSION = "))
+        .unwrap_or_else(|| panic!("{} sets no WIRE_VERSION", path.display()));
+    let version: u16 = line["WIRE_VERSION = ".len()..]
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert_eq!(version, graspopt_protocol::WIRE_VERSION, "{}", path.display());
+}
