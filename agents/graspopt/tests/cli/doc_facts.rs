@@ -271,5 +271,10 @@ fn the_python_hand_agents_speak_the_protocols_wire_version() {
         .next()
         .and_then(|v| v.parse().ok())
         .unwrap_or_else(|| panic!("{line}"));
-    assert_eq!(version, graspopt_protocol::WIRE_VERSION, "{}", path.display());
+    assert_eq!(
+        version,
+        graspopt_protocol::WIRE_VERSION,
+        "{}",
+        path.display()
+    );
 }
