@@ -1,10 +1,9 @@
 use graspopt_bus::{AliveEvent, BusError};
 use graspopt_protocol::keys::AliveKey;
 use graspopt_protocol::{
-    AgentKind, Encoding, ObjectEstimate, PlannerMethod, Pose, RunId, SuggestReply, SuggestRequest,
-    TrialResult, WaitReason,
+    AgentKind, Encoding, ObjectEstimate, Pose, RunId, SuggestReply, SuggestRequest, TrialResult,
+    WaitReason,
 };
-use graspopt_sim::ParamKind;
 
 use super::*;
 use crate::core::planner::PLANNER_RETRY_MS;
@@ -14,17 +13,7 @@ const LEASE: i64 = 1_000;
 /// A coordinator of run `r` (`trials` trials, one parameter), its object estimate in, a
 /// metric agent alive, and hands `workers`.
 fn coordinator(trials: u64, workers: &[&str]) -> Coordinator {
-    let spec = RunSpec {
-        object: "sphere".into(),
-        hand: "barrett".into(),
-        params: vec![ParamKind::Approach],
-        bounds: None,
-        trials,
-        seed: 1,
-        method: PlannerMethod::Random,
-        initial: None,
-        settings: None,
-    };
+    let spec = crate::spec::tests::spec(trials);
     let run = RunId::new("r").unwrap();
     let mut c = Coordinator::new(&run, spec, RunState::new(trials), None, LEASE as u64, 0);
     c.handle(

@@ -104,4 +104,4 @@ pub fn param_names(spec: &RunSpec) -> Vec<String> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

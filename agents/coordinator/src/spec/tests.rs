@@ -5,7 +5,8 @@ use graspopt_sim::Object;
 use super::*;
 use crate::state::Disposition;
 
-fn spec(trials: u64) -> RunSpec {
+/// A one-parameter run of `trials` random trials on the sphere (the crate's test run).
+pub(crate) fn spec(trials: u64) -> RunSpec {
     RunSpec {
         object: "sphere".into(),
         hand: "barrett".into(),

@@ -18,6 +18,8 @@ use crate::error::{Problem, ValidationError};
 pub const MAX_METRICS: usize = 64;
 /// At most this many bytes in a metric's key.
 pub const MAX_METRIC_KEY: usize = 64;
+// The validation's texts say both limits in words (`Problem` holds static text).
+const _: () = assert!(MAX_METRICS == 64 && MAX_METRIC_KEY == 64);
 
 /// One metric's value: a count, a flag or a real number.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
